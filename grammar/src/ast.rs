@@ -356,6 +356,8 @@ pub enum Condition {
     Pattern(Pattern),
     /// No agent's latest event matches; the span covers `not`.
     Not { pattern: Pattern, span: Span },
+    /// `stale AGENT` (or, `negated`, `not stale AGENT`).
+    Stale { agent: Ident, negated: bool, span: Span },
 }
 
 impl Condition {
@@ -363,7 +365,7 @@ impl Condition {
         match self {
             Condition::State(s) => s.span,
             Condition::Pattern(p) => p.span,
-            Condition::Not { span, .. } => *span,
+            Condition::Not { span, .. } | Condition::Stale { span, .. } => *span,
         }
     }
 }
@@ -606,6 +608,8 @@ pub enum Predicate {
     State(StateTest),
     Mode { agent: Ident, mode: Mode, span: Span },
     Link { from: Ident, to: Ident, span: Span },
+    /// `stale LADAR`.
+    Stale { agent: Ident, span: Span },
     /// The latest event of its agent matches.
     Event(Pattern),
 }
@@ -616,7 +620,7 @@ impl Predicate {
             Predicate::Or(_, s) | Predicate::And(_, s) | Predicate::Not(_, s) => *s,
             Predicate::Bool(_, s) => *s,
             Predicate::State(t) => t.span,
-            Predicate::Mode { span, .. } | Predicate::Link { span, .. } => *span,
+            Predicate::Mode { span, .. } | Predicate::Link { span, .. } | Predicate::Stale { span, .. } => *span,
             Predicate::Event(p) => p.span,
         }
     }

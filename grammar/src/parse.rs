@@ -221,6 +221,7 @@ fn describe(r: Rule) -> Option<&'static str> {
         Rule::condition | Rule::cond_term => "a condition",
         Rule::pattern => "an event pattern",
         Rule::state_test => "a state test (`state == S`)",
+        Rule::stale_test => "a staleness test (`stale AGENT`)",
         Rule::constraint => "a field constraint",
         Rule::cmp_op => "a comparison (`<`, `==`, ...)",
         Rule::range_op => "`..` or `..=`",
@@ -597,6 +598,18 @@ impl Builder<'_> {
         let inner = pair.into_inner().next()?;
         Some(match inner.as_rule() {
             Rule::state_test => Condition::State(self.state_test(inner)?),
+            Rule::stale_test => {
+                let span = self.span(&inner);
+                let mut negated = false;
+                let mut agent = None;
+                for p in inner.into_inner() {
+                    match p.as_rule() {
+                        Rule::not_kw => negated = true,
+                        _ => agent = Some(self.ident(p)),
+                    }
+                }
+                Condition::Stale { agent: agent?, negated, span }
+            }
             Rule::negation => {
                 let span = self.span(&inner);
                 Condition::Not { pattern: self.pattern(inner.into_inner().next()?)?, span }
@@ -865,6 +878,7 @@ impl Builder<'_> {
                     Rule::predicate => self.predicate(a),
                     Rule::boolean => Some(Predicate::Bool(a.as_str() == "true", aspan)),
                     Rule::state_test => Some(Predicate::State(self.state_test(a)?)),
+                    Rule::atom_stale => Some(Predicate::Stale { agent: self.ident(a.into_inner().next()?), span: aspan }),
                     Rule::atom_link => {
                         let mut i = a.into_inner();
                         let from = self.ident(i.next()?);
