@@ -1,1 +1,106 @@
+//! The situ compiler: from source files to a checked [`Model`] and a list of
+//! diagnostics.
+//!
+//! The pipeline is one function, [`check`], of named hand-offs:
+//! ```text
+//! load (read, decode, parse every file, follow includes)   -> Loaded
+//! resolve (names, types, tables, FSMs, tests, properties)   -> Model + diagnostics
+//! allow (attributes mark the warnings they silence)          -> diagnostics
+//! ```
+//! The crate does no I/O of its own: files come through a [`Loader`]
+//! ([`loader::FsLoader`] for the file system, [`loader::MemLoader`] for tests).
+//!
+//! ```
+//! use situ_compiler::{check_source, codes};
+//!
+//! let ok = check_source("ok.situ", "states { IT initial RD }\n\
+//!     agent Ready sensor { event RDY }\n\
+//!     rule ready { when state == IT and RDY then RD }");
+//! assert!(ok.diagnostics.is_empty());
+//! assert_eq!(ok.model.rules[0].name, "ready");
+//!
+//! let bad = check_source("bad.situ", "states { IT initial }\nrule r { when RDY then RD }");
+//! let found: Vec<&str> = bad.diagnostics.iter().map(|d| d.code).collect();
+//! assert_eq!(found, [codes::UNDEFINED_EVENT, codes::UNDEFINED_STATE]);
+//! ```
 
+pub mod codes;
+pub mod load;
+pub mod loader;
+pub mod model;
+pub mod render;
+pub mod checks;
+mod resolve;
+pub mod source;
+
+pub use load::RootError;
+pub use loader::Loader;
+pub use model::Model;
+pub use situ_grammar::diag::{Diagnostic, FileId, Severity};
+pub use source::SourceMap;
+
+use std::path::Path;
+
+/// The result of checking one root file and its includes.
+#[derive(Debug, Clone)]
+pub struct Checked {
+    pub sources: SourceMap,
+    /// Complete when there is no error; otherwise what could be resolved.
+    pub model: Model,
+    /// Every finding, sorted by file and place; allowed ones included.
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+impl Checked {
+    /// The findings to show: all but the allowed ones.
+    pub fn visible(&self) -> impl Iterator<Item = &Diagnostic> {
+        self.diagnostics.iter().filter(|d| !d.allowed)
+    }
+
+    pub fn errors(&self) -> usize {
+        self.visible().filter(|d| d.severity == Severity::Error).count()
+    }
+
+    pub fn warnings(&self) -> usize {
+        self.visible().filter(|d| d.severity == Severity::Warning).count()
+    }
+
+    /// Whether the findings fail the check (errors, or with `deny_warnings` any warning).
+    pub fn fails(&self, deny_warnings: bool) -> bool {
+        self.errors() > 0 || (deny_warnings && self.warnings() > 0)
+    }
+}
+
+/// Checks `root` and every file it includes.
+pub fn check(root: &Path, loader: &dyn Loader) -> Result<Checked, RootError> {
+    let loaded = load::load(root, loader)?;
+    Ok(check_loaded(loaded))
+}
+
+/// Checks a source given as text; includes are not available.
+pub fn check_source(name: &str, text: &str) -> Checked {
+    check_loaded(load::load_text(name, text, &loader::MemLoader::new()))
+}
+
+/// Codes that only say a name is missing: after a syntax error the name may
+/// well be declared in the item that failed to parse, so these are not shown.
+const NAME_CODES: &[&str] = &[
+    codes::UNDEFINED_STATE,
+    codes::UNDEFINED_AGENT,
+    codes::UNDEFINED_EVENT,
+    codes::UNDEFINED_FUNCTION,
+    codes::UNDEFINED_FIELD,
+    codes::INITIAL_STATE,
+    codes::NEVER_STALE,
+];
+
+fn check_loaded(loaded: load::Loaded) -> Checked {
+    let load::Loaded { sources, files, mut diagnostics } = loaded;
+    let syntax_failed = !diagnostics.is_empty();
+    let (model, found) = resolve::resolve(&files);
+    diagnostics.extend(found.into_iter().filter(|d| !(syntax_failed && NAME_CODES.contains(&d.code))));
+    diagnostics.sort_by(|a, b| {
+        (a.primary.file, a.primary.span.start, a.code).cmp(&(b.primary.file, b.primary.span.start, b.code))
+    });
+    Checked { sources, model, diagnostics }
+}

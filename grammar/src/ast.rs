@@ -572,6 +572,8 @@ pub enum Quantifier {
 }
 
 /// The body of a property.
+// One per property: the size of the variants does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub enum Formula {
     /// A predicate that must hold (or never hold) after every event.

@@ -219,7 +219,7 @@ fn describe(r: Rule) -> Option<&'static str> {
         Rule::trigger => "a trigger (`state == S` or an event)",
         Rule::salience => "`salience`",
         Rule::condition | Rule::cond_term => "a condition",
-        Rule::pattern => "an event pattern",
+        Rule::pattern | Rule::prop_pattern => "an event pattern",
         Rule::state_test => "a state test (`state == S`)",
         Rule::stale_test => "a staleness test (`stale AGENT`)",
         Rule::constraint => "a field constraint",

@@ -1,0 +1,119 @@
+use super::domain::Domain;
+use super::situation::Situation;
+use crate::check_source;
+use crate::model::{Type, Value};
+use situ_grammar::ast::CmpOp;
+
+fn real(op: CmpOp, v: f64) -> Domain {
+    Domain::of_comparison(&Type::F64, op, Value::F64(v))
+}
+
+#[test]
+fn open_and_closed_ends_meet_exactly() {
+    assert!(real(CmpOp::Lt, 30.0).intersect(&real(CmpOp::Ge, 30.0)).is_empty());
+    assert!(!real(CmpOp::Le, 30.0).intersect(&real(CmpOp::Ge, 30.0)).is_empty());
+    assert!(real(CmpOp::Lt, 30.0).intersect(&real(CmpOp::Gt, 30.0)).is_empty());
+    let ne = real(CmpOp::Ne, 5.0);
+    assert!(ne.intersect(&real(CmpOp::Eq, 5.0)).is_empty());
+    assert!(!ne.intersect(&real(CmpOp::Ge, 5.0)).is_empty());
+}
+
+#[test]
+fn nan_satisfies_no_comparison_but_escapes_them() {
+    let full = Domain::full(&Type::F64);
+    let nan_only = full.subtract(&real(CmpOp::Lt, 1.0)).subtract(&real(CmpOp::Ge, 1.0));
+    assert!(!nan_only.is_empty(), "NaN is neither < 1 nor >= 1");
+    assert!(nan_only.intersect(&real(CmpOp::Ne, 1.0)).is_empty(), "NaN is not even != 1");
+    assert!(real(CmpOp::Lt, f64::NAN).is_empty());
+}
+
+#[test]
+fn integers_are_discrete() {
+    let lt = Domain::of_comparison(&Type::I64, CmpOp::Lt, Value::I64(3));
+    let gt = Domain::of_comparison(&Type::I64, CmpOp::Gt, Value::I64(2));
+    assert!(lt.intersect(&gt).is_empty(), "no integer is > 2 and < 3");
+    let ge = Domain::of_comparison(&Type::I64, CmpOp::Ge, Value::I64(i64::MAX));
+    assert_eq!(ge.sample(&Type::I64), Some(serde_json::json!(i64::MAX)));
+}
+
+#[test]
+fn symbols_subtract() {
+    let ty = Type::Symbols(vec!["left".into(), "right".into()]);
+    let left = Domain::of_comparison(&ty, CmpOp::Eq, Value::Symbol(0));
+    let rest = Domain::full(&ty).subtract(&left);
+    assert_eq!(rest.sample(&ty), Some(serde_json::json!("right")));
+    assert!(rest.subtract(&Domain::of_comparison(&ty, CmpOp::Eq, Value::Symbol(1))).is_empty());
+}
+
+const STACK: &str = "states { IT initial RS RO }
+agent LADAR sensor {
+    stale after 200ms
+    event LAOBS { distance: f64, side: {left, right} }
+    event LAOBN
+}
+agent GPS sensor { stale after 1s event FIX { error: f64 } }
+";
+
+fn rules(body: &str) -> crate::Checked {
+    let c = check_source("t.situ", &format!("{STACK}{body}"));
+    assert!(c.diagnostics.is_empty(), "{:?}", c.diagnostics);
+    c
+}
+
+#[test]
+fn two_events_of_one_agent_never_hold_together() {
+    let c = rules("rule a { when LAOBS and LAOBN then RO }");
+    let err = Situation::of_rule(&c.model, &c.model.rules[0]).unwrap_err();
+    assert!(err.reason.contains("one latest event"), "{}", err.reason);
+    assert_eq!(err.origins.len(), 2);
+}
+
+#[test]
+fn rules_meet_on_overlapping_ranges_only() {
+    let c = rules(
+        "rule near { when LAOBS(distance < 30.0) then RO }
+         rule far { when LAOBS(distance >= 30.0) then RS }
+         rule edge { when LAOBS(distance <= 30.0, side == left) then RS }",
+    );
+    let m = &c.model;
+    let sit = |i: usize| Situation::of_rule(m, &m.rules[i]).unwrap();
+    assert!(sit(0).meet(m, &sit(1)).is_err());
+    let both = sit(1).meet(m, &sit(2)).unwrap().witness(m).unwrap();
+    assert_eq!(both.json["facts"][0]["payload"]["distance"], 30.0);
+    assert_eq!(both.json["facts"][0]["payload"]["side"], "left");
+    assert!(!both.widened);
+}
+
+#[test]
+fn negations_are_escaped_or_refuted() {
+    let c = rules(
+        "rule a { when LAOBS(distance < 10.0) and not LAOBS(distance < 20.0) then RO }
+         rule b { when LAOBS(distance < 30.0) and not LAOBS(distance < 20.0) then RO }
+         rule c { when LAOBS x2 and not LAOBS x3 then RO }
+         rule d { when stale GPS and not FIX then RO }
+         rule e { when stale GPS and FIX then RO }",
+    );
+    let m = &c.model;
+    let witness = |i: usize| Situation::of_rule(m, &m.rules[i]).and_then(|s| s.witness(m));
+    assert!(witness(0).is_err());
+    let b = witness(1).unwrap();
+    assert_eq!(b.json["facts"][0]["payload"]["distance"], 20.0);
+    let c3 = witness(2).unwrap();
+    assert_eq!(c3.json["facts"][0]["run"], 2);
+    assert!(witness(3).is_ok());
+    assert!(witness(4).is_err());
+}
+
+#[test]
+fn variables_widen_instead_of_guessing() {
+    let c = rules("rule v { when LAOBS(distance: ?d) and FIX(error > ?d) then RO }");
+    let w = Situation::of_rule(&c.model, &c.model.rules[0]).unwrap().witness(&c.model).unwrap();
+    assert!(w.widened);
+}
+
+#[test]
+fn witnesses_read_like_events() {
+    let c = rules("rule w { when state == RS and LAOBS(distance in 0.0..12.0, side == right) x3 then RO }");
+    let w = Situation::of_rule(&c.model, &c.model.rules[0]).unwrap().witness(&c.model).unwrap();
+    assert_eq!(w.describe(), "state RS with LAOBS(distance: 0.0, side: right) x3");
+}

@@ -1,0 +1,105 @@
+//! The central registry of diagnostic codes. Every finding the compiler can
+//! report has an entry here with its severity, a one-line title, and the long
+//! text `situ explain` prints (one Markdown file per code in `docs/codes/`).
+
+use situ_grammar::diag::Severity;
+
+/// One diagnostic code.
+#[derive(Debug, Clone, Copy)]
+pub struct Code {
+    /// `E0101`; shown to users as `situ::E0101`.
+    pub code: &'static str,
+    pub severity: Severity,
+    /// A short title.
+    pub title: &'static str,
+    /// The long text: What it does / Why is this bad / Example / Use instead.
+    pub explain: &'static str,
+}
+
+macro_rules! codes {
+    ($( $konst:ident = $code:literal, $sev:ident, $title:literal; )*) => {
+        $(
+            #[doc = $title]
+            pub const $konst: &str = $code;
+        )*
+        /// Every code, in order.
+        pub const ALL: &[Code] = &[
+            $( Code {
+                code: $code,
+                severity: Severity::$sev,
+                title: $title,
+                explain: include_str!(concat!("../docs/codes/", $code, ".md")),
+            }, )*
+        ];
+    };
+}
+
+codes! {
+    SYNTAX = "E0001", Error, "syntax error";
+    NOT_UTF8 = "E0002", Error, "the file is not UTF-8 text";
+    INCLUDE_NOT_FOUND = "E0003", Error, "included file cannot be read";
+    INCLUDE_CYCLE = "E0004", Error, "include cycle";
+    TOO_DEEP = "E0006", Error, "nesting too deep";
+    BAD_LITERAL = "E0007", Error, "literal out of range";
+    TOO_MANY_ERRORS = "E0008", Error, "too many syntax errors";
+    UNDEFINED_STATE = "E0101", Error, "undefined state";
+    DUPLICATE = "E0102", Error, "duplicate definition";
+    UNDEFINED_AGENT = "E0103", Error, "undefined agent";
+    UNDEFINED_EVENT = "E0104", Error, "undefined event";
+    UNDEFINED_FUNCTION = "E0105", Error, "undefined function";
+    UNDEFINED_FIELD = "E0106", Error, "undefined payload field";
+    INITIAL_STATE = "E0107", Error, "not exactly one initial state";
+    UNBOUND_VARIABLE = "E0108", Error, "unbound variable";
+    UNDEFINED_FSM_STATE = "E0109", Error, "undefined FSM state";
+    FOREIGN_TRIGGER = "E0110", Error, "FSM triggered by another agent's event";
+    BAD_ALLOW = "E0111", Error, "bad code in allow";
+    CONFLICTING_MEMBERS = "E0112", Error, "conflicting agent members";
+    MISSING_FIELD = "E0113", Error, "test event without every payload field";
+    NEVER_STALE = "E0114", Error, "stale test on an agent that never goes stale";
+    FSM_INITIAL = "E0115", Error, "not exactly one initial FSM state";
+    SELF_LINK = "E0116", Error, "agent links to itself";
+    TYPE_MISMATCH = "E0201", Error, "type mismatch";
+    UNKNOWN_SYMBOL = "E0202", Error, "unknown symbol";
+    BAD_OPERATOR = "E0203", Error, "operator does not apply to this type";
+    ZERO = "E0204", Error, "zero count or length";
+    VARIABLE_TYPE = "E0205", Error, "variable used with incompatible types";
+}
+
+/// Looks a code up, with or without its `situ::` prefix, in any case.
+pub fn lookup(code: &str) -> Option<&'static Code> {
+    let code = code.strip_prefix("situ::").unwrap_or(code);
+    ALL.iter().find(|c| c.code.eq_ignore_ascii_case(code))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parser_codes_are_registered() {
+        use situ_grammar::parse;
+        for code in [parse::SYNTAX, parse::TOO_DEEP, parse::BAD_LITERAL, parse::TOO_MANY_ERRORS] {
+            assert!(lookup(code).is_some(), "{code} is not in the registry");
+        }
+    }
+
+    #[test]
+    fn every_code_is_unique_and_documented() {
+        let mut seen = std::collections::BTreeSet::new();
+        for c in ALL {
+            assert!(seen.insert(c.code), "{} twice", c.code);
+            assert!(c.explain.starts_with(&format!("# {}", c.code)), "{}: doc must start with its code", c.code);
+            for section in ["## What it does", "## Why is this bad", "## Example", "## Use instead"] {
+                assert!(c.explain.contains(section), "{}: missing `{section}`", c.code);
+            }
+            let expected_sev = if c.code.starts_with('W') { Severity::Warning } else { Severity::Error };
+            assert_eq!(c.severity, expected_sev, "{}: the letter of a code is its severity", c.code);
+        }
+    }
+
+    #[test]
+    fn lookup_accepts_prefix_and_case() {
+        assert_eq!(lookup("situ::e0101").map(|c| c.code), Some("E0101"));
+        assert!(lookup("E9999").is_none());
+    }
+}

@@ -1,0 +1,140 @@
+//! Reading a root file and everything it includes: decoding, parsing, and the
+//! include graph (relative paths, each file once, cycles refused).
+
+use crate::codes;
+use crate::loader::Loader;
+use crate::source::{SourceFile, SourceMap};
+use situ_grammar::ast::{File, Item, Span};
+use situ_grammar::diag::{Diagnostic, FileId};
+use std::path::{Path, PathBuf};
+
+/// Every file of one compilation, parsed.
+#[derive(Debug, Clone, Default)]
+pub struct Loaded {
+    pub sources: SourceMap,
+    /// The parsed files, each after the files it includes (the root last), so
+    /// that items are in declaration order: an include stands for its items.
+    pub files: Vec<(FileId, File)>,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+/// The root file could not be read at all (a usage or I/O error, not a finding).
+#[derive(Debug)]
+pub struct RootError {
+    pub path: PathBuf,
+    pub error: std::io::Error,
+}
+
+impl std::fmt::Display for RootError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "cannot read `{}`: {}", self.path.display(), self.error)
+    }
+}
+
+impl std::error::Error for RootError {}
+
+/// Loads `root` and its includes.
+pub fn load(root: &Path, loader: &dyn Loader) -> Result<Loaded, RootError> {
+    let bytes = loader.read(root).map_err(|error| RootError { path: root.to_path_buf(), error })?;
+    let identity = loader.identity(root).unwrap_or_else(|_| root.to_path_buf());
+    let mut state = LoadState { loader, loaded: Loaded::default(), seen: Vec::new(), stack: Vec::new() };
+    state.visit(root, identity, bytes);
+    Ok(state.loaded)
+}
+
+/// Loads a source given as text (no includes are possible unless `loader` serves them).
+pub fn load_text(name: &str, text: &str, loader: &dyn Loader) -> Loaded {
+    let mut state = LoadState { loader, loaded: Loaded::default(), seen: Vec::new(), stack: Vec::new() };
+    state.visit(Path::new(name), PathBuf::from(name), text.as_bytes().to_vec());
+    state.loaded
+}
+
+struct LoadState<'a> {
+    loader: &'a dyn Loader,
+    loaded: Loaded,
+    /// Identities of the files read so far.
+    seen: Vec<PathBuf>,
+    /// Identities of the files being read, root first: an include of one of
+    /// these is a cycle.
+    stack: Vec<PathBuf>,
+}
+
+impl LoadState<'_> {
+    fn visit(&mut self, path: &Path, identity: PathBuf, bytes: Vec<u8>) -> FileId {
+        self.seen.push(identity.clone());
+        let name = path.display().to_string();
+        let text = match String::from_utf8(bytes) {
+            Ok(text) => text,
+            Err(err) => {
+                let at = err.utf8_error().valid_up_to();
+                let lossy = String::from_utf8_lossy(err.as_bytes()).into_owned();
+                // Point at the first bad byte, in the lossy text's offsets.
+                let offset = String::from_utf8_lossy(&err.as_bytes()[..at]).len();
+                let id = self.loaded.sources.add(SourceFile::new(name, lossy));
+                self.loaded.diagnostics.push(
+                    Diagnostic::error(
+                        codes::NOT_UTF8,
+                        format!("this file is not UTF-8 text (invalid byte at offset {at})"),
+                        id,
+                        Span::new(offset, offset + '\u{FFFD}'.len_utf8()),
+                        "not UTF-8",
+                    )
+                    .with_help("situ sources are UTF-8; is this the right file?"),
+                );
+                return id;
+            }
+        };
+        let id = self.loaded.sources.add(SourceFile::new(name, text));
+        let parsed = situ_grammar::parse(&self.loaded.sources.get(id).text, id);
+        self.loaded.diagnostics.extend(parsed.errors);
+        self.stack.push(identity);
+        for item in &parsed.file.items {
+            if let Item::Include(inc) = item {
+                self.include(path, id, &inc.path.value, inc.path.span);
+            }
+        }
+        self.stack.pop();
+        self.loaded.files.push((id, parsed.file));
+        id
+    }
+
+    fn include(&mut self, from: &Path, from_id: FileId, target: &str, span: Span) {
+        let path = from.parent().unwrap_or(Path::new("")).join(target);
+        let identity = match self.loader.identity(&path) {
+            Ok(identity) => identity,
+            Err(err) => return self.not_found(&path, from_id, span, &err),
+        };
+        if let Some(pos) = self.stack.iter().position(|p| *p == identity) {
+            let cycle: Vec<String> =
+                self.stack[pos..].iter().chain([&identity]).map(|p| p.display().to_string()).collect();
+            self.loaded.diagnostics.push(
+                Diagnostic::error(codes::INCLUDE_CYCLE, "include cycle", from_id, span, "this include closes a cycle")
+                    .with_help(format!("the files include each other: {}", cycle.join(" -> ")))
+                    .with_witness(serde_json::json!({ "cycle": cycle })),
+            );
+            return;
+        }
+        if self.seen.contains(&identity) {
+            return; // included before: each file is read once
+        }
+        match self.loader.read(&path) {
+            Ok(bytes) => {
+                self.visit(&path, identity, bytes);
+            }
+            Err(err) => self.not_found(&path, from_id, span, &err),
+        }
+    }
+
+    fn not_found(&mut self, path: &Path, from_id: FileId, span: Span, err: &std::io::Error) {
+        self.loaded.diagnostics.push(
+            Diagnostic::error(
+                codes::INCLUDE_NOT_FOUND,
+                format!("cannot include `{}`: {err}", path.display()),
+                from_id,
+                span,
+                "included here",
+            )
+            .with_help("include paths are relative to the file that includes them"),
+        );
+    }
+}

@@ -1,0 +1,242 @@
+//! Name resolution and type checking: from the parsed files to the [`Model`].
+//!
+//! The phases run in order, each one small and each reporting every finding
+//! it has (none stops at the first):
+//! 1. [`declare`]: states, agents, events, fields and functions get ids;
+//!    duplicates and the initial state are checked.
+//! 2. [`behaviour`]: every agent's table or FSM.
+//! 3. [`rules`]: every rule's conditions, with payload types and variables.
+//! 4. [`scenarios`]: tests and properties.
+//! 5. [`allow`]: `#[allow(...)]` attributes mark the findings they silence.
+
+mod allow;
+mod behaviour;
+mod declare;
+mod rules;
+mod scenarios;
+mod types;
+
+use crate::codes;
+use crate::model::*;
+use situ_grammar::ast::{self, Span};
+use situ_grammar::diag::{Diagnostic, FileId};
+use std::collections::HashMap;
+
+/// Resolves the parsed files of one compilation. The model is complete only
+/// when no error was found; otherwise it holds what could be resolved.
+pub fn resolve(files: &[(FileId, ast::File)]) -> (Model, Vec<Diagnostic>) {
+    let mut cx = Cx::default();
+    let root = files.last().map_or(FileId(0), |(id, _)| *id);
+    declare::declare(&mut cx, files, root);
+    for (file, item) in items(files) {
+        match item {
+            ast::Item::Agent(agent) => behaviour::agent(&mut cx, file, agent),
+            ast::Item::Rule(rule) => rules::rule(&mut cx, file, rule),
+            ast::Item::Test(test) => scenarios::test(&mut cx, file, test),
+            ast::Item::Property(prop) => scenarios::property(&mut cx, file, prop),
+            ast::Item::Include(_) | ast::Item::States(_) => {}
+        }
+    }
+    allow::apply(&mut cx.diags, files);
+    (cx.model, cx.diags)
+}
+
+/// Every item of every file, in declaration order.
+fn items(files: &[(FileId, ast::File)]) -> impl Iterator<Item = (FileId, &ast::Item)> {
+    files.iter().flat_map(|(id, f)| f.items.iter().map(move |i| (*id, i)))
+}
+
+/// The resolution context: the model being built, the name tables, the findings.
+#[derive(Default)]
+struct Cx {
+    model: Model,
+    diags: Vec<Diagnostic>,
+    states: HashMap<String, StateId>,
+    agents: HashMap<String, AgentId>,
+    events: HashMap<String, EventId>,
+    rule_names: HashMap<String, Origin>,
+}
+
+impl Cx {
+    fn origin(file: FileId, span: Span) -> Origin {
+        Origin { file, span }
+    }
+
+    fn state(&mut self, file: FileId, name: &ast::Ident) -> Option<StateId> {
+        let found = self.states.get(&name.name).copied();
+        if found.is_none() {
+            let mut d = Diagnostic::error(
+                codes::UNDEFINED_STATE,
+                format!("undefined state `{}`", name.name),
+                file,
+                name.span,
+                "no state of this name",
+            );
+            if let Some(s) = suggest(&name.name, self.model.states.iter().map(|s| s.name.as_str())) {
+                d = d.with_help(format!("a state with a similar name exists: `{s}`"));
+            } else {
+                d = d.with_help("declare it in the `states { ... }` block");
+            }
+            self.diags.push(d);
+        }
+        found
+    }
+
+    fn agent(&mut self, file: FileId, name: &ast::Ident) -> Option<AgentId> {
+        let found = self.agents.get(&name.name).copied();
+        if found.is_none() {
+            let mut d = Diagnostic::error(
+                codes::UNDEFINED_AGENT,
+                format!("undefined agent `{}`", name.name),
+                file,
+                name.span,
+                "no agent of this name",
+            );
+            if let Some(s) = suggest(&name.name, self.model.agents.iter().map(|a| a.name.as_str())) {
+                d = d.with_help(format!("an agent with a similar name exists: `{s}`"));
+            }
+            self.diags.push(d);
+        }
+        found
+    }
+
+    fn event(&mut self, file: FileId, name: &ast::Ident) -> Option<EventId> {
+        let found = self.events.get(&name.name).copied();
+        if found.is_none() {
+            let mut d = Diagnostic::error(
+                codes::UNDEFINED_EVENT,
+                format!("undefined event `{}`", name.name),
+                file,
+                name.span,
+                "no agent reports an event of this name",
+            );
+            if let Some(s) = suggest(&name.name, self.model.events.iter().map(|e| e.name.as_str())) {
+                d = d.with_help(format!("an event with a similar name exists: `{s}`"));
+            } else {
+                d = d.with_help("declare it in the agent that reports it: `event NAME { ... }`");
+            }
+            self.diags.push(d);
+        }
+        found
+    }
+
+    /// A function of `agent`, by name.
+    fn function(&mut self, file: FileId, agent: AgentId, name: &ast::Ident) -> Option<FunctionRef> {
+        let a = &self.model.agents[agent.index()];
+        let found = a.functions.iter().position(|f| f.name == name.name);
+        if found.is_none() {
+            let agent_name = a.name.clone();
+            let mut d = Diagnostic::error(
+                codes::UNDEFINED_FUNCTION,
+                format!("agent `{agent_name}` has no function `{}`", name.name),
+                file,
+                name.span,
+                "not a function of this agent",
+            );
+            d = match suggest(&name.name, a.functions.iter().map(|f| f.name.as_str())) {
+                Some(s) => d.with_help(format!("did you mean `{s}`?")),
+                None => d.with_help(format!("declare it in agent `{agent_name}`: `function {}`", name.name)),
+            };
+            self.diags.push(d);
+        }
+        found
+    }
+
+    /// A field of `event`, by name.
+    fn field(&mut self, file: FileId, event: EventId, name: &ast::Ident) -> Option<usize> {
+        let e = &self.model.events[event.index()];
+        let found = e.field(&name.name);
+        if found.is_none() {
+            let fields: Vec<&str> = e.fields.iter().map(|f| f.name.as_str()).collect();
+            let help = if fields.is_empty() {
+                format!("`{}` has no payload", e.name)
+            } else {
+                format!("the fields of `{}` are: {}", e.name, fields.join(", "))
+            };
+            self.diags.push(
+                Diagnostic::error(
+                    codes::UNDEFINED_FIELD,
+                    format!("event `{}` has no field `{}`", e.name, name.name),
+                    file,
+                    name.span,
+                    "no such field",
+                )
+                .with_help(help),
+            );
+        }
+        found
+    }
+
+    /// A state test as a set of allowed states.
+    fn state_set(&mut self, file: FileId, test: &ast::StateTest) -> StateSet {
+        let named: std::collections::BTreeSet<StateId> =
+            test.states.iter().filter_map(|s| self.state(file, s)).collect();
+        let states = if test.negated { self.model.state_ids().filter(|s| !named.contains(s)).collect() } else { named };
+        StateSet { states, origin: Cx::origin(file, test.span) }
+    }
+
+    /// A count that must be positive.
+    fn positive(&mut self, file: FileId, value: u64, span: Span, what: &str) -> bool {
+        if value == 0 {
+            self.diags.push(
+                Diagnostic::error(codes::ZERO, format!("{what} must be positive"), file, span, "zero")
+                    .with_help("use at least 1 (or leave it out)"),
+            );
+        }
+        value > 0
+    }
+
+    fn duplicate(&mut self, what: &str, name: &str, file: FileId, span: Span, first: Origin) {
+        self.diags.push(
+            Diagnostic::error(codes::DUPLICATE, format!("{what} `{name}` is defined twice"), file, span, "defined again here")
+                .with_label(first.file, first.span, "first defined here")
+                .with_help("rename one of them or remove the duplicate"),
+        );
+    }
+}
+
+/// The closest name by edit distance, if close enough to be a likely typo.
+fn suggest<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> Option<&'a str> {
+    let limit = (name.chars().count() / 3).max(1);
+    candidates
+        .map(|c| (edit_distance(&name.to_lowercase(), &c.to_lowercase()), c))
+        .filter(|(d, _)| *d <= limit)
+        .min_by_key(|(d, _)| *d)
+        .map(|(_, c)| c)
+}
+
+/// The optimal string alignment distance: insertions, deletions,
+/// substitutions and swaps of two neighbours each cost one.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
+    let mut d = vec![vec![0usize; b.len() + 1]; a.len() + 1];
+    for (i, row) in d.iter_mut().enumerate() {
+        row[0] = i;
+    }
+    for (j, cell) in d[0].iter_mut().enumerate() {
+        *cell = j;
+    }
+    for i in 1..=a.len() {
+        for j in 1..=b.len() {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            d[i][j] = (d[i - 1][j] + 1).min(d[i][j - 1] + 1).min(d[i - 1][j - 1] + cost);
+            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                d[i][j] = d[i][j].min(d[i - 2][j - 2] + 1);
+            }
+        }
+    }
+    d[a.len()][b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn suggestions_find_typos_only() {
+        let names = ["LAOBS", "LAOBN", "RFRS"];
+        assert_eq!(suggest("LAOSB", names.iter().copied()), Some("LAOBS"));
+        assert_eq!(suggest("XYZ", names.iter().copied()), None);
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+    }
+}

@@ -1,0 +1,76 @@
+//! `situ fmt FILE… [--check]`: formats in place, atomically (a temporary
+//! file next to the original, then a rename), so that no file is ever left
+//! half written.
+
+use super::{FAILED, OK, USAGE};
+use situ_compiler::render;
+use situ_compiler::source::{SourceFile, SourceMap};
+use std::path::{Path, PathBuf};
+
+pub fn run(files: &[PathBuf], check: bool) -> u8 {
+    let mut status = OK;
+    for path in files {
+        let code = one(path, check);
+        status = status.max(code);
+    }
+    status
+}
+
+fn one(path: &Path, check: bool) -> u8 {
+    let text = match std::fs::read(path).map(String::from_utf8) {
+        Ok(Ok(text)) => text,
+        Ok(Err(_)) => {
+            eprintln!("error: `{}` is not UTF-8 text", path.display());
+            return FAILED;
+        }
+        Err(err) => {
+            eprintln!("error: cannot read `{}`: {err}", path.display());
+            return USAGE;
+        }
+    };
+    let formatted = match situ_grammar::format(&text) {
+        Ok(f) => f,
+        Err(diags) => {
+            let mut sources = SourceMap::new();
+            sources.add(SourceFile::new(path.display().to_string(), text));
+            for d in &diags {
+                print!("{}", render::human(&sources, d, super::style()));
+            }
+            eprintln!("error: `{}` has syntax errors; not formatted", path.display());
+            return FAILED;
+        }
+    };
+    if formatted == text {
+        return OK;
+    }
+    if check {
+        println!("would reformat {}", path.display());
+        return FAILED;
+    }
+    match write_atomically(path, &formatted) {
+        Ok(()) => {
+            println!("formatted {}", path.display());
+            OK
+        }
+        Err(err) => {
+            eprintln!("error: cannot write `{}`: {err}", path.display());
+            USAGE
+        }
+    }
+}
+
+fn write_atomically(path: &Path, text: &str) -> std::io::Result<()> {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.situ-fmt.{}", std::process::id()));
+    let result = std::fs::write(&tmp, text).and_then(|()| {
+        if let Ok(meta) = std::fs::metadata(path) {
+            std::fs::set_permissions(&tmp, meta.permissions())?;
+        }
+        std::fs::rename(&tmp, path)
+    });
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
