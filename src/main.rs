@@ -62,4 +62,3 @@ mod tests {
         super::Cli::command().debug_assert();
     }
 }
-

@@ -26,7 +26,7 @@ fn write(dir: &Path, name: &str, content: impl AsRef<[u8]>) -> String {
     path.display().to_string()
 }
 
-const VALID: &str = "states { IT initial RD }\nagent Ready sensor { event RDY }\nrule ready { when state == IT and RDY then RD }\n";
+const VALID: &str = "states { IT initial RD final }\nagent Ready sensor { event RDY }\nrule ready { when state == IT and RDY then RD }\n";
 
 #[test]
 fn the_papers_stacks_check_clean() {
@@ -186,7 +186,14 @@ fn bad_input_gets_diagnostics_never_a_panic() {
     write(d, "b.situ", "include \"a.situ\"\n");
     fails_with(&d.join("a.situ").display().to_string(), "E0004");
     fails_with(&write(d, "self.situ", "include \"self.situ\"\nstates { IT initial }\n"), "E0004");
-    fails_with(&write(d, "huge_int.situ", "states { IT initial }\nrule r salience 99999999999999999999 { when state == IT then IT }\n"), "E0007");
+    fails_with(
+        &write(
+            d,
+            "huge_int.situ",
+            "states { IT initial }\nrule r salience 99999999999999999999 { when state == IT then IT }\n",
+        ),
+        "E0007",
+    );
 }
 
 #[test]

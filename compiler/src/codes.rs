@@ -63,6 +63,25 @@ codes! {
     BAD_OPERATOR = "E0203", Error, "operator does not apply to this type";
     ZERO = "E0204", Error, "zero count or length";
     VARIABLE_TYPE = "E0205", Error, "variable used with incompatible types";
+    UNREACHABLE_STATE = "E0301", Error, "unreachable state";
+    CONFLICTING_RULES = "E0302", Error, "conflicting rules";
+    SHADOWED_RULE = "W0303", Warning, "rule shadowed by rules of higher salience";
+    UNSATISFIABLE_RULE = "E0304", Error, "rule that can never fire";
+    OSCILLATION = "E0305", Error, "rules that oscillate";
+    TRAP_STATE = "W0306", Warning, "non-final state with no way out";
+    DEAD_END = "W0307", Warning, "state from which no final state is reachable";
+    UNUSED_EVENT = "W0308", Warning, "event no rule or FSM reads";
+    NEVER_RUNNING = "W0309", Warning, "agent that never runs";
+    UNUSED_FUNCTION = "W0310", Warning, "function never called";
+    NO_TABLE_ENTRY = "W0311", Warning, "state without a table entry";
+    DUPLICATE_ENTRY = "W0312", Warning, "state with two table entries";
+    UNREACHABLE_FSM_STATE = "W0313", Warning, "unreachable FSM state";
+    NONDETERMINISTIC_FSM = "W0314", Warning, "FSM transitions that fire on the same input";
+    LINK_TO_IDLE = "W0315", Warning, "link to or from an agent that is not running";
+    ACTUATOR_WITHOUT_INPUT = "W0316", Warning, "running actuator with no input";
+    SENSOR_WITHOUT_OUTPUT = "W0317", Warning, "running sensor whose outputs go nowhere";
+    DATA_CYCLE = "W0318", Warning, "data cycle";
+    MAY_CONFLICT = "W0319", Warning, "rules that may conflict";
 }
 
 /// Looks a code up, with or without its `situ::` prefix, in any case.

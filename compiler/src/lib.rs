@@ -5,6 +5,7 @@
 //! ```text
 //! load (read, decode, parse every file, follow includes)   -> Loaded
 //! resolve (names, types, tables, FSMs, tests, properties)   -> Model + diagnostics
+//! checks (static checks, on a model without errors)         -> diagnostics
 //! allow (attributes mark the warnings they silence)          -> diagnostics
 //! ```
 //! The crate does no I/O of its own: files come through a [`Loader`]
@@ -13,7 +14,7 @@
 //! ```
 //! use situ_compiler::{check_source, codes};
 //!
-//! let ok = check_source("ok.situ", "states { IT initial RD }\n\
+//! let ok = check_source("ok.situ", "states { IT initial RD final }\n\
 //!     agent Ready sensor { event RDY }\n\
 //!     rule ready { when state == IT and RDY then RD }");
 //! assert!(ok.diagnostics.is_empty());
@@ -24,12 +25,12 @@
 //! assert_eq!(found, [codes::UNDEFINED_EVENT, codes::UNDEFINED_STATE]);
 //! ```
 
+pub mod checks;
 pub mod codes;
 pub mod load;
 pub mod loader;
 pub mod model;
 pub mod render;
-pub mod checks;
 mod resolve;
 pub mod source;
 
@@ -99,6 +100,10 @@ fn check_loaded(loaded: load::Loaded) -> Checked {
     let syntax_failed = !diagnostics.is_empty();
     let (model, found) = resolve::resolve(&files);
     diagnostics.extend(found.into_iter().filter(|d| !(syntax_failed && NAME_CODES.contains(&d.code))));
+    if diagnostics.iter().all(|d| d.severity != Severity::Error) {
+        diagnostics.extend(checks::run(&model));
+    }
+    resolve::allow::apply(&mut diagnostics, &files);
     diagnostics.sort_by(|a, b| {
         (a.primary.file, a.primary.span.start, a.code).cmp(&(b.primary.file, b.primary.span.start, b.code))
     });

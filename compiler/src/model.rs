@@ -298,7 +298,8 @@ impl Rule {
 
     /// The number of tests of the rule, for conflict resolution by specificity.
     pub fn specificity(&self) -> usize {
-        let pattern_tests = |p: &Pattern| 1 + p.tests.len() + usize::from(p.run_length > 1) + usize::from(p.within.is_some());
+        let pattern_tests =
+            |p: &Pattern| 1 + p.tests.len() + usize::from(p.run_length > 1) + usize::from(p.within.is_some());
         self.guards.len()
             + self.stale.len()
             + self.patterns.iter().map(pattern_tests).sum::<usize>()
@@ -350,11 +351,21 @@ pub struct FieldTest {
 /// What is tested of a field.
 #[derive(Debug, Clone, Serialize)]
 pub enum FieldCheck {
-    /// Binds (or, when bound before, must equal) a variable.
+    /// The binding site of a variable: tests nothing, gives the variable the
+    /// field's value. A variable has one binding site, in a positive
+    /// pattern (or, for a variable local to a `not` pattern, in that
+    /// pattern); every other `field: ?v` is a `Compare` with `==`.
     Bind(VarId),
-    Compare { op: CmpOp, rhs: Operand },
+    Compare {
+        op: CmpOp,
+        rhs: Operand,
+    },
     /// `lo..hi` (`inclusive`: `lo..=hi`).
-    Range { lo: Operand, hi: Operand, inclusive: bool },
+    Range {
+        lo: Operand,
+        hi: Operand,
+        inclusive: bool,
+    },
 }
 
 /// A value or a variable.
@@ -445,9 +456,18 @@ pub enum Pred {
     Bool(bool),
     /// The state is one of these.
     State(StateSet),
-    Mode { agent: AgentId, mode: Mode },
-    Link { from: AgentId, to: AgentId },
+    Mode {
+        agent: AgentId,
+        mode: Mode,
+    },
+    Link {
+        from: AgentId,
+        to: AgentId,
+    },
     Stale(AgentId),
     /// The latest event of its agent matches; `variables` are local to it.
-    Event { pattern: Pattern, variables: Vec<Variable> },
+    Event {
+        pattern: Pattern,
+        variables: Vec<Variable>,
+    },
 }

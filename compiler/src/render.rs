@@ -74,14 +74,9 @@ impl Report {
                 related.push(Report::new(sources, &note));
             }
         }
-        let mut d = d.clone();
-        if let Some(w) = &d.witness {
-            let w = format!("witness: {w}");
-            d.help = Some(match d.help.take() {
-                Some(h) => format!("{h}\n{w}"),
-                None => w,
-            });
-        }
+        // The witness is structured data for tools (JSON, SARIF); for people
+        // each check writes it into its message, labels and help.
+        let d = d.clone();
         Report { d, source: NamedSource::new(file.name.clone(), file.text.clone()), labels, related }
     }
 }

@@ -497,9 +497,7 @@ pub enum TestClause {
 impl TestClause {
     pub fn span(&self) -> Span {
         match self {
-            TestClause::Given { span, .. }
-            | TestClause::On { span, .. }
-            | TestClause::Expect { span, .. } => *span,
+            TestClause::Given { span, .. } | TestClause::On { span, .. } | TestClause::Expect { span, .. } => *span,
         }
     }
 }
@@ -608,10 +606,21 @@ pub enum Predicate {
     Not(Box<Predicate>, Span),
     Bool(bool, Span),
     State(StateTest),
-    Mode { agent: Ident, mode: Mode, span: Span },
-    Link { from: Ident, to: Ident, span: Span },
+    Mode {
+        agent: Ident,
+        mode: Mode,
+        span: Span,
+    },
+    Link {
+        from: Ident,
+        to: Ident,
+        span: Span,
+    },
     /// `stale LADAR`.
-    Stale { agent: Ident, span: Span },
+    Stale {
+        agent: Ident,
+        span: Span,
+    },
     /// The latest event of its agent matches.
     Event(Pattern),
 }

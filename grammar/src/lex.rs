@@ -21,8 +21,7 @@ fn item_starts_at(bytes: &[u8], at: usize) -> bool {
         return true;
     }
     ITEM_KEYWORDS.iter().any(|kw| {
-        rest.starts_with(kw.as_bytes())
-            && rest.get(kw.len()).is_none_or(|c| !(c.is_ascii_alphanumeric() || *c == b'_'))
+        rest.starts_with(kw.as_bytes()) && rest.get(kw.len()).is_none_or(|c| !(c.is_ascii_alphanumeric() || *c == b'_'))
     })
 }
 

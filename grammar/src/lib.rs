@@ -13,7 +13,9 @@
 
 pub mod ast;
 pub mod diag;
+pub mod fmt;
 pub mod lex;
 pub mod parse;
 
+pub use fmt::format;
 pub use parse::{parse, Parsed};

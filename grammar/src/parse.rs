@@ -55,8 +55,14 @@ pub fn parse(src: &str, file: FileId) -> Parsed {
     for span in lex::split_items(src) {
         if errors.len() >= MAX_SYNTAX_ERRORS {
             errors.push(
-                Diagnostic::error(TOO_MANY_ERRORS, format!("too many syntax errors; stopped after {MAX_SYNTAX_ERRORS}"), file, Span::new(span.start, span.start), "stopped here")
-                    .with_help("is this a situ source file?"),
+                Diagnostic::error(
+                    TOO_MANY_ERRORS,
+                    format!("too many syntax errors; stopped after {MAX_SYNTAX_ERRORS}"),
+                    file,
+                    Span::new(span.start, span.start),
+                    "stopped here",
+                )
+                .with_help("is this a situ source file?"),
             );
             break;
         }
@@ -65,8 +71,14 @@ pub fn parse(src: &str, file: FileId) -> Parsed {
         if depth > MAX_NESTING {
             let at = span.start + at;
             errors.push(
-                Diagnostic::error(TOO_DEEP, format!("this item is nested {depth} levels deep; at most {MAX_NESTING} are allowed"), file, Span::new(at, at + 1), "too deep from here")
-                    .with_help("split the expression into several rules or properties"),
+                Diagnostic::error(
+                    TOO_DEEP,
+                    format!("this item is nested {depth} levels deep; at most {MAX_NESTING} are allowed"),
+                    file,
+                    Span::new(at, at + 1),
+                    "too deep from here",
+                )
+                .with_help("split the expression into several rules or properties"),
             );
             continue;
         }
@@ -122,7 +134,8 @@ fn syntax_error(err: &pest::error::Error<Rule>, text: &str, offset: usize, file:
         (None, true) => format!("syntax error: unexpected {}", found.0),
         (None, false) => format!("syntax error: expected {}, found {}", one_of(&expected), found.0),
     };
-    let label = if expected.is_empty() { "unexpected here".to_string() } else { format!("expected {}", one_of(&expected)) };
+    let label =
+        if expected.is_empty() { "unexpected here".to_string() } else { format!("expected {}", one_of(&expected)) };
     let mut diag = Diagnostic::error(SYNTAX, message, file, Span::new(at, end), label);
     if let Some(help) = hint(text, pos) {
         diag = diag.with_help(help);
@@ -177,11 +190,59 @@ fn hint(text: &str, pos: usize) -> Option<String> {
 
 /// The reserved words of the language (mirrors `keyword` in the grammar).
 pub const KEYWORDS: &[&str] = &[
-    "states", "agent", "rule", "test", "property", "include", "initial", "final", "sensor", "actuator", "processing",
-    "interface", "stale", "after", "event", "function", "table", "fsm", "rate", "when", "then", "salience", "and", "or",
-    "not", "in", "state", "within", "run", "sleep", "wait", "from", "to", "on", "given", "expect", "at", "link", "no",
-    "always", "never", "next", "eventually", "events", "true", "false", "runs", "running", "sleeping", "waiting", "f64",
-    "i64", "bool",
+    "states",
+    "agent",
+    "rule",
+    "test",
+    "property",
+    "include",
+    "initial",
+    "final",
+    "sensor",
+    "actuator",
+    "processing",
+    "interface",
+    "stale",
+    "after",
+    "event",
+    "function",
+    "table",
+    "fsm",
+    "rate",
+    "when",
+    "then",
+    "salience",
+    "and",
+    "or",
+    "not",
+    "in",
+    "state",
+    "within",
+    "run",
+    "sleep",
+    "wait",
+    "from",
+    "to",
+    "on",
+    "given",
+    "expect",
+    "at",
+    "link",
+    "no",
+    "always",
+    "never",
+    "next",
+    "eventually",
+    "events",
+    "true",
+    "false",
+    "runs",
+    "running",
+    "sleeping",
+    "waiting",
+    "f64",
+    "i64",
+    "bool",
 ];
 
 /// The words for grammar rules in error messages; `None` for rules that only
@@ -280,7 +341,13 @@ impl Builder<'_> {
     }
 
     fn literal_error(&mut self, span: Span, what: &str) {
-        self.errors.push(Diagnostic::error(BAD_LITERAL, format!("{what} does not fit"), self.file, span, "out of range"));
+        self.errors.push(Diagnostic::error(
+            BAD_LITERAL,
+            format!("{what} does not fit"),
+            self.file,
+            span,
+            "out of range",
+        ));
     }
 
     fn int(&mut self, pair: P) -> Option<i64> {
@@ -375,7 +442,13 @@ impl Builder<'_> {
 
     fn state_decl(&mut self, pair: P) -> StateDecl {
         let span = self.span(&pair);
-        let mut decl = StateDecl { name: Ident { name: String::new(), span }, initial: None, is_final: None, description: None, span };
+        let mut decl = StateDecl {
+            name: Ident { name: String::new(), span },
+            initial: None,
+            is_final: None,
+            description: None,
+            span,
+        };
         for p in pair.into_inner() {
             match p.as_rule() {
                 Rule::ident => decl.name = self.ident(p),
@@ -454,7 +527,8 @@ impl Builder<'_> {
 
     fn event_decl(&mut self, pair: P) -> EventDecl {
         let span = self.span(&pair);
-        let mut decl = EventDecl { name: Ident { name: String::new(), span }, fields: Vec::new(), description: None, span };
+        let mut decl =
+            EventDecl { name: Ident { name: String::new(), span }, fields: Vec::new(), description: None, span };
         for p in pair.into_inner() {
             match p.as_rule() {
                 Rule::ident => decl.name = self.ident(p),
@@ -878,7 +952,9 @@ impl Builder<'_> {
                     Rule::predicate => self.predicate(a),
                     Rule::boolean => Some(Predicate::Bool(a.as_str() == "true", aspan)),
                     Rule::state_test => Some(Predicate::State(self.state_test(a)?)),
-                    Rule::atom_stale => Some(Predicate::Stale { agent: self.ident(a.into_inner().next()?), span: aspan }),
+                    Rule::atom_stale => {
+                        Some(Predicate::Stale { agent: self.ident(a.into_inner().next()?), span: aspan })
+                    }
                     Rule::atom_link => {
                         let mut i = a.into_inner();
                         let from = self.ident(i.next()?);

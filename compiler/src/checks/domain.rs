@@ -2,9 +2,9 @@
 //! a set of constant comparisons holds. Static checks intersect and subtract
 //! them to decide whether conditions can hold together.
 //!
-//! - f64: a union of disjoint intervals with open or closed ends over the
-//!   reals, plus a flag for NaN. NaN satisfies no comparison (not even `!=`),
-//!   so any comparison removes it.
+//! - f64: a union of disjoint closed ranges of f64 values (an open end is the
+//!   neighbouring f64: the values are discrete), plus a flag for NaN. NaN
+//!   satisfies no comparison (not even `!=`), so any comparison removes it.
 //! - i64: a union of disjoint closed integer ranges.
 //! - bool and symbols: a bit set of the allowed values.
 
@@ -12,75 +12,43 @@ use crate::model::{FieldCheck, Operand, Type, Value};
 use serde::Serialize;
 use situ_grammar::ast::CmpOp;
 
-/// One end of a real interval.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct End {
-    pub value: f64,
-    /// Whether the end value itself belongs to the interval.
-    pub closed: bool,
-}
-
-/// A non-empty real interval; `-inf`/`+inf` ends are open.
+/// A non-empty closed range of f64 values, `lo <= hi`, ends included.
+/// f64 values are discrete, so an open end is the neighbouring value:
+/// `x < 30.0` is `x <= 29.999999999999996`, and `(a, next_up(a))` is empty.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Interval {
-    pub lo: End,
-    pub hi: End,
+    pub lo: f64,
+    pub hi: f64,
 }
 
 impl Interval {
-    pub const ALL: Interval =
-        Interval { lo: End { value: f64::NEG_INFINITY, closed: false }, hi: End { value: f64::INFINITY, closed: false } };
+    /// Every f64 value but NaN, infinities included.
+    pub const ALL: Interval = Interval { lo: f64::NEG_INFINITY, hi: f64::INFINITY };
 
-    fn new(lo: End, hi: End) -> Option<Interval> {
-        let ok = lo.value < hi.value || (lo.value == hi.value && lo.closed && hi.closed);
-        ok.then_some(Interval { lo, hi })
+    fn new(lo: f64, hi: f64) -> Option<Interval> {
+        (lo <= hi).then_some(Interval { lo, hi })
     }
 
     fn intersect(self, o: Interval) -> Option<Interval> {
-        let lo = max_lo(self.lo, o.lo);
-        let hi = min_hi(self.hi, o.hi);
-        Interval::new(lo, hi)
+        Interval::new(self.lo.max(o.lo), self.hi.min(o.hi))
     }
 
     /// A value inside, preferring round numbers, for witnesses.
     pub fn sample(self) -> f64 {
-        let (lo, hi) = (self.lo.value, self.hi.value);
-        if self.lo.closed {
-            return lo;
+        let (lo, hi) = (self.lo, self.hi);
+        if lo <= 0.0 && 0.0 <= hi {
+            return 0.0;
         }
-        if self.hi.closed {
-            return hi;
-        }
-        match (lo.is_finite(), hi.is_finite()) {
-            (false, false) => 0.0,
-            (true, false) => lo.floor() + 1.0,
-            (false, true) => hi.ceil() - 1.0,
-            (true, true) => {
-                let mid = lo + (hi - lo) / 2.0;
-                let round = mid.round();
-                if round > lo && round < hi {
-                    round
-                } else {
-                    mid
-                }
+        for candidate in [lo.ceil(), hi.floor()] {
+            if candidate.is_finite() && lo <= candidate && candidate <= hi {
+                return candidate;
             }
         }
-    }
-}
-
-fn max_lo(a: End, b: End) -> End {
-    if a.value > b.value || (a.value == b.value && !a.closed) {
-        a
-    } else {
-        b
-    }
-}
-
-fn min_hi(a: End, b: End) -> End {
-    if a.value < b.value || (a.value == b.value && !a.closed) {
-        a
-    } else {
-        b
+        if lo.is_finite() {
+            lo
+        } else {
+            hi
+        }
     }
 }
 
@@ -131,16 +99,14 @@ impl Domain {
                     // Nothing compares with NaN.
                     return Domain::Real { intervals: vec![], nan: false };
                 }
-                let inf = |closed| End { value: f64::INFINITY, closed };
-                let ninf = End { value: f64::NEG_INFINITY, closed: false };
-                let at = |closed| End { value: v, closed };
+                let (ninf, inf) = (f64::NEG_INFINITY, f64::INFINITY);
                 let intervals = match op {
-                    CmpOp::Lt => vec![Interval::new(ninf, at(false))],
-                    CmpOp::Le => vec![Interval::new(ninf, at(true))],
-                    CmpOp::Gt => vec![Interval::new(at(false), inf(false))],
-                    CmpOp::Ge => vec![Interval::new(at(true), inf(false))],
-                    CmpOp::Eq => vec![Interval::new(at(true), at(true))],
-                    CmpOp::Ne => vec![Interval::new(ninf, at(false)), Interval::new(at(false), inf(false))],
+                    CmpOp::Lt => vec![Interval::new(ninf, v.next_down())],
+                    CmpOp::Le => vec![Interval::new(ninf, v)],
+                    CmpOp::Gt => vec![Interval::new(v.next_up(), inf)],
+                    CmpOp::Ge => vec![Interval::new(v, inf)],
+                    CmpOp::Eq => vec![Interval::new(v, v)],
+                    CmpOp::Ne => vec![Interval::new(ninf, v.next_down()), Interval::new(v.next_up(), inf)],
                 };
                 Domain::Real { intervals: intervals.into_iter().flatten().collect(), nan: false }
             }
@@ -206,7 +172,7 @@ impl Domain {
                         }
                     }
                 }
-                out.sort_by(|x, y| x.lo.value.total_cmp(&y.lo.value));
+                out.sort_by(|x, y| x.lo.total_cmp(&y.lo));
                 Domain::Real { intervals: out, nan: *na && *nb }
             }
             (Domain::Int(a), Domain::Int(b)) => {
@@ -234,6 +200,13 @@ impl Domain {
         }
     }
 
+    /// Drops NaN from an f64 domain.
+    pub fn remove_nan(&mut self) {
+        if let Domain::Real { nan, .. } = self {
+            *nan = false;
+        }
+    }
+
     fn clear(&mut self) {
         match self {
             Domain::Real { intervals, nan } => {
@@ -249,18 +222,20 @@ impl Domain {
     pub fn subtract(&self, other: &Domain) -> Domain {
         match (self, other) {
             (Domain::Real { intervals, nan }, Domain::Real { intervals: b, nan: nb }) => {
-                // complement of b, then intersect
+                // The complement of b, then the intersection.
                 let mut comp = Vec::new();
-                let mut lo = End { value: f64::NEG_INFINITY, closed: false };
+                let mut lo = f64::NEG_INFINITY;
                 for i in b {
-                    let hi = End { value: i.lo.value, closed: !i.lo.closed };
-                    if let Some(x) = Interval::new(lo, hi) {
-                        comp.push(x);
+                    if i.lo > f64::NEG_INFINITY {
+                        comp.extend(Interval::new(lo, i.lo.next_down()));
                     }
-                    lo = End { value: i.hi.value, closed: !i.hi.closed };
+                    lo = i.hi.next_up();
+                    if i.hi == f64::INFINITY {
+                        lo = f64::NAN; // nothing above
+                    }
                 }
-                if let Some(x) = Interval::new(lo, End { value: f64::INFINITY, closed: false }) {
-                    comp.push(x);
+                if !lo.is_nan() {
+                    comp.extend(Interval::new(lo, f64::INFINITY));
                 }
                 let d = Domain::Real { intervals: intervals.clone(), nan: *nan }
                     .intersect(&Domain::Real { intervals: comp, nan: true });
@@ -300,7 +275,13 @@ impl Domain {
                 None => None,
             },
             (Domain::Int(r), _) => r.first().map(|(lo, hi)| {
-                let v = if *lo <= 0 && 0 <= *hi { 0 } else if lo.abs() < hi.abs() { *lo } else { *hi };
+                let v = if *lo <= 0 && 0 <= *hi {
+                    0
+                } else if lo.abs() < hi.abs() {
+                    *lo
+                } else {
+                    *hi
+                };
                 json!(v as i64)
             }),
             (Domain::Finite { allowed, .. }, Type::Bool) => {

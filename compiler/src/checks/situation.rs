@@ -8,6 +8,7 @@
 use super::domain::Domain;
 use crate::model::*;
 use serde_json::{json, Value as Json};
+use situ_grammar::ast::CmpOp;
 use std::collections::{BTreeMap, BTreeSet};
 
 /// What the latest fact of one agent must be.
@@ -50,6 +51,9 @@ pub struct Situation {
     pub agents: BTreeMap<AgentId, AgentReq>,
     /// `not` patterns that must not match.
     pub negations: Vec<Pattern>,
+    /// Fields that must hold one value (a variable bound in one and tested
+    /// for equality in the others); kept exact by [`propagate`].
+    pub equal: Vec<Equality>,
     /// Some condition (a comparison with a variable) was widened: the
     /// situation may contain memories in which the conditions do not hold.
     pub widened: bool,
@@ -65,6 +69,7 @@ impl Situation {
             states,
             agents: BTreeMap::new(),
             negations: Vec::new(),
+            equal: Vec::new(),
             widened: false,
             origins: BTreeMap::new(),
             state_origins: Vec::new(),
@@ -74,13 +79,46 @@ impl Situation {
     /// The memories in which the positive conditions of `rule` hold (its
     /// negations are kept aside, see [`Situation::witness`]).
     pub fn of_rule(model: &Model, rule: &Rule) -> Result<Situation, Unsat> {
-        let states = rule.allowed_states().unwrap_or_else(|| model.state_ids().collect());
+        let mut states = rule.allowed_states().unwrap_or_else(|| model.state_ids().collect());
+        let guarded = !states.is_empty();
+        // A rule is activated only where the state is not already its target.
+        states.remove(&rule.target);
         let mut sit = Situation::states(states);
         sit.state_origins = rule.guards.iter().map(|g| g.origin).collect();
         if sit.states.is_empty() {
-            return Err(Unsat { reason: "its state guards exclude each other".into(), origins: sit.state_origins });
+            let reason = if guarded {
+                "it is only allowed in its own target state, where it is never activated"
+            } else {
+                "its state guards exclude each other"
+            };
+            return Err(Unsat { reason: reason.into(), origins: sit.state_origins });
         }
+        // `?v` tested for equality with its binding site, both on fields of
+        // one type: an equality class, decided exactly. Mixed numeric types
+        // stay comparisons with a variable (widened).
+        let site = |v: VarId| {
+            rule.patterns.iter().find_map(|p| {
+                p.tests.iter().find(|t| matches!(t.check, FieldCheck::Bind(b) if b == v)).map(|t| (p.event, t.field))
+            })
+        };
+        let mut exact: Vec<Pattern> = Vec::new();
         for p in &rule.patterns {
+            let mut p = p.clone();
+            p.tests.retain(|t| {
+                let FieldCheck::Compare { op: CmpOp::Eq, rhs: Operand::Var(v) } = t.check else { return true };
+                let Some((event, field)) = site(v) else { return true };
+                let ty = |e: EventId, f: usize| &model.event(e).fields[f].ty;
+                if ty(event, field) != ty(p.event, t.field) {
+                    return true;
+                }
+                let members = [(model.event(event).agent, field), (model.event(p.event).agent, t.field)];
+                sit.equal.push(Equality { variable: rule.variables[v].name.clone(), members: members.to_vec() });
+                false
+            });
+            exact.push(p);
+        }
+        merge_classes(&mut sit.equal);
+        for p in &exact {
             sit.require_pattern(model, p)?;
         }
         for s in &rule.stale {
@@ -88,10 +126,12 @@ impl Situation {
         }
         sit.negations = rule.negations.clone();
         sit.widened |= rule.negations.iter().any(has_variable);
+        sit.propagate(model)?;
         Ok(sit)
     }
 
-    fn require_pattern(&mut self, model: &Model, p: &Pattern) -> Result<(), Unsat> {
+    /// Adds a positive pattern.
+    pub fn require_pattern(&mut self, model: &Model, p: &Pattern) -> Result<(), Unsat> {
         let event = model.event(p.event);
         let agent = model.agent(event.agent);
         let mut fields: Vec<Domain> = event.fields.iter().map(|f| Domain::full(&f.ty)).collect();
@@ -103,7 +143,15 @@ impl Situation {
         }
         let max_age = agent.stale_after.unwrap_or(u64::MAX).min(p.within.unwrap_or(u64::MAX));
         let fact = Fact { event: p.event, fields, run: (p.run_length, u64::MAX), age: (0, max_age) };
-        self.meet_fact(model, event.agent, fact, p.origin)
+        self.meet_fact(model, event.agent, fact, p.origin)?;
+        self.propagate(model)
+    }
+
+    /// Narrows the fields of every equality class to the values they can
+    /// share, or says why there are none.
+    pub fn propagate(&mut self, model: &Model) -> Result<(), Unsat> {
+        propagate(model, &mut self.agents, &self.equal)
+            .map_err(|reason| Unsat { reason, origins: self.origins.values().flatten().copied().collect() })
     }
 
     fn meet_fact(&mut self, model: &Model, agent: AgentId, fact: Fact, origin: Origin) -> Result<(), Unsat> {
@@ -147,7 +195,10 @@ impl Situation {
             });
         }
         if merged.run.0 > merged.run.1 {
-            return Err(Unsat { reason: format!("no run length of `{}` satisfies all its bounds", event.name), origins });
+            return Err(Unsat {
+                reason: format!("no run length of `{}` satisfies all its bounds", event.name),
+                origins,
+            });
         }
         if merged.age.0 > merged.age.1 {
             return Err(Unsat { reason: format!("no age of `{}` satisfies all its windows", event.name), origins });
@@ -157,7 +208,8 @@ impl Situation {
         Ok(())
     }
 
-    fn require_stale(&mut self, model: &Model, agent: AgentId, stale: bool, origin: Origin) -> Result<(), Unsat> {
+    /// Requires the agent stale (`stale == true`) or not stale.
+    pub fn require_stale(&mut self, model: &Model, agent: AgentId, stale: bool, origin: Origin) -> Result<(), Unsat> {
         let mut origins = self.origins.get(&agent).cloned().unwrap_or_default();
         origins.push(origin);
         let name = &model.agent(agent).name;
@@ -166,7 +218,10 @@ impl Situation {
             (AgentReq::Free | AgentReq::Fresh, false) => AgentReq::Fresh,
             (AgentReq::Fact(f), false) => AgentReq::Fact(f),
             (AgentReq::Fact(_), true) => {
-                return Err(Unsat { reason: format!("`{name}` is required stale, so none of its events matches"), origins })
+                return Err(Unsat {
+                    reason: format!("`{name}` is required stale, so none of its events matches"),
+                    origins,
+                })
             }
             (AgentReq::Stale, false) | (AgentReq::Fresh, true) => {
                 return Err(Unsat { reason: format!("`{name}` is required both stale and not stale"), origins })
@@ -177,13 +232,31 @@ impl Situation {
         Ok(())
     }
 
+    /// A quick test that can rule out a meet without building it: some
+    /// agent needs two different events, or a fact and staleness.
+    pub fn compatible(&self, other: &Situation) -> bool {
+        if self.states.is_disjoint(&other.states) {
+            return false;
+        }
+        self.agents.iter().all(|(agent, a)| match (a, other.agents.get(agent)) {
+            (AgentReq::Fact(x), Some(AgentReq::Fact(y))) => x.event == y.event,
+            (AgentReq::Fact(_), Some(AgentReq::Stale))
+            | (AgentReq::Stale, Some(AgentReq::Fact(_) | AgentReq::Fresh)) => false,
+            (AgentReq::Fresh, Some(AgentReq::Stale)) => false,
+            _ => true,
+        })
+    }
+
     /// The memories in both situations.
     pub fn meet(&self, model: &Model, other: &Situation) -> Result<Situation, Unsat> {
         let mut sit = self.clone();
         sit.states = self.states.intersection(&other.states).copied().collect();
         sit.state_origins.extend(other.state_origins.iter().copied());
         if sit.states.is_empty() {
-            return Err(Unsat { reason: "their state guards have no state in common".into(), origins: sit.state_origins });
+            return Err(Unsat {
+                reason: "their state guards have no state in common".into(),
+                origins: sit.state_origins,
+            });
         }
         for (agent, req) in &other.agents {
             let origin = other.origins.get(agent).and_then(|o| o.first()).copied();
@@ -203,6 +276,11 @@ impl Situation {
         }
         sit.negations.extend(other.negations.iter().cloned());
         sit.widened |= other.widened;
+        if !other.equal.is_empty() {
+            sit.equal.extend(other.equal.iter().cloned());
+            merge_classes(&mut sit.equal);
+        }
+        sit.propagate(model)?;
         Ok(sit)
     }
 
@@ -212,7 +290,7 @@ impl Situation {
     /// `MAX_BRANCHES`; beyond that the answer is widened to "maybe").
     pub fn witness(&self, model: &Model) -> Result<Witness, Unsat> {
         let mut budget = MAX_BRANCHES;
-        match escape(model, self.agents.clone(), &self.negations, &mut budget) {
+        match escape(model, self.agents.clone(), &self.negations, &self.equal, &mut budget) {
             Some(agents) => Ok(Witness::new(model, &self.states, &agents, self.widened || budget == 0)),
             None if budget == 0 => Ok(Witness::new(model, &self.states, &self.agents, true)),
             None => Err(Unsat {
@@ -224,6 +302,80 @@ impl Situation {
 }
 
 const MAX_BRANCHES: usize = 4096;
+
+/// Fields of the agents' latest facts that must hold one value: `(agent,
+/// field index)`, the field of the event the agent's fact must be.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Equality {
+    /// The variable that joins them, for reasons.
+    pub variable: String,
+    pub members: Vec<(AgentId, usize)>,
+}
+
+/// Joins classes that share a member, so that each field is in one class.
+fn merge_classes(classes: &mut Vec<Equality>) {
+    let mut i = 0;
+    while i < classes.len() {
+        let mut j = i + 1;
+        let mut merged = false;
+        while j < classes.len() {
+            if classes[j].members.iter().any(|m| classes[i].members.contains(m)) {
+                let other = classes.swap_remove(j);
+                for m in other.members {
+                    if !classes[i].members.contains(&m) {
+                        classes[i].members.push(m);
+                    }
+                }
+                merged = true;
+            } else {
+                j += 1;
+            }
+        }
+        if !merged {
+            i += 1;
+        }
+    }
+}
+
+/// Narrows every class's fields to their common values. Two fields that
+/// must be equal cannot be NaN, which equals nothing.
+fn propagate(model: &Model, agents: &mut BTreeMap<AgentId, AgentReq>, equal: &[Equality]) -> Result<(), String> {
+    for class in equal {
+        let mut common: Option<Domain> = None;
+        for (agent, field) in &class.members {
+            if let Some(AgentReq::Fact(f)) = agents.get(agent) {
+                let d = &f.fields[*field];
+                common = Some(match common {
+                    None => d.clone(),
+                    Some(c) => c.intersect(d),
+                });
+            }
+        }
+        let Some(mut common) = common else { continue };
+        common.remove_nan();
+        let name = |(agent, field): &(AgentId, usize)| match agents.get(agent) {
+            Some(AgentReq::Fact(f)) => {
+                let e = model.event(f.event);
+                format!("`{}.{}`", e.name, e.fields[*field].name)
+            }
+            _ => format!("a field of `{}`", model.agent(*agent).name),
+        };
+        if common.is_empty() {
+            let fields: Vec<String> = class.members.iter().map(name).collect();
+            return Err(format!(
+                "`?{}` makes {} equal, and no value satisfies the constraints of all of them",
+                class.variable,
+                fields.join(" and ")
+            ));
+        }
+        for (agent, field) in &class.members {
+            if let Some(AgentReq::Fact(f)) = agents.get_mut(agent) {
+                f.fields[*field] = common.clone();
+            }
+        }
+    }
+    Ok(())
+}
 
 fn has_variable(p: &Pattern) -> bool {
     p.tests.iter().any(|t| match &t.check {
@@ -238,6 +390,7 @@ fn escape(
     model: &Model,
     agents: BTreeMap<AgentId, AgentReq>,
     negations: &[Pattern],
+    equal: &[Equality],
     budget: &mut usize,
 ) -> Option<BTreeMap<AgentId, AgentReq>> {
     if *budget == 0 {
@@ -248,13 +401,15 @@ fn escape(
     let agent = model.event(n.event).agent;
     let fact = match agents.get(&agent) {
         // No fact, another event, or stale: the negated pattern cannot match.
-        None | Some(AgentReq::Free | AgentReq::Fresh | AgentReq::Stale) => return escape(model, agents, rest, budget),
-        Some(AgentReq::Fact(f)) if f.event != n.event => return escape(model, agents, rest, budget),
+        None | Some(AgentReq::Free | AgentReq::Fresh | AgentReq::Stale) => {
+            return escape(model, agents, rest, equal, budget)
+        }
+        Some(AgentReq::Fact(f)) if f.event != n.event => return escape(model, agents, rest, equal, budget),
         Some(AgentReq::Fact(f)) => f.clone(),
     };
     if has_variable(n) {
         // Beyond exact: assume it can be escaped (the caller marks it widened).
-        return escape(model, agents, rest, budget);
+        return escape(model, agents, rest, equal, budget);
     }
     let event = model.event(n.event);
     // The ways out: a field outside the negated constraint, a shorter run, an older fact.
@@ -279,7 +434,10 @@ fn escape(
     for way in ways {
         let mut next = agents.clone();
         next.insert(agent, AgentReq::Fact(way));
-        if let Some(found) = escape(model, next, rest, budget) {
+        if propagate(model, &mut next, equal).is_err() {
+            continue;
+        }
+        if let Some(found) = escape(model, next, rest, equal, budget) {
             return Some(found);
         }
     }

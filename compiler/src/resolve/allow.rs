@@ -32,8 +32,14 @@ pub fn apply(diags: &mut Vec<Diagnostic>, files: &[(FileId, ast::File)]) {
                         .with_help("only warnings can be allowed; fix the error instead"),
                     ),
                     None => bad.push(
-                        Diagnostic::error(codes::BAD_ALLOW, format!("unknown code `{}`", code.name), *file, code.span, "no such code")
-                            .with_help("`situ explain CODE` lists the codes; they look like `W0301`"),
+                        Diagnostic::error(
+                            codes::BAD_ALLOW,
+                            format!("unknown code `{}`", code.name),
+                            *file,
+                            code.span,
+                            "no such code",
+                        )
+                        .with_help("`situ explain CODE` lists the codes; they look like `W0301`"),
                     ),
                 }
             }
@@ -42,7 +48,9 @@ pub fn apply(diags: &mut Vec<Diagnostic>, files: &[(FileId, ast::File)]) {
     for d in diags.iter_mut() {
         let p = &d.primary;
         if d.severity == Severity::Warning
-            && scopes.iter().any(|(f, s, c)| *f == p.file && s.start <= p.span.start && p.span.end <= s.end && *c == d.code)
+            && scopes
+                .iter()
+                .any(|(f, s, c)| *f == p.file && s.start <= p.span.start && p.span.end <= s.end && *c == d.code)
         {
             d.allowed = true;
         }

@@ -27,7 +27,11 @@ pub(super) fn agent(cx: &mut Cx, file: FileId, agent: &ast::Agent) {
                     Span::new(span.start, span.start + what.len()),
                     format!("a second {what}"),
                 )
-                .with_label(file, Span::new(first_span.start, first_span.start + first_what.len()), format!("the {first_what}"))
+                .with_label(
+                    file,
+                    Span::new(first_span.start, first_span.start + first_what.len()),
+                    format!("the {first_what}"),
+                )
                 .with_help("an agent's behaviour is one table or one fsm; merge them"),
             );
             continue;
@@ -137,8 +141,14 @@ fn fsm(cx: &mut Cx, file: FileId, agent: AgentId, fsm: &ast::Fsm) -> Option<Fsm>
     }
     if initial.is_none() && ok {
         cx.diags.push(
-            Diagnostic::error(codes::FSM_INITIAL, "this FSM has no initial state", file, Span::new(fsm.span.start, fsm.span.start + 3), "no `initial` state")
-                .with_help("mark the state the agent starts in: `Idle initial => sleep`"),
+            Diagnostic::error(
+                codes::FSM_INITIAL,
+                "this FSM has no initial state",
+                file,
+                Span::new(fsm.span.start, fsm.span.start + 3),
+                "no `initial` state",
+            )
+            .with_help("mark the state the agent starts in: `Idle initial => sleep`"),
         );
         ok = false;
     }

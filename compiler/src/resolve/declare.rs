@@ -95,7 +95,9 @@ fn declare_agent(cx: &mut Cx, file: FileId, agent: &ast::Agent) {
     for member in &agent.members {
         match member {
             ast::AgentMember::Stale(s) => {
-                if once(cx, file, &mut stale_seen, s.span, "stale after") && cx.positive(file, s.after.nanos, s.after.span, "a stale time") {
+                if once(cx, file, &mut stale_seen, s.span, "stale after")
+                    && cx.positive(file, s.after.nanos, s.after.span, "a stale time")
+                {
                     cx.model.agents[id.index()].stale_after = Some(s.after.nanos);
                 }
             }

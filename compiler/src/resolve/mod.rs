@@ -7,9 +7,10 @@
 //! 2. [`behaviour`]: every agent's table or FSM.
 //! 3. [`rules`]: every rule's conditions, with payload types and variables.
 //! 4. [`scenarios`]: tests and properties.
-//! 5. [`allow`]: `#[allow(...)]` attributes mark the findings they silence.
+//! 5. [`allow`] (called by the pipeline after the static checks):
+//!    `#[allow(...)]` attributes mark the findings they silence.
 
-mod allow;
+pub(crate) mod allow;
 mod behaviour;
 mod declare;
 mod rules;
@@ -37,7 +38,6 @@ pub fn resolve(files: &[(FileId, ast::File)]) -> (Model, Vec<Diagnostic>) {
             ast::Item::Include(_) | ast::Item::States(_) => {}
         }
     }
-    allow::apply(&mut cx.diags, files);
     (cx.model, cx.diags)
 }
 
@@ -55,6 +55,8 @@ struct Cx {
     agents: HashMap<String, AgentId>,
     events: HashMap<String, EventId>,
     rule_names: HashMap<String, Origin>,
+    test_names: HashMap<String, Origin>,
+    property_names: HashMap<String, Origin>,
 }
 
 impl Cx {
@@ -188,9 +190,15 @@ impl Cx {
 
     fn duplicate(&mut self, what: &str, name: &str, file: FileId, span: Span, first: Origin) {
         self.diags.push(
-            Diagnostic::error(codes::DUPLICATE, format!("{what} `{name}` is defined twice"), file, span, "defined again here")
-                .with_label(first.file, first.span, "first defined here")
-                .with_help("rename one of them or remove the duplicate"),
+            Diagnostic::error(
+                codes::DUPLICATE,
+                format!("{what} `{name}` is defined twice"),
+                file,
+                span,
+                "defined again here",
+            )
+            .with_label(first.file, first.span, "first defined here")
+            .with_help("rename one of them or remove the duplicate"),
         );
     }
 }

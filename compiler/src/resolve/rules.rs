@@ -24,6 +24,9 @@ pub(super) fn rule(cx: &mut Cx, file: FileId, rule: &ast::Rule) {
     }
     let mut ok = true;
     let (mut guards, mut patterns, mut negations, mut stale) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    // Which variables have had their binding site: the first positive
+    // `field: ?v` binds, every later one is an equality test.
+    let mut bound = Vec::new();
     for c in &rule.conditions {
         match c {
             ast::Condition::State(test) => {
@@ -31,14 +34,17 @@ pub(super) fn rule(cx: &mut Cx, file: FileId, rule: &ast::Rule) {
                 guards.push(cx.state_set(file, test));
                 ok &= cx.diags.len() == before;
             }
-            ast::Condition::Pattern(p) => match pattern(cx, file, p, &mut scope) {
+            ast::Condition::Pattern(p) => match pattern(cx, file, p, &mut scope, &mut bound) {
                 Some(p) => patterns.push(p),
                 None => ok = false,
             },
             ast::Condition::Not { pattern: p, .. } => {
+                // The rule's variables are bound outside: here they are
+                // tested; a variable first bound here is local to `not`.
                 let mut local = scope.clone();
+                let mut local_bound = vec![true; scope.len()];
                 collect_binds(cx, file, p, &mut local);
-                match pattern(cx, file, p, &mut local) {
+                match pattern(cx, file, p, &mut local, &mut local_bound) {
                     Some(p) => negations.push(p),
                     None => ok = false,
                 }
@@ -118,7 +124,17 @@ fn variable_type(file: FileId, var: &ast::Ident, ty: &Type, bound: &Variable) ->
 }
 
 /// Resolves one pattern; `None` when something in it does not resolve.
-pub(super) fn pattern(cx: &mut Cx, file: FileId, pat: &ast::Pattern, scope: &mut [Variable]) -> Option<Pattern> {
+/// `bound[v]` says whether `?v` already has its binding site: a `field: ?v`
+/// of a variable not bound yet becomes its [`FieldCheck::Bind`], any other
+/// one an equality test with it.
+pub(super) fn pattern(
+    cx: &mut Cx,
+    file: FileId,
+    pat: &ast::Pattern,
+    scope: &mut [Variable],
+    bound: &mut Vec<bool>,
+) -> Option<Pattern> {
+    bound.resize(scope.len(), false);
     let event = cx.event(file, &pat.event)?;
     let mut ok = true;
     let mut tests = Vec::new();
@@ -130,9 +146,16 @@ pub(super) fn pattern(cx: &mut Cx, file: FileId, pat: &ast::Pattern, scope: &mut
         let ty = cx.model.event(event).fields[field].ty.clone();
         let name = c.field.name.as_str();
         let check = match &c.test {
-            ast::FieldTest::Bind(var) => scope.iter().position(|v| v.name == var.name).map(FieldCheck::Bind),
+            ast::FieldTest::Bind(var) => scope.iter().position(|v| v.name == var.name).map(|v| {
+                if std::mem::replace(&mut bound[v], true) {
+                    FieldCheck::Compare { op: ast::CmpOp::Eq, rhs: Operand::Var(v) }
+                } else {
+                    FieldCheck::Bind(v)
+                }
+            }),
             ast::FieldTest::Compare { op, op_span, rhs } => {
-                let fits = !op.is_ordering() || types::ordered(cx, file, &ty, name, *op_span, &format!("`{}`", op.symbol()));
+                let fits =
+                    !op.is_ordering() || types::ordered(cx, file, &ty, name, *op_span, &format!("`{}`", op.symbol()));
                 let rhs = operand(cx, file, rhs, &ty, name, scope);
                 rhs.filter(|_| fits).map(|rhs| FieldCheck::Compare { op: *op, rhs })
             }
@@ -161,10 +184,23 @@ pub(super) fn pattern(cx: &mut Cx, file: FileId, pat: &ast::Pattern, scope: &mut
     if let Some(w) = &pat.within {
         ok &= cx.positive(file, w.nanos, w.span, "a window");
     }
-    ok.then(|| Pattern { event, tests, run_length, within: pat.within.map(|w| w.nanos), origin: Cx::origin(file, pat.span) })
+    ok.then(|| Pattern {
+        event,
+        tests,
+        run_length,
+        within: pat.within.map(|w| w.nanos),
+        origin: Cx::origin(file, pat.span),
+    })
 }
 
-fn operand(cx: &mut Cx, file: FileId, op: &ast::Operand, ty: &Type, field: &str, scope: &[Variable]) -> Option<Operand> {
+fn operand(
+    cx: &mut Cx,
+    file: FileId,
+    op: &ast::Operand,
+    ty: &Type,
+    field: &str,
+    scope: &[Variable],
+) -> Option<Operand> {
     match op {
         ast::Operand::Literal(lit) => types::literal(cx, file, lit, ty, field).map(Operand::Value),
         ast::Operand::Variable(var) => {

@@ -9,9 +9,10 @@ use situ_grammar::diag::{Diagnostic, FileId};
 
 pub(super) fn test(cx: &mut Cx, file: FileId, test: &ast::Test) {
     let origin = Cx::origin(file, test.name.span);
-    if let Some(first) = cx.model.tests.iter().find(|t| t.name == test.name.value) {
-        let first = first.origin;
+    if let Some(first) = cx.test_names.get(&test.name.value).copied() {
         cx.duplicate("test", &test.name.value, file, test.name.span, first);
+    } else {
+        cx.test_names.insert(test.name.value.clone(), origin);
     }
     let mut steps = Vec::new();
     let mut ok = true;
@@ -91,12 +92,21 @@ fn event_fact(cx: &mut Cx, file: FileId, e: &ast::EventInstance) -> Option<Event
         cx.diags.push(
             Diagnostic::error(
                 codes::MISSING_FIELD,
-                format!("event `{}` is missing {}: {}", e.event.name, plural(missing.len(), "field"), missing.join(", ")),
+                format!(
+                    "event `{}` is missing {}: {}",
+                    e.event.name,
+                    plural(missing.len(), "field"),
+                    missing.join(", ")
+                ),
                 file,
                 e.event.span,
                 "incomplete payload",
             )
-            .with_help(format!("a test event gives every field: `{}({})`", e.event.name, example.join(", "))),
+            .with_help(format!(
+                "a test event gives every field: `{}({})`",
+                e.event.name,
+                example.join(", ")
+            )),
         );
         ok = false;
     }
@@ -127,7 +137,9 @@ fn plural(n: usize, word: &str) -> String {
 fn expectation(cx: &mut Cx, file: FileId, e: &ast::Expectation) -> Option<Expectation> {
     let origin = Cx::origin(file, e.span());
     match e {
-        ast::Expectation::State { state, .. } => cx.state(file, state).map(|state| Expectation::State { state, origin }),
+        ast::Expectation::State { state, .. } => {
+            cx.state(file, state).map(|state| Expectation::State { state, origin })
+        }
         ast::Expectation::Mode { agent, mode, .. } => {
             cx.agent(file, agent).map(|agent| Expectation::Mode { agent, mode: *mode, origin })
         }
@@ -146,9 +158,10 @@ fn expectation(cx: &mut Cx, file: FileId, e: &ast::Expectation) -> Option<Expect
 
 pub(super) fn property(cx: &mut Cx, file: FileId, prop: &ast::Property) {
     let origin = Cx::origin(file, prop.name.span);
-    if let Some(first) = cx.model.properties.iter().find(|p| p.name == prop.name.value) {
-        let first = first.origin;
+    if let Some(first) = cx.property_names.get(&prop.name.value).copied() {
         cx.duplicate("property", &prop.name.value, file, prop.name.span, first);
+    } else {
+        cx.property_names.insert(prop.name.value.clone(), origin);
     }
     let formula = match &prop.formula {
         ast::Formula::Now(p) => pred(cx, file, p).map(Formula::Now),
@@ -181,7 +194,12 @@ pub(super) fn property(cx: &mut Cx, file: FileId, prop: &ast::Property) {
         }
     };
     if let Some(formula) = formula {
-        cx.model.properties.push(Property { name: prop.name.value.clone(), quantifier: prop.quantifier, formula, origin });
+        cx.model.properties.push(Property {
+            name: prop.name.value.clone(),
+            quantifier: prop.quantifier,
+            formula,
+            origin,
+        });
     }
 }
 
@@ -200,7 +218,9 @@ fn pred(cx: &mut Cx, file: FileId, p: &ast::Predicate) -> Option<Pred> {
             let set = cx.state_set(file, test);
             (cx.diags.len() == before).then_some(Pred::State(set))
         }
-        ast::Predicate::Mode { agent, mode, .. } => cx.agent(file, agent).map(|agent| Pred::Mode { agent, mode: *mode }),
+        ast::Predicate::Mode { agent, mode, .. } => {
+            cx.agent(file, agent).map(|agent| Pred::Mode { agent, mode: *mode })
+        }
         ast::Predicate::Link { from, to, .. } => {
             let from = cx.agent(file, from);
             let to = cx.agent(file, to);
@@ -210,7 +230,7 @@ fn pred(cx: &mut Cx, file: FileId, p: &ast::Predicate) -> Option<Pred> {
         ast::Predicate::Event(pat) => {
             let mut variables = Vec::new();
             collect_binds(cx, file, pat, &mut variables);
-            let pattern = pattern(cx, file, pat, &mut variables)?;
+            let pattern = pattern(cx, file, pat, &mut variables, &mut Vec::new())?;
             Some(Pred::Event { pattern, variables })
         }
     }
