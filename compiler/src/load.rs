@@ -54,9 +54,9 @@ struct LoadState<'a> {
     loaded: Loaded,
     /// Identities of the files read so far.
     seen: Vec<PathBuf>,
-    /// Identities of the files being read, root first: an include of one of
-    /// these is a cycle.
-    stack: Vec<PathBuf>,
+    /// Identities of the files being read, root first, with the names they
+    /// were reached by: an include of one of these is a cycle.
+    stack: Vec<(PathBuf, String)>,
 }
 
 impl LoadState<'_> {
@@ -87,7 +87,7 @@ impl LoadState<'_> {
         let id = self.loaded.sources.add(SourceFile::new(name, text));
         let parsed = situ_grammar::parse(&self.loaded.sources.get(id).text, id);
         self.loaded.diagnostics.extend(parsed.errors);
-        self.stack.push(identity);
+        self.stack.push((identity, self.loaded.sources.get(id).name.clone()));
         for item in &parsed.file.items {
             if let Item::Include(inc) = item {
                 self.include(path, id, &inc.path.value, inc.path.span);
@@ -104,9 +104,11 @@ impl LoadState<'_> {
             Ok(identity) => identity,
             Err(err) => return self.not_found(&path, from_id, span, &err),
         };
-        if let Some(pos) = self.stack.iter().position(|p| *p == identity) {
-            let cycle: Vec<String> =
-                self.stack[pos..].iter().chain([&identity]).map(|p| p.display().to_string()).collect();
+        if let Some(pos) = self.stack.iter().position(|(p, _)| *p == identity) {
+            // Named as the user wrote them, not by their canonical paths.
+            let back = path.display().to_string();
+            let cycle: Vec<&str> =
+                self.stack[pos..].iter().map(|(_, name)| name.as_str()).chain([back.as_str()]).collect();
             self.loaded.diagnostics.push(
                 Diagnostic::error(codes::INCLUDE_CYCLE, "include cycle", from_id, span, "this include closes a cycle")
                     .with_help(format!("the files include each other: {}", cycle.join(" -> ")))

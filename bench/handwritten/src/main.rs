@@ -1,0 +1,2 @@
+//! Placeholder: the hand-written matcher of `rules/outdoor.situ`.
+fn main() {}
