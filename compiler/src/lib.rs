@@ -25,6 +25,7 @@
 //! assert_eq!(found, [codes::UNDEFINED_EVENT, codes::UNDEFINED_STATE]);
 //! ```
 
+pub mod bundle;
 pub mod checks;
 pub mod codes;
 pub mod load;
@@ -32,6 +33,7 @@ pub mod loader;
 pub mod model;
 pub mod render;
 mod resolve;
+pub mod rete;
 pub mod source;
 
 pub use load::RootError;

@@ -285,7 +285,10 @@ pub struct Rule {
     /// The variables of the rule; [`VarId`] indexes this.
     pub variables: Vec<Variable>,
     pub target: StateId,
+    /// The rule's name.
     pub origin: Origin,
+    /// The whole rule, from its attributes to its closing brace.
+    pub item: Origin,
 }
 
 impl Rule {

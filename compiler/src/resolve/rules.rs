@@ -68,6 +68,7 @@ pub(super) fn rule(cx: &mut Cx, file: FileId, rule: &ast::Rule) {
             variables: scope,
             target,
             origin,
+            item: Cx::origin(file, rule.span),
         });
     }
 }

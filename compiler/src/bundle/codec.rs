@@ -1,0 +1,403 @@
+//! Writing and reading bundle files, JSON or binary, with the checks that
+//! make a damaged file an error that says what is wrong, never a panic and
+//! never a half-read network.
+//!
+//! - **JSON** (the default): the envelope of [`super`]'s documentation, with
+//!   the content pretty-printed, for people and diffs.
+//! - **Binary** (`situ build --binary`): `SITUBNDL`, the format version
+//!   (u32 LE), the content length (u64 LE), the SHA-256 of the content, the
+//!   compiler version (u32 LE length, UTF-8), then the content in postcard.
+//!
+//! Reading checks, in order: that the file is a bundle at all, that it is
+//! complete, that its format version is this one, that the content's hash
+//! is the recorded one, that the content decodes, and that every index in it
+//! is in range ([`validate`]). Each failure is its own [`LoadError`].
+
+use super::{Content, FORMAT_NAME, FORMAT_VERSION};
+use serde::{Deserialize, Serialize};
+use serde_json::value::RawValue;
+use sha2::{Digest, Sha256};
+use std::fmt;
+
+/// How a bundle is written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Encoding {
+    Json,
+    Binary,
+}
+
+const MAGIC: &[u8; 8] = b"SITUBNDL";
+
+/// The version of the compiler that writes bundles.
+pub const COMPILER_VERSION: &str = env!("CARGO_PKG_VERSION");
+
+/// Why a file is not a bundle this runtime can load.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum LoadError {
+    /// Not a situ bundle at all (another kind of file).
+    NotABundle { reason: String },
+    /// A bundle cut short: the file ends before the content does.
+    Truncated { reason: String },
+    /// A bundle whose JSON was damaged (invalid JSON inside).
+    Damaged { reason: String },
+    /// Written by a newer situ, in a format this one does not know.
+    NewerFormat { found: u32, supported: u32, compiler: String },
+    /// Written by an older situ, in a format this one no longer reads.
+    OlderFormat { found: u32, supported: u32, compiler: String },
+    /// The content is not the one that was hashed: it was edited.
+    Modified { expected: String, found: String },
+    /// The hash matches but the content is not a valid bundle of this format.
+    Invalid { reason: String },
+}
+
+impl fmt::Display for LoadError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            LoadError::NotABundle { reason } => write!(f, "not a situ bundle: {reason}"),
+            LoadError::Truncated { reason } => write!(f, "the bundle is truncated: {reason}"),
+            LoadError::Damaged { reason } => write!(f, "the bundle is damaged: {reason}"),
+            LoadError::NewerFormat { found, supported, compiler } => write!(
+                f,
+                "the bundle has format version {found} (written by situ {compiler}); this situ reads version {supported}: upgrade situ or rebuild the bundle"
+            ),
+            LoadError::OlderFormat { found, supported, compiler } => write!(
+                f,
+                "the bundle has format version {found} (written by situ {compiler}); this situ reads version {supported}: rebuild it with `situ build`"
+            ),
+            LoadError::Modified { expected, found } => write!(
+                f,
+                "the bundle was modified after it was built: its content hashes to {found}, not to the recorded {expected}; rebuild it with `situ build`"
+            ),
+            LoadError::Invalid { reason } => write!(f, "the bundle is invalid: {reason}"),
+        }
+    }
+}
+
+impl std::error::Error for LoadError {}
+
+#[derive(Serialize)]
+struct EnvelopeOut<'a> {
+    format: &'static str,
+    format_version: u32,
+    compiler_version: &'static str,
+    sha256: String,
+    content: &'a RawValue,
+}
+
+#[derive(Deserialize)]
+struct EnvelopeIn<'a> {
+    format: Option<String>,
+    format_version: Option<u32>,
+    compiler_version: Option<String>,
+    sha256: Option<String>,
+    #[serde(borrow)]
+    content: Option<&'a RawValue>,
+}
+
+/// The SHA-256 of bytes, in lowercase hex.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    Sha256::digest(bytes).iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// The file bytes of a bundle.
+pub fn encode(content: &Content, encoding: Encoding) -> Vec<u8> {
+    match encoding {
+        Encoding::Json => {
+            let body = serde_json::to_string_pretty(content).expect("bundle content serializes");
+            let raw = RawValue::from_string(body).expect("serde_json writes valid JSON");
+            let envelope = EnvelopeOut {
+                format: FORMAT_NAME,
+                format_version: FORMAT_VERSION,
+                compiler_version: COMPILER_VERSION,
+                sha256: sha256_hex(raw.get().as_bytes()),
+                content: &raw,
+            };
+            let mut out = serde_json::to_vec(&envelope).expect("the envelope serializes");
+            out.push(b'\n');
+            out
+        }
+        Encoding::Binary => {
+            let body = postcard::to_allocvec(content).expect("bundle content serializes");
+            let mut out = Vec::with_capacity(body.len() + 64);
+            out.extend_from_slice(MAGIC);
+            out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+            out.extend_from_slice(&(body.len() as u64).to_le_bytes());
+            out.extend_from_slice(&Sha256::digest(&body));
+            out.extend_from_slice(&(COMPILER_VERSION.len() as u32).to_le_bytes());
+            out.extend_from_slice(COMPILER_VERSION.as_bytes());
+            out.extend_from_slice(&body);
+            out
+        }
+    }
+}
+
+/// Reads a bundle file, JSON or binary (told apart by the first bytes).
+pub fn decode(bytes: &[u8]) -> Result<Content, LoadError> {
+    let content = if bytes.starts_with(MAGIC) {
+        decode_binary(&bytes[MAGIC.len()..])?
+    } else if MAGIC.starts_with(bytes) && !bytes.is_empty() {
+        return Err(LoadError::Truncated { reason: format!("the file ends after {} bytes", bytes.len()) });
+    } else {
+        decode_json(bytes)?
+    };
+    validate(&content).map_err(|reason| LoadError::Invalid { reason })?;
+    Ok(content)
+}
+
+fn decode_json(bytes: &[u8]) -> Result<Content, LoadError> {
+    let text = std::str::from_utf8(bytes)
+        .map_err(|e| LoadError::NotABundle { reason: format!("it is neither a JSON nor a binary bundle ({e})") })?;
+    let looks_like_bundle = text.get(..200.min(text.len())).is_some_and(|head| head.contains(FORMAT_NAME));
+    let envelope: EnvelopeIn = match serde_json::from_str(text) {
+        Ok(e) => e,
+        Err(e) if looks_like_bundle && e.is_eof() => {
+            return Err(LoadError::Truncated { reason: format!("the JSON ends early ({e})") })
+        }
+        Err(e) if looks_like_bundle => return Err(LoadError::Damaged { reason: format!("invalid JSON: {e}") }),
+        Err(e) if text.trim().is_empty() => {
+            return Err(LoadError::NotABundle { reason: format!("the file is empty ({e})") })
+        }
+        Err(e) => return Err(LoadError::NotABundle { reason: format!("it is not a JSON bundle ({e})") }),
+    };
+    if envelope.format.as_deref() != Some(FORMAT_NAME) {
+        return Err(LoadError::NotABundle {
+            reason: match envelope.format {
+                Some(other) => format!("its `format` is `{other}`, not `{FORMAT_NAME}`"),
+                None => format!("it has no `format` field (a bundle says `\"format\": \"{FORMAT_NAME}\"`)"),
+            },
+        });
+    }
+    let compiler = envelope.compiler_version.unwrap_or_else(|| "unknown".into());
+    check_version(envelope.format_version, compiler)?;
+    let (Some(expected), Some(raw)) = (envelope.sha256, envelope.content) else {
+        return Err(LoadError::Damaged { reason: "the `sha256` or `content` field is missing".into() });
+    };
+    let found = sha256_hex(raw.get().as_bytes());
+    if found != expected {
+        return Err(LoadError::Modified { expected, found });
+    }
+    serde_json::from_str(raw.get()).map_err(|e| LoadError::Invalid { reason: e.to_string() })
+}
+
+fn check_version(found: Option<u32>, compiler: String) -> Result<(), LoadError> {
+    match found {
+        None => Err(LoadError::Damaged { reason: "the `format_version` field is missing".into() }),
+        Some(found) if found > FORMAT_VERSION => {
+            Err(LoadError::NewerFormat { found, supported: FORMAT_VERSION, compiler })
+        }
+        Some(found) if found < FORMAT_VERSION => {
+            Err(LoadError::OlderFormat { found, supported: FORMAT_VERSION, compiler })
+        }
+        Some(_) => Ok(()),
+    }
+}
+
+fn decode_binary(bytes: &[u8]) -> Result<Content, LoadError> {
+    let mut at = 0usize;
+    let mut take = |n: usize, what: &str| -> Result<&[u8], LoadError> {
+        let end = at
+            .checked_add(n)
+            .filter(|&e| e <= bytes.len())
+            .ok_or_else(|| LoadError::Truncated { reason: format!("the file ends inside the header ({what})") })?;
+        let slice = &bytes[at..end];
+        at = end;
+        Ok(slice)
+    };
+    let version = u32::from_le_bytes(take(4, "format version")?.try_into().expect("4 bytes"));
+    let length = u64::from_le_bytes(take(8, "content length")?.try_into().expect("8 bytes"));
+    let expected: String = take(32, "hash")?.iter().map(|b| format!("{b:02x}")).collect();
+    let name_len = u32::from_le_bytes(take(4, "compiler version")?.try_into().expect("4 bytes")) as usize;
+    if name_len > 256 {
+        return Err(LoadError::Damaged { reason: format!("a compiler version of {name_len} bytes") });
+    }
+    let compiler = String::from_utf8_lossy(take(name_len, "compiler version")?).into_owned();
+    check_version(Some(version), compiler)?;
+    let body = &bytes[at..];
+    if (body.len() as u64) < length {
+        return Err(LoadError::Truncated { reason: format!("{} of {length} content bytes", body.len()) });
+    }
+    if (body.len() as u64) > length {
+        return Err(LoadError::Damaged { reason: format!("{} bytes follow the content", body.len() as u64 - length) });
+    }
+    let found = sha256_hex(body);
+    if found != expected {
+        return Err(LoadError::Modified { expected, found });
+    }
+    postcard::from_bytes(body).map_err(|e| LoadError::Invalid { reason: e.to_string() })
+}
+
+/// Checks that every index of the content points at something, and that
+/// values fit their fields: what a runtime relies on to never panic.
+pub fn validate(c: &Content) -> Result<(), String> {
+    let (ns, na, ne) = (c.states.len(), c.agents.len(), c.events.len());
+    let idx = |what: &str, i: u32, n: usize| {
+        if (i as usize) < n {
+            Ok(())
+        } else {
+            Err(format!("{what} {i} does not exist ({n} declared)"))
+        }
+    };
+    if ns == 0 {
+        return Err("it declares no state".into());
+    }
+    idx("initial state", c.initial, ns)?;
+    for (i, e) in c.events.iter().enumerate() {
+        idx(&format!("the agent of event `{}`: agent", e.name), e.agent, na)?;
+        if !c.agents[e.agent as usize].events.contains(&(i as u32)) {
+            return Err(format!("event `{}` is not listed by its agent", e.name));
+        }
+        if e.fields.len() > 64 {
+            return Err(format!("event `{}` has {} fields (at most 64)", e.name, e.fields.len()));
+        }
+    }
+    for a in &c.agents {
+        for &e in &a.events {
+            idx(&format!("an event of agent `{}`: event", a.name), e, ne)?;
+        }
+        let nf = a.functions.len();
+        let action = |act: &super::Action| -> Result<(), String> {
+            if let Some(f) = act.function {
+                idx(&format!("a function of agent `{}`: function", a.name), f, nf)?;
+            }
+            for &x in act.from.iter().chain(&act.to) {
+                idx(&format!("a link of agent `{}`: agent", a.name), x, na)?;
+            }
+            Ok(())
+        };
+        match &a.behaviour {
+            super::Behaviour::Always => {}
+            super::Behaviour::Table { actions } => {
+                if actions.len() != ns {
+                    return Err(format!("the table of `{}` has {} states, not {ns}", a.name, actions.len()));
+                }
+                actions.iter().flatten().try_for_each(action)?;
+            }
+            super::Behaviour::Fsm(f) => {
+                idx(&format!("the initial FSM state of `{}`: state", a.name), f.initial, f.states.len())?;
+                f.states.iter().try_for_each(|s| action(&s.action))?;
+                for t in &f.transitions {
+                    idx("an FSM transition's state", t.from, f.states.len())?;
+                    idx("an FSM transition's state", t.to, f.states.len())?;
+                    match &t.trigger {
+                        super::Trigger::States(s) => s.iter().try_for_each(|&s| idx("a trigger state", s, ns))?,
+                        super::Trigger::Event(e) => idx("a trigger event", *e, ne)?,
+                    }
+                }
+            }
+        }
+    }
+    for r in &c.rules {
+        idx(&format!("the target of rule `{}`: state", r.name), r.target, ns)?;
+        for &a in r.matches.iter().chain(&r.stale) {
+            idx(&format!("an agent of rule `{}`: agent", r.name), a, na)?;
+        }
+    }
+    let net = &c.network;
+    for node in &net.alpha {
+        match node {
+            super::AlphaNode::State { states } => {
+                states.iter().try_for_each(|&s| idx("an alpha node's state", s, ns))?
+            }
+            super::AlphaNode::Stale { agent } => idx("an alpha node's agent", *agent, na)?,
+            super::AlphaNode::Event { event, tests, .. } => {
+                idx("an alpha node's event", *event, ne)?;
+                for t in tests {
+                    validate_test(c, *event, t, false)?;
+                }
+            }
+        }
+    }
+    for (i, b) in net.beta.iter().enumerate() {
+        if let Some(p) = b.parent {
+            if p as usize >= i {
+                return Err(format!("beta node {i} comes before its parent {p}"));
+            }
+        }
+        idx("a beta node's alpha node", b.alpha, net.alpha.len())?;
+        let event = match &net.alpha[b.alpha as usize] {
+            super::AlphaNode::Event { event, .. } => Some(*event),
+            _ => None,
+        };
+        for t in &b.tests {
+            let Some(event) = event else { return Err(format!("beta node {i} tests fields of a fact without fields")) };
+            validate_test(c, event, t, true)?;
+        }
+    }
+    if net.terminals.len() != c.rules.len() {
+        return Err(format!("{} terminal nodes for {} rules", net.terminals.len(), c.rules.len()));
+    }
+    for (i, t) in net.terminals.iter().enumerate() {
+        if t.rule as usize != i {
+            return Err(format!("terminal {i} is for rule {}", t.rule));
+        }
+        idx("a terminal's beta node", t.beta, net.beta.len())?;
+    }
+    if c.wiring.len() != ns {
+        return Err(format!("{} wiring graphs for {ns} states", c.wiring.len()));
+    }
+    for w in &c.wiring {
+        idx("a wiring graph's state", w.state, ns)?;
+        for &(a, b) in &w.links {
+            idx("a link's agent", a, na)?;
+            idx("a link's agent", b, na)?;
+        }
+        for l in &w.fsm_links {
+            idx("a link's agent", l.from, na)?;
+            idx("a link's agent", l.to, na)?;
+            idx("a link's agent", l.agent, na)?;
+        }
+    }
+    Ok(())
+}
+
+/// A test on a field of `event`: the field exists, a constant fits its type,
+/// and an operand from another fact exists (only in beta tests).
+fn validate_test(c: &Content, event: u32, t: &super::Test, beta: bool) -> Result<(), String> {
+    use super::{Check, FieldType, Operand, Value};
+    let e = &c.events[event as usize];
+    let Some(field) = e.fields.get(t.field as usize) else {
+        return Err(format!("event `{}` has no field {}", e.name, t.field));
+    };
+    let operand = |o: &Operand| -> Result<(), String> {
+        match o {
+            Operand::Value(v) => {
+                let fits = match (&field.ty, v) {
+                    (FieldType::F64, Value::F64(_) | Value::I64(_)) | (FieldType::I64, Value::I64(_)) => true,
+                    (FieldType::Bool, Value::Bool(_)) => true,
+                    (FieldType::Symbols(s), Value::Symbol(i)) => (*i as usize) < s.len(),
+                    _ => false,
+                };
+                if fits {
+                    Ok(())
+                } else {
+                    Err(format!("a constant compared with `{}.{}` does not fit its type", e.name, field.name))
+                }
+            }
+            Operand::Own { field: f } => {
+                if (*f as usize) < e.fields.len() {
+                    Ok(())
+                } else {
+                    Err(format!("event `{}` has no field {f}", e.name))
+                }
+            }
+            Operand::Fact { agent, field: f } if beta => {
+                let Some(a) = c.agents.get(*agent as usize) else {
+                    return Err(format!("agent {agent} does not exist"));
+                };
+                // The operand reads whatever event the agent's fact is; every
+                // event of the agent must have the field (the runtime checks
+                // the event before reading, so this is only a sanity bound).
+                if a.events.iter().any(|&ev| (*f as usize) < c.events[ev as usize].fields.len()) {
+                    Ok(())
+                } else {
+                    Err(format!("no event of agent `{}` has field {f}", a.name))
+                }
+            }
+            Operand::Fact { .. } => Err("an alpha test reads another fact".into()),
+        }
+    };
+    match &t.check {
+        Check::Compare { rhs, .. } => operand(rhs),
+        Check::Range { lo, hi, .. } => operand(lo).and_then(|_| operand(hi)),
+    }
+}

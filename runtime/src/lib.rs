@@ -1,0 +1,12 @@
+//! The situ runtime: it loads bundles and runs them. It never needs the
+//! grammar: a bundle is everything it knows of a program.
+//!
+//! - [`rete`]: the inference machine, a Rete interpreter over the bundle's
+//!   network and a working memory of one state and one fact per agent;
+//! - [`bulletinboard`]: the Bulletinboard of Zhang & Zhu (2005) around it:
+//!   posting events, the state history, subscriptions, explanations, hot swap;
+//! - [`stream`]: seeded random event streams and their text form, for
+//!   benchmarks and differential tests.
+
+pub mod rete;
+pub mod stream;

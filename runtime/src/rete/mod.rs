@@ -1,0 +1,725 @@
+//! The Rete interpreter: the inference machine of the Bulletinboard.
+//!
+//! The working memory is the state fact and, per agent, its latest event
+//! (payload, time, run length, posting sequence), or nothing, or "stale"
+//! (language reference §10.2). Because each agent has at most one fact, each
+//! alpha memory holds at most one fact and each beta memory at most one
+//! token: memories are flags, and a token's facts are the agents' current
+//! facts. What stays Rete is the propagation: a change of the memory touches
+//! only the alpha nodes of the event concerned and the beta nodes below
+//! them, in topological order, never the whole network.
+//!
+//! [`Engine::post`] processes one event (§10.4):
+//! 1. now = max(now, t); facts older than their agent's `stale after`
+//!    expire and windows close; the network is brought to rest;
+//! 2. the new fact replaces the agent's previous one; rest again.
+//!
+//! Rest: among the activated rules (conditions hold, target differs from the
+//! state), fire the first by salience, specificity, recency, declaration
+//! order; set the state; repeat. More than [`Engine::cascade_limit`] firings
+//! for one event is a [`PostError::Cascade`].
+
+mod eval;
+mod net;
+
+use net::{AlphaKind, Net, OperandRt, TestKind, TestRt, NONE};
+use situ_compiler::bundle::{Content, FieldType, Value};
+use std::sync::Arc;
+
+pub use eval::{compare, in_range};
+
+/// The default bound of a cascade (§10.4).
+pub const CASCADE_LIMIT: usize = 64;
+
+/// An agent's latest fact.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Slot {
+    /// `NONE`: no fact (never reported, expired, or reset).
+    event: u32,
+    time: u64,
+    run: u64,
+    /// The posting sequence number (recency).
+    seq: u64,
+}
+
+const EMPTY: Slot = Slot { event: NONE, time: 0, run: 0, seq: 0 };
+
+/// A fact as matched by a firing, for explanations.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MatchedFact {
+    pub agent: u32,
+    pub event: u32,
+    pub payload: Vec<Value>,
+    pub time: u64,
+    pub run: u64,
+}
+
+/// One rule firing.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Firing {
+    pub rule: u32,
+    pub from: u32,
+    pub to: u32,
+    /// Now, when it fired.
+    pub time: u64,
+    /// The facts its positive patterns matched, in pattern order.
+    pub matched: Vec<MatchedFact>,
+    /// The agents its `stale A` tests found stale.
+    pub stale: Vec<u32>,
+}
+
+/// What one event (or a settling) did: the rules that fired, in order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StateChange {
+    /// The state at rest before, and after.
+    pub from: u32,
+    pub to: u32,
+    pub time: u64,
+    pub firings: Vec<Firing>,
+}
+
+impl StateChange {
+    /// Whether the state at rest changed (a cascade may come back).
+    pub fn changed(&self) -> bool {
+        self.from != self.to
+    }
+
+    /// The change in source terms: every firing with its rule, where it is
+    /// written, and the facts that made it hold.
+    pub fn explain(&self, c: &Content) -> String {
+        let mut out = format!(
+            "{} -> {} at {}",
+            c.states[self.from as usize].name,
+            c.states[self.to as usize].name,
+            format_time(self.time)
+        );
+        for f in &self.firings {
+            let rule = &c.rules[f.rule as usize];
+            out.push_str(&format!(
+                "\n  rule `{}` ({}, salience {}) fired in {}: ",
+                rule.name, rule.source, rule.salience, c.states[f.from as usize].name
+            ));
+            let mut why: Vec<String> = f.matched.iter().map(|m| describe_fact(c, m)).collect();
+            why.extend(f.stale.iter().map(|&a| format!("{} stale", c.agents[a as usize].name)));
+            if why.is_empty() {
+                out.push_str("its state guard holds");
+            } else {
+                out.push_str(&why.join(", "));
+            }
+            out.push_str(&format!(" -> {}", c.states[f.to as usize].name));
+        }
+        out
+    }
+}
+
+/// A fact as a person writes an event: `LAOBS(distance: 12.0, height: 0.5) x2 at 1.230s`.
+pub fn describe_fact(c: &Content, m: &MatchedFact) -> String {
+    let e = &c.events[m.event as usize];
+    let mut s = e.name.clone();
+    if !e.fields.is_empty() {
+        let args: Vec<String> =
+            e.fields.iter().zip(&m.payload).map(|(f, v)| format!("{}: {}", f.name, show_value(&f.ty, *v))).collect();
+        s.push_str(&format!("({})", args.join(", ")));
+    }
+    if m.run > 1 {
+        s.push_str(&format!(" x{}", m.run));
+    }
+    s.push_str(&format!(" at {}", format_time(m.time)));
+    s
+}
+
+/// A value as written in situ.
+pub fn show_value(ty: &FieldType, v: Value) -> String {
+    match (ty, v) {
+        (FieldType::Symbols(s), Value::Symbol(i)) => s.get(i as usize).cloned().unwrap_or_else(|| format!("#{i}")),
+        (_, Value::F64(f)) if f.is_finite() && f.fract() == 0.0 && f.abs() < 1e15 => format!("{f:.1}"),
+        (_, Value::F64(f)) => format!("{f}"),
+        (_, Value::I64(i)) => i.to_string(),
+        (_, Value::Bool(b)) => b.to_string(),
+        (_, Value::Symbol(i)) => format!("#{i}"),
+    }
+}
+
+/// Nanoseconds as seconds with millisecond precision: `1.230s`.
+pub fn format_time(ns: u64) -> String {
+    format!("{}.{:03}s", ns / 1_000_000_000, (ns / 1_000_000) % 1000)
+}
+
+/// Why an event was not taken, or what went wrong while it was processed.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PostError {
+    /// No event has this id in the bundle.
+    UnknownEvent { event: u32 },
+    /// The payload has the wrong number of values.
+    Arity { event: u32, expected: usize, found: usize },
+    /// A value does not fit its field's type.
+    Type { event: u32, field: u32, expected: FieldType },
+    /// The network did not come to rest within the bound: the firings so
+    /// far, which name the rules. The state is the last one reached.
+    Cascade { limit: usize, firings: Vec<Firing> },
+}
+
+impl PostError {
+    pub fn describe(&self, c: &Content) -> String {
+        match self {
+            PostError::UnknownEvent { event } => format!("unknown event id {event}"),
+            PostError::Arity { event, expected, found } => format!(
+                "event `{}` has {expected} payload field(s), {found} given",
+                c.events.get(*event as usize).map_or("?", |e| &e.name)
+            ),
+            PostError::Type { event, field, expected } => {
+                let e = &c.events[*event as usize];
+                format!(
+                    "field `{}.{}` is {}, the value is not",
+                    e.name,
+                    e.fields[*field as usize].name,
+                    expected.describe()
+                )
+            }
+            PostError::Cascade { limit, firings } => {
+                let mut names: Vec<&str> = firings.iter().map(|f| c.rules[f.rule as usize].name.as_str()).collect();
+                names.dedup();
+                format!(
+                    "the rules did not come to rest within {limit} firings: {} (an oscillation: make their conditions exclude each other)",
+                    names.join(", ")
+                )
+            }
+        }
+    }
+}
+
+/// The Rete network of a bundle with its working memory.
+#[derive(Debug, Clone)]
+pub struct Engine {
+    content: Arc<Content>,
+    net: Net,
+    // Working memory.
+    state: u32,
+    slots: Vec<Slot>,
+    payload: Vec<Value>,
+    stale: Vec<bool>,
+    now: u64,
+    seq: u64,
+    // Timers: per agent the time its fact expires and the next window that
+    // closes (u64::MAX: none); the earliest of all, possibly too early.
+    stale_at: Vec<u64>,
+    window_at: Vec<u64>,
+    next_deadline: u64,
+    // Network memories.
+    alpha_mem: Vec<bool>,
+    beta_tok: Vec<bool>,
+    dirty: Vec<u64>,
+    dirty_lo: usize,
+    dirty_hi: usize,
+    /// Activated rules, and each rule's position in it (`NONE`: not activated).
+    active: Vec<u32>,
+    active_pos: Vec<u32>,
+    cascade_limit: usize,
+}
+
+impl Engine {
+    /// The engine of a validated bundle, in its initial state with no facts.
+    pub fn new(content: Arc<Content>) -> Engine {
+        let net = Net::new(&content);
+        let na = content.agents.len();
+        let nb = net.beta.len();
+        let mut e = Engine {
+            state: content.initial,
+            slots: vec![EMPTY; na],
+            payload: vec![Value::Bool(false); net.payload_len],
+            stale: vec![false; na],
+            now: 0,
+            seq: 0,
+            stale_at: vec![u64::MAX; na],
+            window_at: vec![u64::MAX; na],
+            next_deadline: u64::MAX,
+            alpha_mem: vec![false; net.alpha.len()],
+            beta_tok: vec![false; nb],
+            dirty: vec![0; nb.div_ceil(64).max(1)],
+            dirty_lo: usize::MAX,
+            dirty_hi: 0,
+            active: Vec::new(),
+            active_pos: vec![NONE; content.rules.len()],
+            cascade_limit: CASCADE_LIMIT,
+            content,
+            net,
+        };
+        e.recompute();
+        e
+    }
+
+    pub fn content(&self) -> &Arc<Content> {
+        &self.content
+    }
+
+    /// The current state.
+    pub fn state(&self) -> u32 {
+        self.state
+    }
+
+    /// The largest timestamp seen.
+    pub fn now(&self) -> u64 {
+        self.now
+    }
+
+    /// The cascade bound (default [`CASCADE_LIMIT`]).
+    pub fn cascade_limit(&self) -> usize {
+        self.cascade_limit
+    }
+
+    pub fn set_cascade_limit(&mut self, limit: usize) {
+        self.cascade_limit = limit.max(1);
+    }
+
+    /// An agent's live fact: event, payload, time, run length.
+    pub fn fact(&self, agent: u32) -> Option<MatchedFact> {
+        let slot = self.slots.get(agent as usize)?;
+        (slot.event != NONE).then(|| self.snapshot(agent))
+    }
+
+    /// Whether the agent's fact has expired.
+    pub fn is_stale(&self, agent: u32) -> bool {
+        self.stale.get(agent as usize).copied().unwrap_or(false)
+    }
+
+    /// The rules activated now (at rest: none).
+    pub fn activated(&self) -> &[u32] {
+        &self.active
+    }
+
+    /// Back to the initial state with no facts; now is kept.
+    pub fn reset(&mut self) {
+        self.state = self.content.initial;
+        self.slots.fill(EMPTY);
+        self.stale.fill(false);
+        self.stale_at.fill(u64::MAX);
+        self.window_at.fill(u64::MAX);
+        self.next_deadline = u64::MAX;
+        self.recompute();
+    }
+
+    /// Checks an event against the bundle's schema.
+    pub fn validate(&self, event: u32, payload: &[Value]) -> Result<(), PostError> {
+        let Some(e) = self.content.events.get(event as usize) else {
+            return Err(PostError::UnknownEvent { event });
+        };
+        if e.fields.len() != payload.len() {
+            return Err(PostError::Arity { event, expected: e.fields.len(), found: payload.len() });
+        }
+        for (i, (f, v)) in e.fields.iter().zip(payload).enumerate() {
+            let fits = match (&f.ty, v) {
+                (FieldType::F64, Value::F64(_))
+                | (FieldType::I64, Value::I64(_))
+                | (FieldType::Bool, Value::Bool(_)) => true,
+                (FieldType::Symbols(s), Value::Symbol(k)) => (*k as usize) < s.len(),
+                _ => false,
+            };
+            if !fits {
+                return Err(PostError::Type { event, field: i as u32, expected: f.ty.clone() });
+            }
+        }
+        Ok(())
+    }
+
+    /// Processes one event: expiry, rest, the new fact, rest. Returns the
+    /// firings, if any rule fired.
+    pub fn post(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Option<StateChange>, PostError> {
+        self.validate(event, payload)?;
+        let from = self.state;
+        let mut firings = Vec::new();
+        if time > self.now {
+            self.now = time;
+        }
+        if self.now > self.next_deadline {
+            self.expire();
+        }
+        self.rest(&mut firings)?;
+        self.insert(event, time, payload);
+        if self.now > self.next_deadline {
+            // The fact came late: it may be expired already.
+            self.expire();
+        }
+        self.rest(&mut firings)?;
+        Ok((!firings.is_empty()).then_some(StateChange { from, to: self.state, time: self.now, firings }))
+    }
+
+    /// Brings the network to rest without an event (e.g. at start, for
+    /// rules that hold with no facts).
+    pub fn settle(&mut self) -> Result<Option<StateChange>, PostError> {
+        let from = self.state;
+        let mut firings = Vec::new();
+        self.rest(&mut firings)?;
+        Ok((!firings.is_empty()).then_some(StateChange { from, to: self.state, time: self.now, firings }))
+    }
+
+    /// Sets the state without firing rules (tests' `given`, hot swap).
+    pub fn force_state(&mut self, state: u32) {
+        if (state as usize) < self.content.states.len() {
+            self.set_state(state);
+        }
+    }
+
+    /// Sets an agent's fact without firing rules (tests' `given`): the
+    /// event at `time` with run length `run`; now advances to `time`.
+    pub fn force_fact(&mut self, event: u32, time: u64, payload: &[Value], run: u64) -> Result<(), PostError> {
+        self.validate(event, payload)?;
+        self.now = self.now.max(time);
+        self.insert(event, time, payload);
+        let agent = self.content.events[event as usize].agent as usize;
+        self.slots[agent].run = run.max(1);
+        self.refresh_alpha(agent as u32);
+        self.propagate();
+        Ok(())
+    }
+
+    // ─── Working memory ────────────────────────────────────────────────
+
+    fn snapshot(&self, agent: u32) -> MatchedFact {
+        let slot = self.slots[agent as usize];
+        let n = self.content.events.get(slot.event as usize).map_or(0, |e| e.fields.len());
+        let at = self.net.payload_at[agent as usize] as usize;
+        MatchedFact {
+            agent,
+            event: slot.event,
+            payload: self.payload[at..at + n].to_vec(),
+            time: slot.time,
+            run: slot.run,
+        }
+    }
+
+    /// Replaces the agent's fact and updates its alpha memories (no propagation).
+    fn insert(&mut self, event: u32, time: u64, payload: &[Value]) {
+        let agent = self.content.events[event as usize].agent;
+        let a = agent as usize;
+        let old = self.slots[a];
+        self.seq += 1;
+        let run = if old.event == event { old.run + 1 } else { 1 };
+        self.slots[a] = Slot { event, time, run, seq: self.seq };
+        let at = self.net.payload_at[a] as usize;
+        self.payload[at..at + payload.len()].copy_from_slice(payload);
+        if self.stale[a] {
+            self.stale[a] = false;
+            self.set_stale_alpha(agent, false);
+        }
+        if old.event != NONE && old.event != event {
+            self.clear_event_alpha(old.event);
+        }
+        self.eval_event_alpha(event);
+        // Timers.
+        let stale_after = self.net.stale_after[a];
+        self.stale_at[a] = if stale_after == u64::MAX { u64::MAX } else { time.saturating_add(stale_after) };
+        self.window_at[a] = self.next_window(event, time);
+        self.next_deadline = self.next_deadline.min(self.stale_at[a]).min(self.window_at[a]);
+    }
+
+    /// When the next window of a fact of `event` reported at `time` closes:
+    /// `time + w` for the smallest window `w` still open (`u64::MAX`: none).
+    fn next_window(&self, event: u32, time: u64) -> u64 {
+        let (s, e) = self.net.event_windows_at[event as usize];
+        self.net.windows[s as usize..e as usize]
+            .iter()
+            .map(|w| time.saturating_add(*w))
+            .find(|&deadline| deadline >= self.now)
+            .unwrap_or(u64::MAX)
+    }
+
+    /// Expires facts and closes windows whose time has passed.
+    fn expire(&mut self) {
+        let mut next = u64::MAX;
+        for i in 0..self.net.timed_agents.len() {
+            let a = self.net.timed_agents[i] as usize;
+            if self.stale_at[a] < self.now {
+                // `now - t > stale after`: the fact expires.
+                let old = self.slots[a].event;
+                self.slots[a] = EMPTY;
+                self.clear_event_alpha(old);
+                self.stale[a] = true;
+                self.set_stale_alpha(a as u32, true);
+                self.stale_at[a] = u64::MAX;
+                self.window_at[a] = u64::MAX;
+            } else if self.window_at[a] < self.now {
+                self.refresh_alpha(a as u32);
+                let slot = self.slots[a];
+                self.window_at[a] = self.next_window(slot.event, slot.time);
+            }
+            next = next.min(self.stale_at[a]).min(self.window_at[a]);
+        }
+        self.next_deadline = next;
+    }
+
+    // ─── Alpha network ─────────────────────────────────────────────────
+
+    fn clear_event_alpha(&mut self, event: u32) {
+        let (s, e) = self.net.event_alpha_at[event as usize];
+        for i in s..e {
+            let a = self.net.event_alpha[i as usize] as usize;
+            if self.alpha_mem[a] {
+                self.alpha_mem[a] = false;
+                self.mark_succ(a);
+            }
+        }
+    }
+
+    /// Re-evaluates the alpha nodes of `event` against its agent's new fact:
+    /// successors of nodes that pass or passed are marked (a replaced fact
+    /// is a new token even when the test result stays).
+    fn eval_event_alpha(&mut self, event: u32) {
+        let (s, e) = self.net.event_alpha_at[event as usize];
+        for i in s..e {
+            let a = self.net.event_alpha[i as usize] as usize;
+            let pass = self.alpha_passes(a);
+            if pass || self.alpha_mem[a] {
+                self.alpha_mem[a] = pass;
+                self.mark_succ(a);
+            }
+        }
+    }
+
+    /// Re-evaluates the alpha nodes of an agent's current event (windows,
+    /// forced run lengths); marks successors only where the result changes.
+    fn refresh_alpha(&mut self, agent: u32) {
+        let event = self.slots[agent as usize].event;
+        if event == NONE {
+            return;
+        }
+        let (s, e) = self.net.event_alpha_at[event as usize];
+        for i in s..e {
+            let a = self.net.event_alpha[i as usize] as usize;
+            let pass = self.alpha_passes(a);
+            if pass != self.alpha_mem[a] {
+                self.alpha_mem[a] = pass;
+                self.mark_succ(a);
+            }
+        }
+    }
+
+    fn set_stale_alpha(&mut self, agent: u32, stale: bool) {
+        let a = self.net.stale_alpha[agent as usize];
+        if a != NONE && self.alpha_mem[a as usize] != stale {
+            self.alpha_mem[a as usize] = stale;
+            self.mark_succ(a as usize);
+        }
+    }
+
+    fn alpha_passes(&self, a: usize) -> bool {
+        let node = &self.net.alpha[a];
+        match node.kind {
+            AlphaKind::State => self.net.state_in(node, self.state),
+            AlphaKind::Stale => self.stale[node.agent as usize],
+            AlphaKind::Event => {
+                let slot = &self.slots[node.agent as usize];
+                if slot.event != node.key || slot.run < node.min_run {
+                    return false;
+                }
+                if node.within_ns != u64::MAX && self.now.saturating_sub(slot.time) > node.within_ns {
+                    return false;
+                }
+                let at = self.net.payload_at[node.agent as usize] as usize;
+                let (s, e) = node.tests;
+                self.net.alpha_tests[s as usize..e as usize].iter().all(|t| self.test(t, at))
+            }
+        }
+    }
+
+    #[inline]
+    fn operand(&self, o: OperandRt, own: usize) -> Value {
+        match o {
+            OperandRt::Value(v) => v,
+            OperandRt::Own(f) => self.payload[own + f as usize],
+            OperandRt::Fact { agent, field } => {
+                let a = agent as usize;
+                if field < self.net.stride[a] {
+                    self.payload[self.net.payload_at[a] as usize + field as usize]
+                } else {
+                    // Cannot happen in a valid token; a value that matches nothing.
+                    Value::F64(f64::NAN)
+                }
+            }
+        }
+    }
+
+    #[inline]
+    fn test(&self, t: &TestRt, own: usize) -> bool {
+        let x = self.payload[own + t.field as usize];
+        match t.kind {
+            TestKind::Compare { op, rhs } => compare(op, x, self.operand(rhs, own)),
+            TestKind::Range { lo, hi, inclusive } => {
+                in_range(x, self.operand(lo, own), self.operand(hi, own), inclusive)
+            }
+        }
+    }
+
+    // ─── Beta network ──────────────────────────────────────────────────
+
+    #[inline]
+    fn mark(&mut self, b: usize) {
+        let w = b / 64;
+        self.dirty[w] |= 1 << (b % 64);
+        self.dirty_lo = self.dirty_lo.min(w);
+        self.dirty_hi = self.dirty_hi.max(w);
+    }
+
+    fn mark_succ(&mut self, a: usize) {
+        let (s, e) = self.net.alpha[a].succ;
+        for i in s..e {
+            let b = self.net.succ[i as usize] as usize;
+            self.mark(b);
+        }
+    }
+
+    /// Re-evaluates the marked beta nodes, parents before children.
+    fn propagate(&mut self) {
+        if self.dirty_lo == usize::MAX {
+            return;
+        }
+        let mut w = self.dirty_lo;
+        while w <= self.dirty_hi {
+            let bits = self.dirty[w];
+            if bits == 0 {
+                w += 1;
+                continue;
+            }
+            let bit = bits.trailing_zeros() as usize;
+            self.dirty[w] &= !(1u64 << bit);
+            self.eval_beta(w * 64 + bit);
+        }
+        self.dirty_lo = usize::MAX;
+        self.dirty_hi = 0;
+    }
+
+    fn eval_beta(&mut self, b: usize) {
+        let node = self.net.beta[b];
+        let parent_ok = node.parent == NONE || self.beta_tok[node.parent as usize];
+        let tok = parent_ok && {
+            let right = self.alpha_mem[node.alpha as usize] && self.join_tests(&node);
+            right != node.negative
+        };
+        let was = self.beta_tok[b];
+        self.beta_tok[b] = tok;
+        if tok || was {
+            // New, gone, or refreshed (its facts may have changed): the
+            // children re-evaluate.
+            let (s, e) = node.children;
+            for i in s..e {
+                let c = self.net.children[i as usize] as usize;
+                self.mark(c);
+            }
+        }
+        if tok != was {
+            let (s, e) = node.terminals;
+            for i in s..e {
+                let r = self.net.terminal_rules[i as usize];
+                self.set_active(r, tok);
+            }
+        }
+    }
+
+    #[inline]
+    fn join_tests(&self, node: &net::BetaRt) -> bool {
+        let (s, e) = node.tests;
+        if s == e {
+            return true;
+        }
+        let own = self.net.payload_at[node.agent as usize] as usize;
+        self.net.beta_tests[s as usize..e as usize].iter().all(|t| self.test(t, own))
+    }
+
+    fn set_active(&mut self, rule: u32, on: bool) {
+        let r = rule as usize;
+        if on && self.active_pos[r] == NONE {
+            self.active_pos[r] = self.active.len() as u32;
+            self.active.push(rule);
+        } else if !on && self.active_pos[r] != NONE {
+            let pos = self.active_pos[r] as usize;
+            self.active.swap_remove(pos);
+            if let Some(&moved) = self.active.get(pos) {
+                self.active_pos[moved as usize] = pos as u32;
+            }
+            self.active_pos[r] = NONE;
+        }
+    }
+
+    /// Every memory from scratch (construction, reset, hot swap).
+    fn recompute(&mut self) {
+        for a in 0..self.net.alpha.len() {
+            self.alpha_mem[a] = self.alpha_passes(a);
+        }
+        for r in std::mem::take(&mut self.active) {
+            self.active_pos[r as usize] = NONE;
+        }
+        self.beta_tok.fill(false);
+        self.dirty.fill(0);
+        for b in 0..self.net.beta.len() {
+            self.mark(b);
+        }
+        self.propagate();
+    }
+
+    // ─── Inference ─────────────────────────────────────────────────────
+
+    fn set_state(&mut self, state: u32) {
+        let old = self.state;
+        if old == state {
+            return;
+        }
+        self.state = state;
+        // Only the state alpha nodes that contain one of the two states flip.
+        for s in [old, state] {
+            let (lo, hi) = self.net.state_alpha_at[s as usize];
+            for i in lo..hi {
+                let a = self.net.state_alpha[i as usize] as usize;
+                let pass = self.net.state_in(&self.net.alpha[a], state);
+                if pass != self.alpha_mem[a] {
+                    self.alpha_mem[a] = pass;
+                    self.mark_succ(a);
+                }
+            }
+        }
+        self.propagate();
+    }
+
+    /// The activated rule that fires first (§10.4), if any.
+    fn best(&self) -> Option<u32> {
+        let mut best: Option<(u32, (i64, u32, u64))> = None;
+        for &r in &self.active {
+            let rule = &self.net.rules[r as usize];
+            let (s, e) = rule.matches;
+            let recency = self.net.rule_agents[s as usize..e as usize]
+                .iter()
+                .map(|&a| self.slots[a as usize].seq)
+                .max()
+                .unwrap_or(0);
+            let key = (rule.salience, rule.specificity, recency);
+            // Ties: the rule declared first.
+            let better = match best {
+                None => true,
+                Some((b, bk)) => key > bk || (key == bk && r < b),
+            };
+            if better {
+                best = Some((r, key));
+            }
+        }
+        best.map(|(r, _)| r)
+    }
+
+    /// Fires until no rule is activated; `firings` holds the firings of the
+    /// whole event so far (the bound is per event).
+    fn rest(&mut self, firings: &mut Vec<Firing>) -> Result<(), PostError> {
+        self.propagate();
+        while let Some(r) = self.best() {
+            if firings.len() == self.cascade_limit {
+                return Err(PostError::Cascade { limit: self.cascade_limit, firings: std::mem::take(firings) });
+            }
+            let rule = &self.content.rules[r as usize];
+            let matched = rule.matches.iter().map(|&a| self.snapshot(a)).collect();
+            let stale = rule.stale.iter().copied().filter(|&a| self.stale[a as usize]).collect();
+            let to = rule.target;
+            firings.push(Firing { rule: r, from: self.state, to, time: self.now, matched, stale });
+            self.set_state(to);
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests;
