@@ -42,6 +42,60 @@ enum Command {
         /// A code such as E0101 or situ::E0101.
         code: Option<String>,
     },
+    /// Compile a checked source to a bundle (versioned, hashed); exit 1 on findings, 2 on I/O.
+    Build {
+        file: PathBuf,
+        /// The bundle file to write.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Write the compact binary form instead of JSON.
+        #[arg(long)]
+        binary: bool,
+        /// Print the network's node counts and what sharing saved.
+        #[arg(long)]
+        stats: bool,
+        /// Refuse to build on warnings too.
+        #[arg(long)]
+        deny_warnings: bool,
+    },
+    /// Throughput and latency of the Bulletinboard on a seeded random event stream, as JSON.
+    Bench {
+        /// A `.situ` source or a bundle.
+        file: PathBuf,
+        /// How many events.
+        #[arg(long, default_value_t = 1_000_000)]
+        events: u64,
+        /// The stream's seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Read the events from this stream file instead (bench/README.md).
+        #[arg(long)]
+        stream_in: Option<PathBuf>,
+        /// Write the generated stream here.
+        #[arg(long)]
+        stream_out: Option<PathBuf>,
+        /// Write the `INDEX STATE` lines of the state changes here.
+        #[arg(long)]
+        states_out: Option<PathBuf>,
+        /// Do not reset to the initial state after a final state.
+        #[arg(long)]
+        no_reset: bool,
+    },
+    /// Pictures: the wiring of a state, the Rete network, the state transitions.
+    Graph {
+        /// A `.situ` source or a bundle (the states view needs the source).
+        file: PathBuf,
+        #[arg(long, value_enum)]
+        view: cmd::graph::View,
+        /// The state whose wiring to draw (default: all, as clusters).
+        #[arg(long)]
+        state: Option<String>,
+        #[arg(long, value_enum, default_value_t = cmd::graph::Format::Dot)]
+        format: cmd::graph::Format,
+        /// Write here instead of standard output.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -50,6 +104,15 @@ fn main() -> ExitCode {
         Command::Check { files, format, deny_warnings } => cmd::check::run(&files, format, deny_warnings),
         Command::Fmt { files, check } => cmd::fmt::run(&files, check),
         Command::Explain { code } => cmd::explain::run(code.as_deref()),
+        Command::Build { file, output, binary, stats, deny_warnings } => {
+            cmd::build::run(&file, &output, binary, stats, deny_warnings)
+        }
+        Command::Bench { file, events, seed, stream_in, stream_out, states_out, no_reset } => {
+            cmd::bench::run(cmd::bench::Args { file, events, seed, stream_in, stream_out, states_out, no_reset })
+        }
+        Command::Graph { file, view, state, format, output } => {
+            cmd::graph::run(&file, view, state.as_deref(), format, output.as_ref())
+        }
     };
     ExitCode::from(code)
 }

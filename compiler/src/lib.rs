@@ -28,6 +28,7 @@
 pub mod bundle;
 pub mod checks;
 pub mod codes;
+pub mod graph;
 pub mod load;
 pub mod loader;
 pub mod model;

@@ -8,5 +8,7 @@
 //! - [`stream`]: seeded random event streams and their text form, for
 //!   benchmarks and differential tests.
 
+pub mod bench;
+pub mod bulletinboard;
 pub mod rete;
 pub mod stream;

@@ -1,12 +1,26 @@
 //! Event streams: a seeded random generator over a bundle's event alphabet,
 //! and the text form of `bench/README.md` that every benchmarked engine reads.
 //!
-//! The generator is meant to exercise rules, not to be uniform:
-//! - agents report in proportion to their `rate` (10 Hz when not given), at
-//!   exponentially distributed intervals, so that the stale timers of the
-//!   rules file are sometimes exceeded, as on a real bus;
-//! - an agent repeats its previous event with probability 0.8, so that run
-//!   lengths `xN` build up;
+//! The generator is meant to exercise rules, not to be uniform. A uniform
+//! stream over `outdoor.situ` spends nearly all its time in IT: leaving it
+//! needs ten `LOFIX` in a row and three other reports, while a `TCTAKE` ends
+//! the mission every few dozen events. So:
+//! - **guided events** (half of them): the generator runs the rules itself (a
+//!   [`rete::Engine`](crate::rete::Engine) fed with its own stream) and picks
+//!   a rule that can fire in the current state, then an event of one of its
+//!   patterns with a payload that passes the pattern's tests when it can
+//!   find one; repeated picks build the run lengths. Rules of the state's
+//!   lowest salience band (the mission flow) are picked ten times more
+//!   often than the next band (stops, emergencies), and so on. The missions
+//!   so walk through the states;
+//! - **random events** (the other half): agents report in proportion to
+//!   their `rate` (10 Hz when not given); an agent picks one of its events
+//!   with a weight that halves for each salience band above the lowest (of
+//!   the whole file) of the rules that name the event: the reports that
+//!   only emergency rules read (`PLF`, `TCTAKE`) are rare, as on a road;
+//! - events are spaced by exponentially distributed intervals (the mean is
+//!   one over the sum of the rates), so that the stale timers and windows of
+//!   the rules are sometimes exceeded, as on a real bus;
 //! - numeric payloads are drawn near the constants the rules compare the
 //!   field with (the thresholds) most of the time, else from a wide range;
 //! - f64 values have 3 decimals and are what their text parses to, so that
@@ -14,9 +28,10 @@
 //!
 //! The same seed gives the same stream, on every machine.
 
+use crate::rete::{compare, in_range, Engine};
 use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
-use situ_compiler::bundle::{AlphaNode, Check, Content, FieldType, Operand, Value};
+use situ_compiler::bundle::{AlphaNode, BetaKind, Check, Content, FieldType, Operand, Test, Value};
 use std::fmt::Write as _;
 use std::sync::Arc;
 
@@ -41,7 +56,50 @@ pub struct Generator {
     last: Vec<Option<u32>>,
     /// Per event, per field: the constants the rules compare it with.
     thresholds: Vec<Vec<Vec<f64>>>,
+    /// Per agent, the cumulative weights of its events for random picks.
+    event_weights: Vec<Vec<f64>>,
     now: u64,
+    guide: Guide,
+}
+
+/// The share of guided events.
+const GUIDED: f64 = 0.5;
+
+/// What steers the guided events: the rules run on the stream itself.
+struct Guide {
+    engine: Engine,
+    /// Per state, the rules that can fire in it.
+    by_state: Vec<Vec<u32>>,
+    /// Per rule, the alpha nodes of its positive patterns.
+    patterns: Vec<Vec<u32>>,
+    reset_on_final: bool,
+}
+
+impl Guide {
+    fn new(content: &Arc<Content>) -> Guide {
+        let net = &content.network;
+        let mut by_state = vec![Vec::new(); content.states.len()];
+        let mut patterns = Vec::with_capacity(net.terminals.len());
+        for t in &net.terminals {
+            let mut own = Vec::new();
+            let mut at = Some(t.beta);
+            while let Some(b) = at {
+                let node = &net.beta[b as usize];
+                match &net.alpha[node.alpha as usize] {
+                    AlphaNode::State { states } => {
+                        for &s in states {
+                            by_state[s as usize].push(t.rule);
+                        }
+                    }
+                    AlphaNode::Event { .. } if node.kind == BetaKind::Join => own.push(node.alpha),
+                    _ => {}
+                }
+                at = node.parent;
+            }
+            patterns.push(own);
+        }
+        Guide { engine: Engine::new(content.clone()), by_state, patterns, reset_on_final: true }
+    }
 }
 
 impl Generator {
@@ -80,7 +138,37 @@ impl Generator {
             }
         }
         let last = vec![None; content.agents.len()];
+        let guide = Guide::new(&content);
+        // Salience bands of the file, and each event's lowest.
+        let mut bands: Vec<i64> = content.rules.iter().map(|r| r.salience).collect();
+        bands.sort_unstable();
+        bands.dedup();
+        let mut lowest: Vec<Option<usize>> = vec![None; content.events.len()];
+        for (r, own) in guide.patterns.iter().enumerate() {
+            let band = bands.iter().position(|&b| b == content.rules[r].salience).unwrap_or(0);
+            for &a in own {
+                if let AlphaNode::Event { event, .. } = &content.network.alpha[a as usize] {
+                    let l = &mut lowest[*event as usize];
+                    *l = Some(l.map_or(band, |x| x.min(band)));
+                }
+            }
+        }
+        let event_weights = content
+            .agents
+            .iter()
+            .map(|a| {
+                let mut acc = 0.0;
+                a.events
+                    .iter()
+                    .map(|&e| {
+                        acc += 0.25f64.powi(lowest[e as usize].unwrap_or(0) as i32);
+                        acc
+                    })
+                    .collect()
+            })
+            .collect();
         Generator {
+            guide,
             rng: ChaCha8Rng::seed_from_u64(seed),
             mean_gap: if total > 0.0 { 1e9 / total } else { 1e8 },
             content,
@@ -88,8 +176,16 @@ impl Generator {
             cumulative,
             last,
             thresholds,
+            event_weights,
             now: 0,
         }
+    }
+
+    /// Whether the stream's consumer resets after a final state (as `situ
+    /// bench` does by default): the guide then does too.
+    pub fn reset_on_final(mut self, reset: bool) -> Self {
+        self.guide.reset_on_final = reset;
+        self
     }
 
     /// The next event, or `None` if no agent reports any event.
@@ -103,25 +199,84 @@ impl Generator {
     /// once `payload` has grown): `(event, time)`.
     pub fn next_into(&mut self, payload: &mut Vec<Value>) -> Option<(u32, u64)> {
         let total = *self.cumulative.last()?;
-        let pick = self.rng.random::<f64>() * total;
-        let k = self.cumulative.partition_point(|&c| c <= pick).min(self.agents.len() - 1);
-        let agent = self.agents[k];
-        let events = &self.content.agents[agent as usize].events;
-        let event = match self.last[agent as usize] {
-            Some(e) if self.rng.random_bool(0.8) => e,
-            _ => events[self.rng.random_range(0..events.len())],
+        let start = payload.len();
+        let guided = if self.rng.random_bool(GUIDED) { self.guided(payload) } else { None };
+        let event = match guided {
+            Some(e) => e,
+            None => {
+                let pick = self.rng.random::<f64>() * total;
+                let k = self.cumulative.partition_point(|&c| c <= pick).min(self.agents.len() - 1);
+                let agent = self.agents[k];
+                let events = &self.content.agents[agent as usize].events;
+                let weights = &self.event_weights[agent as usize];
+                let pick = self.rng.random::<f64>() * weights[weights.len() - 1];
+                let event = events[weights.partition_point(|&w| w <= pick).min(events.len() - 1)];
+                for f in 0..self.content.events[event as usize].fields.len() {
+                    let v = self.value(event as usize, f);
+                    payload.push(v);
+                }
+                event
+            }
         };
+        let agent = self.content.events[event as usize].agent;
         self.last[agent as usize] = Some(event);
         // Exponential gaps; at least 1 ns.
         let u: f64 = self.rng.random::<f64>();
         let gap = (-(1.0 - u).ln() * self.mean_gap).clamp(1.0, 1e12) as u64;
         self.now += gap;
-        let fields = self.content.events[event as usize].fields.len();
-        for f in 0..fields {
-            let v = self.value(event as usize, f);
-            payload.push(v);
+        let _ = self.guide.engine.post(event, self.now, &payload[start..]);
+        let state = self.guide.engine.state() as usize;
+        if self.guide.reset_on_final && self.content.states[state].is_final {
+            self.guide.engine.reset();
         }
         Some((event, self.now))
+    }
+
+    /// An event of a pattern of a rule that can fire in the guide's state,
+    /// its payload appended; `None` when no rule can fire there.
+    fn guided(&mut self, payload: &mut Vec<Value>) -> Option<u32> {
+        let state = self.guide.engine.state() as usize;
+        let rules = &self.guide.by_state[state];
+        if rules.is_empty() {
+            return None;
+        }
+        // Mission flow before emergencies: each salience band above the
+        // lowest of the state is ten times less likely.
+        let salience = |r: u32| self.content.rules[r as usize].salience;
+        let mut bands: Vec<i64> = rules.iter().map(|&r| salience(r)).collect();
+        bands.sort_unstable();
+        bands.dedup();
+        let weight = |r: u32| 0.01f64.powi(bands.iter().position(|&b| b == salience(r)).unwrap_or(0) as i32);
+        let total: f64 = rules.iter().map(|&r| weight(r)).sum();
+        let mut pick = self.rng.random::<f64>() * total;
+        let mut rule = rules[rules.len() - 1] as usize;
+        for &r in rules {
+            pick -= weight(r);
+            if pick < 0.0 {
+                rule = r as usize;
+                break;
+            }
+        }
+        let patterns = &self.guide.patterns[rule];
+        if patterns.is_empty() {
+            return None;
+        }
+        let alpha = patterns[self.rng.random_range(0..patterns.len())] as usize;
+        let AlphaNode::Event { event, tests, .. } = &self.content.network.alpha[alpha] else { return None };
+        let (event, tests) = (*event, tests.clone());
+        let n = self.content.events[event as usize].fields.len();
+        let start = payload.len();
+        for _ in 0..16 {
+            payload.truncate(start);
+            for f in 0..n {
+                let v = self.value(event as usize, f);
+                payload.push(v);
+            }
+            if tests.iter().all(|t| passes(t, &payload[start..])) {
+                break;
+            }
+        }
+        Some(event)
     }
 
     fn value(&mut self, event: usize, field: usize) -> Value {
@@ -147,6 +302,23 @@ impl Generator {
             FieldType::Bool => Value::Bool(self.rng.random_bool(0.5)),
             FieldType::Symbols(s) => Value::Symbol(self.rng.random_range(0..s.len().max(1)) as u32),
         }
+    }
+}
+
+/// Whether a payload passes a test on its own fields.
+fn passes(t: &Test, payload: &[Value]) -> bool {
+    let get = |o: &Operand| match o {
+        Operand::Value(v) => Some(*v),
+        Operand::Own { field } => payload.get(*field as usize).copied(),
+        Operand::Fact { .. } => None,
+    };
+    let Some(&x) = payload.get(t.field as usize) else { return false };
+    match &t.check {
+        Check::Compare { op, rhs } => get(rhs).is_some_and(|y| compare(*op, x, y)),
+        Check::Range { lo, hi, inclusive } => match (get(lo), get(hi)) {
+            (Some(lo), Some(hi)) => in_range(x, lo, hi, *inclusive),
+            _ => false,
+        },
     }
 }
 
@@ -259,7 +431,7 @@ mod tests {
     fn the_text_form_reads_back_exactly() {
         let c = outdoor();
         let mut g = Generator::new(c.clone(), 1);
-        let events: Vec<Event> = (0..2000).filter_map(|_| g.next_event()).collect();
+        let events: Vec<Event> = (0..20_000).filter_map(|_| g.next_event()).collect();
         let mut text = header("outdoor.situ", 1);
         for e in &events {
             write_line(&c, &mut text, e.event, e.time, &e.payload);
@@ -267,8 +439,9 @@ mod tests {
         assert_eq!(parse(&c, &text).unwrap(), events);
         // Thresholds are hit exactly, so the boundaries of the rules are exercised.
         let laobs = c.event_id("LAOBS").unwrap();
-        let at_30 = events.iter().filter(|e| e.event == laobs && e.payload[0] == Value::F64(30.0)).count();
-        assert!(at_30 > 0, "LAOBS(distance: 30.000) never drawn");
+        let at_threshold = |e: &&Event| [5.0, 20.0, 30.0].iter().any(|&c| e.payload[0] == Value::F64(c));
+        let hits = events.iter().filter(|e| e.event == laobs).filter(at_threshold).count();
+        assert!(hits > 0, "LAOBS(distance: 5, 20 or 30) never drawn");
     }
 
     #[test]

@@ -47,7 +47,7 @@ fn one(path: &Path, check: bool) -> u8 {
         println!("would reformat {}", path.display());
         return FAILED;
     }
-    match write_atomically(path, &formatted) {
+    match super::write_atomically(path, formatted.as_bytes()) {
         Ok(()) => {
             println!("formatted {}", path.display());
             OK
@@ -57,20 +57,4 @@ fn one(path: &Path, check: bool) -> u8 {
             USAGE
         }
     }
-}
-
-fn write_atomically(path: &Path, text: &str) -> std::io::Result<()> {
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.situ-fmt.{}", std::process::id()));
-    let result = std::fs::write(&tmp, text).and_then(|()| {
-        if let Ok(meta) = std::fs::metadata(path) {
-            std::fs::set_permissions(&tmp, meta.permissions())?;
-        }
-        std::fs::rename(&tmp, path)
-    });
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
 }

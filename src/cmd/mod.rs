@@ -1,10 +1,15 @@
 //! One module per subcommand.
 
+pub mod bench;
+pub mod build;
 pub mod check;
 pub mod explain;
 pub mod fmt;
+pub mod graph;
+pub mod program;
 
 use std::io::IsTerminal;
+use std::path::Path;
 
 /// Exit codes of the command line contract.
 pub const OK: u8 = 0;
@@ -18,4 +23,22 @@ pub fn style() -> situ_compiler::render::Style {
     let colour = std::io::stdout().is_terminal() && std::env::var_os("NO_COLOR").is_none();
     let width = std::env::var("COLUMNS").ok().and_then(|c| c.parse().ok()).unwrap_or(100);
     situ_compiler::render::Style { colour, width }
+}
+
+/// Writes a file so that it is never half written: a temporary file next to
+/// it, then a rename (keeping the permissions of a file it replaces).
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.situ-tmp.{}", std::process::id()));
+    let result = std::fs::write(&tmp, bytes).and_then(|()| {
+        if let Ok(meta) = std::fs::metadata(path) {
+            std::fs::set_permissions(&tmp, meta.permissions())?;
+        }
+        std::fs::rename(&tmp, path)
+    });
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
 }

@@ -22,7 +22,7 @@
 mod eval;
 mod net;
 
-use net::{AlphaKind, Net, OperandRt, TestKind, TestRt, NONE};
+use net::{AlphaKind, Kind, Net, OperandRt, TestKind, TestRt, NONE};
 use situ_compiler::bundle::{Content, FieldType, Value};
 use std::sync::Arc;
 
@@ -215,6 +215,7 @@ pub struct Engine {
     active: Vec<u32>,
     active_pos: Vec<u32>,
     cascade_limit: usize,
+    record: Record,
 }
 
 impl Engine {
@@ -241,6 +242,7 @@ impl Engine {
             active: Vec::new(),
             active_pos: vec![NONE; content.rules.len()],
             cascade_limit: CASCADE_LIMIT,
+            record: Record::default(),
             content,
             net,
         };
@@ -287,35 +289,45 @@ impl Engine {
         &self.active
     }
 
-    /// Back to the initial state with no facts; now is kept.
+    /// Back to the initial state with no facts; now is kept. Incremental:
+    /// only the nodes of the facts there were, and of the state, change.
     pub fn reset(&mut self) {
-        self.state = self.content.initial;
+        for a in 0..self.slots.len() {
+            let event = self.slots[a].event;
+            if event != NONE {
+                self.clear_event_alpha(event);
+            }
+            if self.stale[a] {
+                self.stale[a] = false;
+                self.set_stale_alpha(a as u32, false);
+            }
+        }
         self.slots.fill(EMPTY);
-        self.stale.fill(false);
         self.stale_at.fill(u64::MAX);
         self.window_at.fill(u64::MAX);
         self.next_deadline = u64::MAX;
-        self.recompute();
+        self.set_state(self.content.initial);
+        self.propagate();
     }
 
     /// Checks an event against the bundle's schema.
     pub fn validate(&self, event: u32, payload: &[Value]) -> Result<(), PostError> {
-        let Some(e) = self.content.events.get(event as usize) else {
+        let Some(&(s, e)) = self.net.event_kinds.get(event as usize) else {
             return Err(PostError::UnknownEvent { event });
         };
-        if e.fields.len() != payload.len() {
-            return Err(PostError::Arity { event, expected: e.fields.len(), found: payload.len() });
+        let kinds = &self.net.kinds[s as usize..e as usize];
+        if kinds.len() != payload.len() {
+            return Err(PostError::Arity { event, expected: kinds.len(), found: payload.len() });
         }
-        for (i, (f, v)) in e.fields.iter().zip(payload).enumerate() {
-            let fits = match (&f.ty, v) {
-                (FieldType::F64, Value::F64(_))
-                | (FieldType::I64, Value::I64(_))
-                | (FieldType::Bool, Value::Bool(_)) => true,
-                (FieldType::Symbols(s), Value::Symbol(k)) => (*k as usize) < s.len(),
+        for (i, (k, v)) in kinds.iter().zip(payload).enumerate() {
+            let fits = match (k, v) {
+                (Kind::F64, Value::F64(_)) | (Kind::I64, Value::I64(_)) | (Kind::Bool, Value::Bool(_)) => true,
+                (Kind::Symbol(n), Value::Symbol(x)) => x < n,
                 _ => false,
             };
             if !fits {
-                return Err(PostError::Type { event, field: i as u32, expected: f.ty.clone() });
+                let expected = self.content.events[event as usize].fields[i].ty.clone();
+                return Err(PostError::Type { event, field: i as u32, expected });
             }
         }
         Ok(())
@@ -324,32 +336,78 @@ impl Engine {
     /// Processes one event: expiry, rest, the new fact, rest. Returns the
     /// firings, if any rule fired.
     pub fn post(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Option<StateChange>, PostError> {
+        let step = self.step(event, time, payload)?;
+        Ok((step.firings > 0).then(|| self.last_change()))
+    }
+
+    /// As [`post`](Self::post), without building the [`StateChange`]: no
+    /// allocation once the engine has warmed up. [`last_change`](Self::last_change)
+    /// gives the details of the latest step.
+    pub fn step(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Step, PostError> {
         self.validate(event, payload)?;
-        let from = self.state;
-        let mut firings = Vec::new();
+        self.begin();
         if time > self.now {
             self.now = time;
         }
         if self.now > self.next_deadline {
             self.expire();
         }
-        self.rest(&mut firings)?;
+        if !self.at_rest() {
+            self.rest()?;
+        }
         self.insert(event, time, payload);
         if self.now > self.next_deadline {
             // The fact came late: it may be expired already.
             self.expire();
         }
-        self.rest(&mut firings)?;
-        Ok((!firings.is_empty()).then_some(StateChange { from, to: self.state, time: self.now, firings }))
+        if !self.at_rest() {
+            self.rest()?;
+        }
+        Ok(Step { from: self.record.from, to: self.state, firings: self.record.firings.len() })
     }
 
     /// Brings the network to rest without an event (e.g. at start, for
     /// rules that hold with no facts).
     pub fn settle(&mut self) -> Result<Option<StateChange>, PostError> {
-        let from = self.state;
-        let mut firings = Vec::new();
-        self.rest(&mut firings)?;
-        Ok((!firings.is_empty()).then_some(StateChange { from, to: self.state, time: self.now, firings }))
+        self.begin();
+        self.rest()?;
+        Ok((!self.record.firings.is_empty()).then(|| self.last_change()))
+    }
+
+    /// What the latest step fired, with the facts that made each rule hold.
+    pub fn last_change(&self) -> StateChange {
+        let r = &self.record;
+        let firings = r
+            .firings
+            .iter()
+            .map(|f| Firing {
+                rule: f.rule,
+                from: f.from,
+                to: f.to,
+                time: f.time,
+                matched: r.facts[f.facts.0 as usize..f.facts.1 as usize]
+                    .iter()
+                    .map(|m| MatchedFact {
+                        agent: m.agent,
+                        event: m.event,
+                        payload: r.values[m.values.0 as usize..m.values.1 as usize].to_vec(),
+                        time: m.time,
+                        run: m.run,
+                    })
+                    .collect(),
+                stale: r.stale[f.stale.0 as usize..f.stale.1 as usize].to_vec(),
+            })
+            .collect();
+        StateChange { from: r.from, to: self.state, time: self.now, firings }
+    }
+
+    fn begin(&mut self) {
+        let r = &mut self.record;
+        r.from = self.state;
+        r.firings.clear();
+        r.facts.clear();
+        r.values.clear();
+        r.stale.clear();
     }
 
     /// Sets the state without firing rules (tests' `given`, hot swap).
@@ -372,6 +430,29 @@ impl Engine {
         Ok(())
     }
 
+    /// Moves now forward to `now` (a carried-over clock, at hot swap).
+    pub fn advance_clock(&mut self, now: u64) {
+        self.now = self.now.max(now);
+    }
+
+    /// Marks an agent stale without firing rules (its fact, if any, is gone).
+    pub fn force_stale(&mut self, agent: u32) {
+        let a = agent as usize;
+        if a >= self.slots.len() {
+            return;
+        }
+        let old = self.slots[a].event;
+        if old != NONE {
+            self.clear_event_alpha(old);
+        }
+        self.slots[a] = EMPTY;
+        self.stale[a] = true;
+        self.stale_at[a] = u64::MAX;
+        self.window_at[a] = u64::MAX;
+        self.set_stale_alpha(agent, true);
+        self.propagate();
+    }
+
     // ─── Working memory ────────────────────────────────────────────────
 
     fn snapshot(&self, agent: u32) -> MatchedFact {
@@ -389,7 +470,7 @@ impl Engine {
 
     /// Replaces the agent's fact and updates its alpha memories (no propagation).
     fn insert(&mut self, event: u32, time: u64, payload: &[Value]) {
-        let agent = self.content.events[event as usize].agent;
+        let agent = self.net.event_agent[event as usize];
         let a = agent as usize;
         let old = self.slots[a];
         self.seq += 1;
@@ -461,14 +542,14 @@ impl Engine {
     }
 
     /// Re-evaluates the alpha nodes of `event` against its agent's new fact:
-    /// successors of nodes that pass or passed are marked (a replaced fact
-    /// is a new token even when the test result stays).
+    /// successors are marked where the result changes, and where it stays
+    /// true but join tests below read the replaced fact's values.
     fn eval_event_alpha(&mut self, event: u32) {
         let (s, e) = self.net.event_alpha_at[event as usize];
         for i in s..e {
             let a = self.net.event_alpha[i as usize] as usize;
             let pass = self.alpha_passes(a);
-            if pass || self.alpha_mem[a] {
+            if pass != self.alpha_mem[a] || (pass && self.net.alpha[a].refresh) {
                 self.alpha_mem[a] = pass;
                 self.mark_succ(a);
             }
@@ -588,21 +669,23 @@ impl Engine {
     }
 
     fn eval_beta(&mut self, b: usize) {
-        let node = self.net.beta[b];
+        let node = &self.net.beta[b];
         let parent_ok = node.parent == NONE || self.beta_tok[node.parent as usize];
         let tok = parent_ok && {
-            let right = self.alpha_mem[node.alpha as usize] && self.join_tests(&node);
+            let right = self.alpha_mem[node.alpha as usize] && self.join_tests(node);
             right != node.negative
         };
         let was = self.beta_tok[b];
         self.beta_tok[b] = tok;
-        if tok || was {
-            // New, gone, or refreshed (its facts may have changed): the
-            // children re-evaluate.
+        if tok != was || (tok && node.refresh) {
+            // New, gone, or refreshed with join tests below that read the
+            // facts: the children re-evaluate.
             let (s, e) = node.children;
-            for i in s..e {
-                let c = self.net.children[i as usize] as usize;
-                self.mark(c);
+            for &c in &self.net.children[s as usize..e as usize] {
+                let c = c as usize;
+                let w = c / 64;
+                self.dirty[w] |= 1 << (c % 64);
+                self.dirty_hi = self.dirty_hi.max(w);
             }
         }
         if tok != was {
@@ -702,23 +785,91 @@ impl Engine {
         best.map(|(r, _)| r)
     }
 
-    /// Fires until no rule is activated; `firings` holds the firings of the
-    /// whole event so far (the bound is per event).
-    fn rest(&mut self, firings: &mut Vec<Firing>) -> Result<(), PostError> {
+    /// Whether nothing waits to be propagated and no rule is activated.
+    #[inline]
+    fn at_rest(&self) -> bool {
+        self.dirty_lo == usize::MAX && self.active.is_empty()
+    }
+
+    /// Fires until no rule is activated; the bound counts the firings of
+    /// the whole step.
+    fn rest(&mut self) -> Result<(), PostError> {
         self.propagate();
         while let Some(r) = self.best() {
-            if firings.len() == self.cascade_limit {
-                return Err(PostError::Cascade { limit: self.cascade_limit, firings: std::mem::take(firings) });
+            if self.record.firings.len() == self.cascade_limit {
+                let firings = self.last_change().firings;
+                return Err(PostError::Cascade { limit: self.cascade_limit, firings });
             }
             let rule = &self.content.rules[r as usize];
-            let matched = rule.matches.iter().map(|&a| self.snapshot(a)).collect();
-            let stale = rule.stale.iter().copied().filter(|&a| self.stale[a as usize]).collect();
             let to = rule.target;
-            firings.push(Firing { rule: r, from: self.state, to, time: self.now, matched, stale });
+            let facts0 = self.record.facts.len() as u32;
+            for &a in &rule.matches {
+                let slot = self.slots[a as usize];
+                let n = self.content.events.get(slot.event as usize).map_or(0, |e| e.fields.len());
+                let at = self.net.payload_at[a as usize] as usize;
+                let v0 = self.record.values.len() as u32;
+                self.record.values.extend_from_slice(&self.payload[at..at + n]);
+                let values = (v0, self.record.values.len() as u32);
+                self.record.facts.push(FactRec { agent: a, event: slot.event, time: slot.time, run: slot.run, values });
+            }
+            let stale0 = self.record.stale.len() as u32;
+            for &a in &rule.stale {
+                if self.stale[a as usize] {
+                    self.record.stale.push(a);
+                }
+            }
+            let rec = FiringRec {
+                rule: r,
+                from: self.state,
+                to,
+                time: self.now,
+                facts: (facts0, self.record.facts.len() as u32),
+                stale: (stale0, self.record.stale.len() as u32),
+            };
+            self.record.firings.push(rec);
             self.set_state(to);
         }
         Ok(())
     }
+}
+
+/// What a step did, in short.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Step {
+    /// The state at rest before, and after.
+    pub from: u32,
+    pub to: u32,
+    /// How many rules fired.
+    pub firings: usize,
+}
+
+/// The firings of the latest step, in buffers reused from step to step.
+#[derive(Debug, Clone, Default)]
+struct Record {
+    from: u32,
+    firings: Vec<FiringRec>,
+    facts: Vec<FactRec>,
+    values: Vec<Value>,
+    stale: Vec<u32>,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct FiringRec {
+    rule: u32,
+    from: u32,
+    to: u32,
+    time: u64,
+    facts: (u32, u32),
+    stale: (u32, u32),
+}
+
+#[derive(Debug, Clone, Copy)]
+struct FactRec {
+    agent: u32,
+    event: u32,
+    time: u64,
+    run: u64,
+    values: (u32, u32),
 }
 
 #[cfg(test)]

@@ -51,6 +51,9 @@ pub struct AlphaRt {
     pub within_ns: u64,
     /// Its successors: beta nodes with it as right input, in `succ`.
     pub succ: (u32, u32),
+    /// Whether a join test below it reads fact values: only then does a
+    /// replaced fact that still passes need its successors re-evaluated.
+    pub refresh: bool,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -65,6 +68,8 @@ pub struct BetaRt {
     /// The rules it activates (rules with identical chains share it), in
     /// `terminal_rules`.
     pub terminals: (u32, u32),
+    /// Whether a join test below it reads fact values (see [`AlphaRt::refresh`]).
+    pub refresh: bool,
 }
 
 #[derive(Debug, Clone)]
@@ -110,6 +115,20 @@ pub struct Net {
     pub stale_after: Vec<u64>,
     /// Agents with a staleness or a window to watch.
     pub timed_agents: Vec<u32>,
+    /// Per event: its agent, and its fields' kinds in `kinds`.
+    pub event_agent: Vec<u32>,
+    pub event_kinds: Vec<(u32, u32)>,
+    pub kinds: Vec<Kind>,
+}
+
+/// A field's type, flat, for checking payloads fast.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    F64,
+    I64,
+    Bool,
+    /// A symbol of a set of this many.
+    Symbol(u32),
 }
 
 fn range(start: usize, end: usize) -> (u32, u32) {
@@ -175,6 +194,7 @@ impl Net {
                         min_run: 0,
                         within_ns: u64::MAX,
                         succ: succ_range,
+                        refresh: false,
                     }
                 }
                 AlphaNode::Event { event, tests, min_run, within_ns } => {
@@ -191,6 +211,7 @@ impl Net {
                         min_run: *min_run,
                         within_ns: within_ns.unwrap_or(u64::MAX),
                         succ: succ_range,
+                        refresh: false,
                     }
                 }
                 AlphaNode::Stale { agent } => {
@@ -203,6 +224,7 @@ impl Net {
                         min_run: 0,
                         within_ns: u64::MAX,
                         succ: succ_range,
+                        refresh: false,
                     }
                 }
             };
@@ -233,7 +255,21 @@ impl Net {
                 tests: range(t0, beta_tests.len()),
                 children: range(c0, children.len()),
                 terminals: range(r0, terminal_rules.len()),
+                refresh: false,
             });
+        }
+        // Bottom up (children come after their parents): whether a subtree
+        // has join tests.
+        let mut tested = vec![false; beta.len()];
+        for b in (0..beta.len()).rev() {
+            let (s, e) = beta[b].children;
+            let below = children[s as usize..e as usize].iter().any(|&c| tested[c as usize]);
+            beta[b].refresh = below;
+            tested[b] = below || beta[b].tests.0 != beta[b].tests.1;
+        }
+        for a in &mut alpha {
+            let (s, e) = a.succ;
+            a.refresh = succ[s as usize..e as usize].iter().any(|&b| tested[b as usize]);
         }
 
         let mut rule_agents = Vec::new();
@@ -278,7 +314,23 @@ impl Net {
                     })
             })
             .collect();
+        let event_agent = c.events.iter().map(|e| e.agent).collect();
+        let mut kinds = Vec::new();
+        let mut event_kinds = Vec::with_capacity(ne);
+        for e in &c.events {
+            let s = kinds.len();
+            kinds.extend(e.fields.iter().map(|f| match &f.ty {
+                situ_compiler::bundle::FieldType::F64 => Kind::F64,
+                situ_compiler::bundle::FieldType::I64 => Kind::I64,
+                situ_compiler::bundle::FieldType::Bool => Kind::Bool,
+                situ_compiler::bundle::FieldType::Symbols(s) => Kind::Symbol(s.len() as u32),
+            }));
+            event_kinds.push(range(s, kinds.len()));
+        }
         Net {
+            event_agent,
+            event_kinds,
+            kinds,
             alpha,
             alpha_tests,
             succ,

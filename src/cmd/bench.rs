@@ -1,0 +1,87 @@
+//! `situ bench FILE|BUNDLE [--events N] [--seed S]`: the Bulletinboard's
+//! throughput and latency on a seeded random event stream, as one JSON
+//! object. `--stream-out`, `--states-out` and `--stream-in` make the runs
+//! comparable with other engines (`bench/README.md`).
+
+use super::{OK, USAGE};
+use situ_runtime::bench::{self, Options, Source};
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::PathBuf;
+
+pub struct Args {
+    pub file: PathBuf,
+    pub events: u64,
+    pub seed: u64,
+    pub stream_in: Option<PathBuf>,
+    pub stream_out: Option<PathBuf>,
+    pub states_out: Option<PathBuf>,
+    pub no_reset: bool,
+}
+
+pub fn run(args: Args) -> u8 {
+    let program = match super::program::load(&args.file, false) {
+        Ok(p) => p,
+        Err(code) => return code,
+    };
+    let content = program.content;
+    let events = match &args.stream_in {
+        None => None,
+        Some(path) => {
+            let text = match std::fs::read_to_string(path) {
+                Ok(t) => t,
+                Err(e) => {
+                    eprintln!("error: cannot read `{}`: {e}", path.display());
+                    return USAGE;
+                }
+            };
+            match situ_runtime::stream::parse(&content, &text) {
+                Ok(events) => Some(events),
+                Err(e) => {
+                    eprintln!("error: `{}`: {e}", path.display());
+                    return USAGE;
+                }
+            }
+        }
+    };
+    let create = |path: &Option<PathBuf>| -> Result<Option<BufWriter<File>>, u8> {
+        path.as_ref()
+            .map(|p| {
+                File::create(p).map(BufWriter::new).map_err(|e| {
+                    eprintln!("error: cannot write `{}`: {e}", p.display());
+                    USAGE
+                })
+            })
+            .transpose()
+    };
+    let (mut stream_out, mut states_out) = match (create(&args.stream_out), create(&args.states_out)) {
+        (Ok(a), Ok(b)) => (a, b),
+        (Err(code), _) | (_, Err(code)) => return code,
+    };
+    if let Some(out) = stream_out.as_mut() {
+        let _ = out.write_all(situ_runtime::stream::header(&content.source, args.seed).as_bytes());
+    }
+    let source = match &events {
+        Some(events) => Source::File(events),
+        None => Source::Random { events: args.events, seed: args.seed },
+    };
+    let report = bench::run(
+        content,
+        Options {
+            source,
+            reset_on_final: !args.no_reset,
+            stream_out: stream_out.as_mut().map(|w| w as &mut dyn Write),
+            states_out: states_out.as_mut().map(|w| w as &mut dyn Write),
+        },
+    );
+    for (out, path) in [(stream_out, &args.stream_out), (states_out, &args.states_out)] {
+        if let (Some(mut out), Some(path)) = (out, path) {
+            if let Err(e) = out.flush() {
+                eprintln!("error: cannot write `{}`: {e}", path.display());
+                return USAGE;
+            }
+        }
+    }
+    println!("{}", serde_json::to_string(&report).expect("the report serializes"));
+    OK
+}
