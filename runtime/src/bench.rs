@@ -162,7 +162,7 @@ fn fill(source: &mut ChunkSource, chunk: &mut Chunk, n: usize) -> usize {
 }
 
 enum ChunkSource<'a> {
-    Random { gen: Generator, left: u64 },
+    Random { gen: Box<Generator>, left: u64 },
     File { events: &'a [Event], at: usize },
 }
 
@@ -170,7 +170,7 @@ impl<'a> ChunkSource<'a> {
     fn new(content: &Arc<Content>, source: &Source<'a>, reset_on_final: bool) -> Self {
         match source {
             Source::Random { events, seed } => ChunkSource::Random {
-                gen: Generator::new(content.clone(), *seed).reset_on_final(reset_on_final),
+                gen: Box::new(Generator::new(content.clone(), *seed).reset_on_final(reset_on_final)),
                 left: *events,
             },
             Source::File(events) => ChunkSource::File { events, at: 0 },
