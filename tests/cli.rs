@@ -236,3 +236,83 @@ fn several_files_are_checked_each_on_its_own() {
     let missing = situ(&["check", &ok, "missing.situ"]);
     assert_eq!(code(&missing), 2, "an unreadable file wins over findings");
 }
+
+#[test]
+fn build_writes_a_bundle_that_bench_and_graph_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("outdoor.bundle");
+    let bin = dir.path().join("outdoor.bin");
+    let o = situ(&["build", "rules/outdoor.situ", "-o", json.to_str().unwrap(), "--stats"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let out = stdout(&o);
+    assert!(out.contains("33 terminals") && out.contains("sharing saved"), "{out}");
+    let o = situ(&["build", "rules/outdoor.situ", "-o", bin.to_str().unwrap(), "--binary"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    for bundle in [&json, &bin] {
+        let o = situ(&["bench", bundle.to_str().unwrap(), "--events", "20000", "--seed", "4"]);
+        assert_eq!(code(&o), 0, "{}", stderr(&o));
+        let report: serde_json::Value = serde_json::from_str(stdout(&o).trim()).expect("one JSON object");
+        assert_eq!(report["events"], 20000);
+        for key in ["events_per_sec", "peak_rss_bytes", "state_changes"] {
+            assert!(report[key].as_f64().is_some_and(|v| v > 0.0), "{key}: {report}");
+        }
+        for key in ["p50", "p99", "max"] {
+            assert!(report["latency_ns"][key].as_u64().is_some(), "{report}");
+        }
+        assert_eq!(report["nodes"]["terminals"], 33);
+    }
+    let o = situ(&["graph", json.to_str().unwrap(), "--view", "wiring", "--state", "RO"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(stdout(&o).contains("\"LADAR\" -> \"Fusion\""), "{}", stdout(&o));
+}
+
+#[test]
+fn build_refuses_findings_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = write(dir.path(), "bad.situ", "states { IT initial }\nrule r { when state == IT then RX }\n");
+    let out = dir.path().join("bad.bundle");
+    let o = situ(&["build", &bad, "-o", out.to_str().unwrap()]);
+    assert_eq!(code(&o), 1);
+    assert!(stdout(&o).contains("situ::E0101"), "{}", stdout(&o));
+    assert!(!out.exists(), "no bundle is written for a program with errors");
+    assert_eq!(code(&situ(&["build", "no/such.situ", "-o", out.to_str().unwrap()])), 2);
+}
+
+#[test]
+fn damaged_bundles_are_refused_with_exit_2_and_the_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = dir.path().join("good.bundle");
+    assert_eq!(code(&situ(&["build", "rules/ugv.situ", "-o", good.to_str().unwrap()])), 0);
+    let text = std::fs::read_to_string(&good).unwrap();
+    let cases = [
+        ("edited.bundle", text.replacen("0.3", "0.4", 1), "modified after it was built"),
+        ("cut.bundle", text[..text.len() / 2].to_string(), "truncated"),
+        ("newer.bundle", text.replacen("\"format_version\":1", "\"format_version\":7", 1), "format version 7"),
+        ("notes.bundle", "shopping: milk, eggs\n".to_string(), "not a situ bundle"),
+    ];
+    for (name, content, reason) in cases {
+        let f = write(dir.path(), name, content);
+        for args in [vec!["bench", &f, "--events", "10"], vec!["graph", &f, "--view", "rete"]] {
+            let o = situ(&args);
+            assert_eq!(code(&o), 2, "{name}: {}", stderr(&o));
+            assert!(stderr(&o).contains(reason), "{name}: {}", stderr(&o));
+            assert!(!stderr(&o).contains("panicked"), "{}", stderr(&o));
+        }
+    }
+}
+
+#[test]
+fn graph_draws_states_rete_and_svg() {
+    let o = situ(&["graph", "rules/outdoor.situ", "--view", "states"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(stdout(&o).starts_with("digraph states"), "{}", stdout(&o));
+    assert!(stdout(&o).contains("\"RS\" -> \"RO\""), "{}", stdout(&o));
+    let o = situ(&["graph", "rules/outdoor.situ", "--view", "rete"]);
+    assert!(stdout(&o).contains("road_obstacle_ladar"), "{}", stdout(&o));
+    let o = situ(&["graph", "rules/outdoor.situ", "--view", "wiring", "--state", "RS", "--format", "svg"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(stdout(&o).contains("<svg") && stdout(&o).contains("RFCCD"), "{}", stdout(&o));
+    let o = situ(&["graph", "rules/outdoor.situ", "--view", "wiring", "--state", "XX"]);
+    assert_eq!(code(&o), 2);
+    assert!(stderr(&o).contains("no state `XX`"), "{}", stderr(&o));
+}

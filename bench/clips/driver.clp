@@ -19,12 +19,14 @@
 ;;;   1. now = max(now, T); the clock fact is modified if now moved;
 ;;;   2. expire every agent with `stale after D` whose fact is older than D
 ;;;      (now - t > D, strictly): retract its fact, assert (stale A); if any
-;;;      expired, run to rest;
+;;;      expired, run to rest (if none did, the network is still at rest:
+;;;      advancing now can only close `within` windows, never activate);
 ;;;   3. replace A's fact: run = old run + 1 if A's old (live) fact is the
 ;;;      same event, else 1; retract (stale A) if present; run to rest;
-;;;   4. if the state differs from the state before the event, write
-;;;      "INDEX STATE" to the states file.
-;;;  A rest is (run 65); more than 64 firings is an error (exit code 2).
+;;;   4. if the state differs from the state before the event (after a
+;;;      reset: IT), write "INDEX STATE" to the states file.
+;;;  A rest is (run 65); more than 64 firings in one rest is an error (exit
+;;;  code 2). An agent that never reported has no fact and is not stale.
 ;;; ═══════════════════════════════════════════════════════════════════════
 
 ;;; ─── Static tables ──────────────────────────────────────────────────────

@@ -147,7 +147,11 @@ pub fn decode(bytes: &[u8]) -> Result<Content, LoadError> {
 fn decode_json(bytes: &[u8]) -> Result<Content, LoadError> {
     let text = std::str::from_utf8(bytes)
         .map_err(|e| LoadError::NotABundle { reason: format!("it is neither a JSON nor a binary bundle ({e})") })?;
-    let looks_like_bundle = text.get(..200.min(text.len())).is_some_and(|head| head.contains(FORMAT_NAME));
+    // The writer always starts with this: a file that is a piece of it is
+    // a bundle cut short.
+    let head = format!("{{\"format\":\"{FORMAT_NAME}\"");
+    let looks_like_bundle = (!text.is_empty() && head.starts_with(text))
+        || text.get(..200.min(text.len())).is_some_and(|h| h.contains(FORMAT_NAME));
     let envelope: EnvelopeIn = match serde_json::from_str(text) {
         Ok(e) => e,
         Err(e) if looks_like_bundle && e.is_eof() => {
