@@ -3,6 +3,8 @@
 //!
 //! - [`rete`]: the inference machine, a Rete interpreter over the bundle's
 //!   network and a working memory of one state and one fact per agent;
+//! - [`organise`]: what each agent does in the current state (tables, FSMs)
+//!   and the wiring graph of the moment;
 //! - [`bulletinboard`]: the Bulletinboard of Zhang & Zhu (2005) around it:
 //!   posting events, the state history, subscriptions, explanations, hot swap;
 //! - [`stream`]: seeded random event streams and their text form, for
@@ -10,5 +12,6 @@
 
 pub mod bench;
 pub mod bulletinboard;
+pub mod organise;
 pub mod rete;
 pub mod stream;
