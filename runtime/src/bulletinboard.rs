@@ -141,6 +141,16 @@ impl Bulletinboard {
         self.post(id, time, payload)
     }
 
+    /// Moves the clock forward without an event (the heartbeat that notices
+    /// silent agents); returns what fired.
+    pub fn advance(&mut self, now: u64) -> Result<Option<StateChange>, PostError> {
+        let change = self.engine.advance(now)?;
+        if let Some(c) = &change {
+            self.record(c);
+        }
+        Ok(change)
+    }
+
     /// Brings the network to rest without an event (at start).
     pub fn settle(&mut self) -> Result<Option<StateChange>, PostError> {
         let change = self.engine.settle()?;

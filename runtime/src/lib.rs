@@ -10,8 +10,14 @@
 //! - [`stream`]: seeded random event streams and their text form, for
 //!   benchmarks and differential tests.
 
+pub mod agent;
 pub mod bench;
 pub mod bulletinboard;
+pub mod bus;
 pub mod organise;
+pub mod record;
 pub mod rete;
+pub mod sched;
+pub mod stack;
 pub mod stream;
+pub mod summary;

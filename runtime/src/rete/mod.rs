@@ -366,6 +366,23 @@ impl Engine {
         Ok(Step { from: self.record.from, to: self.state, firings: self.record.firings.len() })
     }
 
+    /// Moves now forward without an event (the Bulletinboard's heartbeat):
+    /// facts older than their `stale after` expire and windows close, and
+    /// the network is brought to rest. A clock that never goes back.
+    pub fn advance(&mut self, now: u64) -> Result<Option<StateChange>, PostError> {
+        self.begin();
+        if now > self.now {
+            self.now = now;
+        }
+        if self.now > self.next_deadline {
+            self.expire();
+        }
+        if !self.at_rest() {
+            self.rest()?;
+        }
+        Ok((!self.record.firings.is_empty()).then(|| self.last_change()))
+    }
+
     /// Brings the network to rest without an event (e.g. at start, for
     /// rules that hold with no facts).
     pub fn settle(&mut self) -> Result<Option<StateChange>, PostError> {

@@ -300,3 +300,16 @@ fn explanations_speak_in_source_terms() {
     assert!(text.contains("rule `obstacle` (t.situ:10:1, salience 5) fired in RS"), "{text}");
     assert!(text.contains("LAOBS(distance: 12.0, height: 0.5) at 1.230s -> RO"), "{text}");
 }
+
+#[test]
+fn the_clock_alone_expires_silent_agents() {
+    let mut t = T::new("rule silent { when state == RS and stale LADAR then EM }");
+    t.go("RS");
+    t.post("LAOBN", 0, &[]);
+    assert!(t.e.advance(300 * MS).unwrap().is_none(), "not older than 300 ms yet");
+    let change = t.e.advance(301 * MS).unwrap().expect("fires without an event");
+    assert_eq!(change.firings[0].stale, vec![0]);
+    assert_eq!(t.state(), "EM");
+    assert!(t.e.advance(100 * MS).unwrap().is_none(), "the clock never goes back");
+    assert_eq!(t.e.now(), 301 * MS);
+}

@@ -1,0 +1,111 @@
+//! The three streams of the paper (Zhang & Zhu 2005, §2.4), kept apart:
+//!
+//! - **data**, agent to agent, along the links of the wiring graph of the
+//!   current state;
+//! - **events**, every agent to the Bulletinboard;
+//! - **status**, the Bulletinboard to every agent.
+//!
+//! [`Bus`] is the interface every transport implements: in one process
+//! ([`inproc::InProc`]) or across processes. Its policies when a queue is
+//! full are part of the interface:
+//!
+//! - data: **keep-latest** — the oldest datum of the receiver's queue is
+//!   dropped (counted per receiver); a controller wants the newest reading;
+//! - events: **never dropped silently** — an event that finds the
+//!   Bulletinboard's queue full is dropped and counted, and the Bulletinboard
+//!   learns how many were lost with the next drain (it raises `BUSOVF` if
+//!   the rules declare it, and records the loss);
+//! - status: only the latest matters — each agent keeps one.
+//!
+//! Urgent messages (ROBIX's urgent letters) go to a lane of their own that
+//! is delivered before the queue, and wake a receiver waiting for its next
+//! step.
+
+pub mod inproc;
+
+use crate::agent::Body;
+use situ_compiler::bundle::Value;
+use std::time::Instant;
+
+/// An event on its way to the Bulletinboard.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EventMsg {
+    /// The reporting agent.
+    pub agent: u32,
+    pub event: u32,
+    /// Nanoseconds.
+    pub time: u64,
+    pub payload: Vec<Value>,
+    pub urgent: bool,
+}
+
+/// The state at rest, broadcast to every agent.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StatusMsg {
+    pub state: u32,
+    pub time: u64,
+    /// Increases with every broadcast.
+    pub seq: u64,
+}
+
+/// A datum on its way from one agent to another.
+#[derive(Debug, Clone)]
+pub struct DataMsg {
+    pub from: u32,
+    pub to: u32,
+    pub time: u64,
+    pub urgent: bool,
+    pub body: Body,
+}
+
+/// What a receiver waiting for its next step was woken by.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Wake {
+    /// Its time came.
+    Deadline,
+    /// An urgent message arrived first.
+    Urgent,
+    /// The bus is shutting down.
+    Closed,
+}
+
+/// Counters of a bus's life.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct BusCounters {
+    pub data_sent: u64,
+    /// Data dropped to keep the latest in a full queue.
+    pub data_overflow: u64,
+    pub events_sent: u64,
+    /// Events that found the Bulletinboard's queue full.
+    pub events_overflow: u64,
+    pub status_sent: u64,
+    pub urgent: u64,
+}
+
+/// A transport of the three streams.
+pub trait Bus: Send + Sync {
+    /// Queues a datum for `msg.to`.
+    fn send_data(&self, msg: DataMsg);
+    /// Queues an event for the Bulletinboard.
+    fn send_event(&self, msg: EventMsg);
+    /// Broadcasts the status to every agent.
+    fn send_status(&self, msg: StatusMsg);
+    /// Moves the agent's queued data into `out` (urgent first).
+    fn recv_data(&self, agent: u32, out: &mut Vec<DataMsg>);
+    /// Drops the agent's queued data (an agent waking up starts afresh);
+    /// returns how many were dropped.
+    fn discard_data(&self, agent: u32) -> usize;
+    /// Moves the queued events into `out` (urgent first); returns how many
+    /// events were lost to a full queue since the previous call.
+    fn recv_events(&self, out: &mut Vec<EventMsg>) -> u64;
+    /// The latest status the agent has received.
+    fn status(&self, agent: u32) -> Option<StatusMsg>;
+    /// Waits until `deadline` or an urgent message for the agent, whichever
+    /// comes first (real-time runs).
+    fn wait(&self, agent: u32, deadline: Instant) -> Wake;
+    /// Waits until `deadline` or an event for the Bulletinboard.
+    fn wait_events(&self, deadline: Instant) -> Wake;
+    /// Wakes every waiter with [`Wake::Closed`].
+    fn close(&self);
+    fn counters(&self) -> BusCounters;
+}

@@ -1,0 +1,1 @@
+//! The MCAP recorder (placeholder; written next).

@@ -1,0 +1,511 @@
+//! The running stack: agents stepping through their running cycle, and the
+//! Bulletinboard turning their events into the state it broadcasts. The
+//! pieces here are shared by the simulated-time scheduler (one thread,
+//! deterministic) and the real-time one (a thread per agent):
+//!
+//! - [`Shared`]: the bundle, the organisation of the moment (the state at
+//!   rest, each agent's table or FSM state), the bus and the recorder;
+//! - [`AgentRunner`]: one agent's running cycle;
+//! - [`BoardRunner`]: the Bulletinboard's events monitor: it checks every
+//!   event (refusing, counting and recording the bad ones), lets the FSMs
+//!   see their agents' events, posts to the engine, and broadcasts each new
+//!   state at rest.
+
+use crate::agent::{Agent, Context, Datum, Outgoing, Report};
+use crate::bulletinboard::Bulletinboard;
+use crate::bus::{Bus, DataMsg, EventMsg, StatusMsg};
+use crate::organise::Organisation;
+use crate::record::{DataRecord, EventRecord, Fate, Level, ModeRecord, Sink, Verdict};
+use crate::rete::{PostError, StateChange};
+use situ_compiler::bundle::{AlphaNode, Check, Content, Mode, Operand, Value};
+use std::collections::BTreeMap;
+use std::sync::{Arc, Mutex, RwLock};
+
+/// What every part of a running stack shares.
+pub struct Shared {
+    pub content: Arc<Content>,
+    pub org: RwLock<Organisation>,
+    pub bus: Arc<dyn Bus>,
+    pub sink: Mutex<Option<Box<dyn Sink>>>,
+}
+
+impl Shared {
+    pub fn new(content: Arc<Content>, bus: Arc<dyn Bus>, sink: Option<Box<dyn Sink>>) -> Shared {
+        Shared { org: RwLock::new(Organisation::new(content.clone())), content, bus, sink: Mutex::new(sink) }
+    }
+
+    pub fn org(&self) -> std::sync::RwLockReadGuard<'_, Organisation> {
+        self.org.read().unwrap_or_else(|p| p.into_inner())
+    }
+
+    fn org_mut(&self) -> std::sync::RwLockWriteGuard<'_, Organisation> {
+        self.org.write().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// Calls the recorder, if there is one.
+    pub fn record(&self, f: impl FnOnce(&mut dyn Sink)) {
+        if let Some(sink) = self.sink.lock().unwrap_or_else(|p| p.into_inner()).as_mut() {
+            f(sink.as_mut());
+        }
+    }
+
+    /// Who gets a datum `from` sends now: the agents it sends to, and the
+    /// running agents that read from it (§10.6, the wiring of the moment).
+    pub fn receivers(&self, org: &Organisation, from: u32) -> Vec<u32> {
+        let mut out: Vec<u32> = org.action(from).map(|a| a.to.clone()).unwrap_or_default();
+        for y in 0..self.content.agents.len() as u32 {
+            if y != from && org.action(y).is_some_and(|a| a.mode == Mode::Running && a.from.contains(&from)) {
+                out.push(y);
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+}
+
+/// What one agent did over a run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct AgentCounters {
+    pub steps: u64,
+    pub data_in: u64,
+    pub data_out: u64,
+    /// Its data outputs while waiting (dropped).
+    pub suppressed: u64,
+    /// Its data to sleeping agents, or to agents it has no link to (dropped).
+    pub undelivered: u64,
+    /// Data queued for it while it slept, dropped when it woke.
+    pub stale_inputs: u64,
+    pub events: u64,
+    /// Reports of events that are not its own (refused before the bus).
+    pub bad_reports: u64,
+}
+
+/// One agent and its running cycle.
+pub struct AgentRunner {
+    pub id: u32,
+    imp: Box<dyn Agent>,
+    pub counters: AgentCounters,
+    msgs: Vec<DataMsg>,
+    inputs: Vec<Datum>,
+    outputs: Vec<Outgoing>,
+    reports: Vec<Report>,
+}
+
+/// What a cycle produced that a scheduler cares about.
+#[derive(Debug, Default)]
+pub struct Cycle {
+    /// Whether the agent was stepped (not sleeping).
+    pub stepped: bool,
+    /// Agents that received an urgent datum.
+    pub urgent_to: Vec<u32>,
+    /// Agents that received any datum.
+    pub data_to: Vec<u32>,
+    /// Whether it reported events.
+    pub reported: bool,
+}
+
+impl AgentRunner {
+    pub fn new(id: u32, imp: Box<dyn Agent>) -> AgentRunner {
+        AgentRunner {
+            id,
+            imp,
+            counters: AgentCounters::default(),
+            msgs: Vec::new(),
+            inputs: Vec::new(),
+            outputs: Vec::new(),
+            reports: Vec::new(),
+        }
+    }
+
+    /// One running cycle at `now`: status → table/FSM → mode and function →
+    /// inputs of the active links → step → outputs along the active links →
+    /// events to the Bulletinboard. A sleeping agent is not stepped.
+    pub fn cycle(&mut self, shared: &Shared, now: u64) -> Cycle {
+        let mut out = Cycle::default();
+        let content = &*shared.content;
+        let (state, mode, function) = {
+            let org = shared.org();
+            (org.state(), org.mode(self.id), org.action(self.id).and_then(|a| a.function))
+        };
+        if mode == Mode::Sleeping {
+            self.counters.stale_inputs += shared.bus.discard_data(self.id) as u64;
+            return out;
+        }
+        self.msgs.clear();
+        shared.bus.recv_data(self.id, &mut self.msgs);
+        self.inputs.clear();
+        self.inputs.extend(self.msgs.drain(..).map(|m| Datum {
+            from: m.from,
+            time: m.time,
+            urgent: m.urgent,
+            body: m.body,
+        }));
+        self.counters.data_in += self.inputs.len() as u64;
+        self.outputs.clear();
+        self.reports.clear();
+        let def = &content.agents[self.id as usize];
+        let function_name = function.and_then(|f| def.functions.get(f as usize)).map(|f| f.name.as_str());
+        {
+            let mut cx = Context {
+                content,
+                agent: self.id,
+                now,
+                state,
+                mode,
+                function: function_name,
+                inputs: &self.inputs,
+                outputs: &mut self.outputs,
+                reports: &mut self.reports,
+            };
+            self.imp.step(&mut cx);
+        }
+        self.counters.steps += 1;
+        out.stepped = true;
+        // Data along the links of the moment.
+        if !self.outputs.is_empty() {
+            let org = shared.org();
+            let receivers = shared.receivers(&org, self.id);
+            for o in self.outputs.drain(..) {
+                let targets: Vec<u32> = match o.to {
+                    None => receivers.clone(),
+                    Some(t) if receivers.contains(&t) => vec![t],
+                    Some(_) => Vec::new(),
+                };
+                let fate_all = if mode == Mode::Waiting { Some(Fate::Suppressed) } else { None };
+                if targets.is_empty() || fate_all.is_some() {
+                    let fate = fate_all.unwrap_or(Fate::Unrouted);
+                    match fate {
+                        Fate::Suppressed => self.counters.suppressed += 1,
+                        _ => self.counters.undelivered += 1,
+                    }
+                    let rec = DataRecord {
+                        time: now,
+                        from: self.id,
+                        to: u32::MAX,
+                        urgent: o.urgent,
+                        size: o.body.size(),
+                        fate,
+                    };
+                    shared.record(|s| s.data(&rec));
+                    continue;
+                }
+                for to in targets {
+                    let fate = if org.mode(to) == Mode::Sleeping { Fate::ToSleeping } else { Fate::Delivered };
+                    let rec = DataRecord { time: now, from: self.id, to, urgent: o.urgent, size: o.body.size(), fate };
+                    shared.record(|s| s.data(&rec));
+                    if fate == Fate::ToSleeping {
+                        self.counters.undelivered += 1;
+                        continue;
+                    }
+                    self.counters.data_out += 1;
+                    if o.urgent {
+                        out.urgent_to.push(to);
+                    }
+                    out.data_to.push(to);
+                    shared.bus.send_data(DataMsg {
+                        from: self.id,
+                        to,
+                        time: now,
+                        urgent: o.urgent,
+                        body: o.body.clone(),
+                    });
+                }
+            }
+        }
+        // Events to the Bulletinboard (running or waiting).
+        for r in self.reports.drain(..) {
+            self.counters.events += 1;
+            out.reported = true;
+            shared.bus.send_event(EventMsg {
+                agent: self.id,
+                event: r.event,
+                time: now,
+                payload: r.payload,
+                urgent: r.urgent,
+            });
+        }
+        out
+    }
+}
+
+/// What the Bulletinboard did over a run.
+#[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
+pub struct BoardCounters {
+    pub accepted: u64,
+    /// Refused events, by reason.
+    pub refused: BTreeMap<String, u64>,
+    /// Events lost to a full queue (told by the bus).
+    pub lost: u64,
+    pub firings: u64,
+    pub changes: u64,
+    pub status_sent: u64,
+    pub cascade_errors: u64,
+    /// Rules fired, by name.
+    pub fired: BTreeMap<String, u64>,
+}
+
+/// The events monitor of the Bulletinboard.
+pub struct BoardRunner {
+    pub board: Bulletinboard,
+    pub counters: BoardCounters,
+    /// Per agent, the time of its latest accepted event.
+    last_time: Vec<u64>,
+    /// Per event, per field: compared with something by a rule.
+    compared: Vec<Vec<bool>>,
+    events: Vec<EventMsg>,
+    /// The `BUSOVF` event, if the rules declare it.
+    overflow_event: Option<u32>,
+    status_seq: u64,
+    /// The modes last recorded, per agent.
+    modes: Vec<Option<(Mode, Option<u32>)>>,
+}
+
+impl BoardRunner {
+    pub fn new(content: Arc<Content>) -> BoardRunner {
+        let mut compared: Vec<Vec<bool>> = content.events.iter().map(|e| vec![false; e.fields.len()]).collect();
+        for node in &content.network.alpha {
+            if let AlphaNode::Event { event, tests, .. } = node {
+                for t in tests {
+                    compared[*event as usize][t.field as usize] = true;
+                    if let Check::Compare { rhs: Operand::Own { field }, .. } = t.check {
+                        compared[*event as usize][field as usize] = true;
+                    }
+                }
+            }
+        }
+        for b in &content.network.beta {
+            if let AlphaNode::Event { event, .. } = &content.network.alpha[b.alpha as usize] {
+                for t in &b.tests {
+                    compared[*event as usize][t.field as usize] = true;
+                }
+            }
+        }
+        let overflow_event = content.event_id("BUSOVF");
+        BoardRunner {
+            last_time: vec![0; content.agents.len()],
+            modes: vec![None; content.agents.len()],
+            board: Bulletinboard::new(content),
+            counters: BoardCounters::default(),
+            compared,
+            events: Vec::new(),
+            overflow_event,
+            status_seq: 0,
+        }
+    }
+
+    /// Broadcasts the initial status and records the initial modes.
+    pub fn start(&mut self, shared: &Shared, now: u64) {
+        self.broadcast(shared, now);
+    }
+
+    /// Takes every queued event, in order (urgent first); returns the
+    /// changes of the state at rest it broadcast.
+    pub fn pump(&mut self, shared: &Shared, now: u64) -> Vec<StateChange> {
+        let mut changes = Vec::new();
+        self.events.clear();
+        let lost = shared.bus.recv_events(&mut self.events);
+        if lost > 0 {
+            self.counters.lost += lost;
+            let text = format!("{lost} event(s) lost: the Bulletinboard's queue was full");
+            shared.record(|s| s.diagnostic(now, Level::Error, &text));
+            if let Some(ev) = self.overflow_event {
+                let payload = self.overflow_payload(&shared.content, ev, lost);
+                let agent = shared.content.events[ev as usize].agent;
+                self.events.insert(0, EventMsg { agent, event: ev, time: now, payload, urgent: true });
+            }
+        }
+        let events = std::mem::take(&mut self.events);
+        for msg in &events {
+            if let Some(c) = self.take(shared, msg) {
+                changes.push(c);
+            }
+        }
+        self.events = events;
+        changes
+    }
+
+    /// The heartbeat: the clock moves to `now` without an event, so that a
+    /// silent agent's fact expires within one period.
+    pub fn tick(&mut self, shared: &Shared, now: u64) -> Option<StateChange> {
+        match self.board.advance(now) {
+            Ok(Some(change)) => {
+                shared.record(|s| s.tick(now));
+                self.after(shared, &change, now);
+                change.changed().then_some(change)
+            }
+            Ok(None) => None,
+            Err(e) => {
+                self.cascade(shared, &e, now);
+                None
+            }
+        }
+    }
+
+    fn overflow_payload(&self, c: &Content, ev: u32, lost: u64) -> Vec<Value> {
+        c.events[ev as usize]
+            .fields
+            .iter()
+            .map(|f| match f.ty {
+                situ_compiler::bundle::FieldType::I64 => Value::I64(lost.min(i64::MAX as u64) as i64),
+                situ_compiler::bundle::FieldType::F64 => Value::F64(lost as f64),
+                situ_compiler::bundle::FieldType::Bool => Value::Bool(true),
+                situ_compiler::bundle::FieldType::Symbols(_) => Value::Symbol(0),
+            })
+            .collect()
+    }
+
+    /// Why an event is refused, if it is.
+    fn check(&self, c: &Content, msg: &EventMsg) -> Option<String> {
+        let Some(def) = c.events.get(msg.event as usize) else {
+            return Some(format!("unknown event id {}", msg.event));
+        };
+        if def.agent != msg.agent {
+            let who = c.agents.get(msg.agent as usize).map_or("?", |a| a.name.as_str());
+            return Some(format!(
+                "`{}` is an event of `{}`, not of `{who}`",
+                def.name, c.agents[def.agent as usize].name
+            ));
+        }
+        if let Err(e) = self.board.engine().validate(msg.event, &msg.payload) {
+            return Some(e.describe(c));
+        }
+        for (i, v) in msg.payload.iter().enumerate() {
+            if let Value::F64(x) = v {
+                if !x.is_finite() && self.compared[msg.event as usize][i] {
+                    return Some(format!(
+                        "`{}.{}` is {x}, and the rules compare it: a sensor fault",
+                        def.name, def.fields[i].name
+                    ));
+                }
+            }
+        }
+        let last = self.last_time[msg.agent as usize];
+        if msg.time < last {
+            return Some(format!("out of order: at {} ns, after an event at {last} ns", msg.time));
+        }
+        None
+    }
+
+    fn take(&mut self, shared: &Shared, msg: &EventMsg) -> Option<StateChange> {
+        let c = shared.content.clone();
+        if let Some(reason) = self.check(&c, msg) {
+            let key = reason_key(&reason);
+            *self.counters.refused.entry(key).or_default() += 1;
+            let rec = EventRecord {
+                time: msg.time,
+                agent: msg.agent,
+                event: msg.event,
+                payload: msg.payload.clone(),
+                urgent: msg.urgent,
+                verdict: Verdict::Refused(reason.clone()),
+            };
+            shared.record(|s| {
+                s.event(&rec);
+                s.diagnostic(msg.time, Level::Warning, &format!("event refused: {reason}"));
+            });
+            return None;
+        }
+        self.last_time[msg.agent as usize] = msg.time;
+        self.counters.accepted += 1;
+        let rec = EventRecord {
+            time: msg.time,
+            agent: msg.agent,
+            event: msg.event,
+            payload: msg.payload.clone(),
+            urgent: msg.urgent,
+            verdict: Verdict::Accepted,
+        };
+        shared.record(|s| s.event(&rec));
+        // The agent's FSM sees its own event before the Bulletinboard's rest.
+        let moved = shared.org_mut().on_event(msg.agent, msg.event);
+        if moved.is_some() {
+            self.record_modes(shared, msg.time);
+        }
+        match self.board.post(msg.event, msg.time, &msg.payload) {
+            Ok(Some(change)) => {
+                self.after(shared, &change, msg.time);
+                change.changed().then_some(change)
+            }
+            Ok(None) => None,
+            Err(e) => {
+                self.cascade(shared, &e, msg.time);
+                None
+            }
+        }
+    }
+
+    fn after(&mut self, shared: &Shared, change: &StateChange, now: u64) {
+        self.counters.firings += change.firings.len() as u64;
+        for f in &change.firings {
+            *self.counters.fired.entry(shared.content.rules[f.rule as usize].name.clone()).or_default() += 1;
+        }
+        shared.record(|s| s.change(change));
+        if change.changed() {
+            self.counters.changes += 1;
+            shared.org_mut().on_state(change.to);
+            self.broadcast(shared, now);
+        }
+    }
+
+    fn cascade(&mut self, shared: &Shared, e: &PostError, now: u64) {
+        self.counters.cascade_errors += 1;
+        let text = e.describe(&shared.content);
+        shared.record(|s| s.diagnostic(now, Level::Error, &text));
+        // The state reached is broadcast: the agents follow the Bulletinboard.
+        if shared.org().state() != self.board.state() {
+            let state = self.board.state();
+            shared.org_mut().on_state(state);
+            self.broadcast(shared, now);
+        }
+    }
+
+    fn broadcast(&mut self, shared: &Shared, now: u64) {
+        self.status_seq += 1;
+        self.counters.status_sent += 1;
+        shared.bus.send_status(StatusMsg { state: self.board.state(), time: now, seq: self.status_seq });
+        self.record_modes(shared, now);
+    }
+
+    /// Records the agents whose mode or function changed.
+    fn record_modes(&mut self, shared: &Shared, now: u64) {
+        let org = shared.org();
+        let mut recs = Vec::new();
+        for a in 0..shared.content.agents.len() as u32 {
+            let action = org.action(a);
+            let now_mode = (action.map_or(Mode::Sleeping, |x| x.mode), action.and_then(|x| x.function));
+            if self.modes[a as usize] != Some(now_mode) {
+                self.modes[a as usize] = Some(now_mode);
+                if now_mode.0 == Mode::Sleeping {
+                    // Whatever it had not read is gone: when it wakes, it
+                    // gets only what arrives after.
+                    shared.bus.discard_data(a);
+                }
+                recs.push(ModeRecord {
+                    time: now,
+                    agent: a,
+                    state: org.state(),
+                    mode: now_mode.0,
+                    function: org.function(a).map(str::to_string),
+                });
+            }
+        }
+        drop(org);
+        shared.record(|s| recs.iter().for_each(|r| s.mode(r)));
+    }
+}
+
+/// A short key for a refusal reason, for counting.
+fn reason_key(reason: &str) -> String {
+    if reason.starts_with("unknown event") {
+        "unknown event".into()
+    } else if reason.contains("is an event of") {
+        "another agent's event".into()
+    } else if reason.contains("sensor fault") {
+        "not a number".into()
+    } else if reason.starts_with("out of order") {
+        "out of order".into()
+    } else {
+        "payload".into()
+    }
+}

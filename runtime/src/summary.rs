@@ -1,0 +1,151 @@
+//! The figures of a run, for a person (a table at the end of `situ run`)
+//! and for tools (`metrics.json`): the states visited and for how long, the
+//! rules that fired, the messages of each stream and what was dropped.
+
+use crate::bus::BusCounters;
+use crate::rete::StateChange;
+use crate::stack::{AgentCounters, BoardCounters};
+use serde::Serialize;
+use situ_compiler::bundle::Content;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+#[derive(Debug, Clone, Serialize)]
+pub struct Summary {
+    /// Simulated (or wall) time covered, seconds.
+    pub duration_s: f64,
+    pub final_state: String,
+    /// Per state, in declaration order: time spent there (s), times entered.
+    pub states: Vec<StateFigures>,
+    /// The sequence of states at rest.
+    pub path: Vec<String>,
+    pub rules_fired: BTreeMap<String, u64>,
+    pub board: BoardCounters,
+    pub bus: BusCounters,
+    pub agents: BTreeMap<String, AgentCounters>,
+    #[serde(skip)]
+    names: Vec<String>,
+    #[serde(skip)]
+    agent_names: Vec<String>,
+    #[serde(skip)]
+    since: u64,
+    #[serde(skip)]
+    current: usize,
+}
+
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct StateFigures {
+    pub state: String,
+    pub seconds: f64,
+    pub entered: u64,
+    /// Agent steps taken in this state (sleeping agents take none).
+    pub agent_steps: u64,
+}
+
+impl Summary {
+    pub fn new(c: &Content) -> Summary {
+        let mut states: Vec<StateFigures> =
+            c.states.iter().map(|s| StateFigures { state: s.name.clone(), ..Default::default() }).collect();
+        states[c.initial as usize].entered = 1;
+        Summary {
+            duration_s: 0.0,
+            final_state: c.states[c.initial as usize].name.clone(),
+            states,
+            path: vec![c.states[c.initial as usize].name.clone()],
+            rules_fired: BTreeMap::new(),
+            board: BoardCounters::default(),
+            bus: BusCounters::default(),
+            agents: BTreeMap::new(),
+            names: c.states.iter().map(|s| s.name.clone()).collect(),
+            agent_names: c.agents.iter().map(|a| a.name.clone()).collect(),
+            since: 0,
+            current: c.initial as usize,
+        }
+    }
+
+    /// A change of the state at rest.
+    pub fn change(&mut self, c: &StateChange) {
+        if !c.changed() {
+            return;
+        }
+        let dt = c.time.saturating_sub(self.since);
+        self.states[self.current].seconds += dt as f64 * 1e-9;
+        self.since = c.time;
+        self.current = c.to as usize;
+        self.states[self.current].entered += 1;
+        self.path.push(self.names[self.current].clone());
+    }
+
+    /// An agent's turn came (`stepped`: it was not sleeping).
+    pub fn stepped(&mut self, _agent: u32, stepped: bool) {
+        if stepped {
+            self.states[self.current].agent_steps += 1;
+        }
+    }
+
+    /// Closes the figures at `now`.
+    pub fn finish(
+        &mut self,
+        now: u64,
+        state: u32,
+        board: &BoardCounters,
+        agents: Vec<(u32, AgentCounters)>,
+        bus: BusCounters,
+    ) {
+        let dt = now.saturating_sub(self.since);
+        self.states[self.current].seconds += dt as f64 * 1e-9;
+        self.since = now;
+        self.duration_s = now as f64 * 1e-9;
+        self.final_state = self.names[state as usize].clone();
+        self.rules_fired = board.fired.clone();
+        self.board = board.clone();
+        self.bus = bus;
+        self.agents = agents.into_iter().map(|(a, c)| (self.agent_names[a as usize].clone(), c)).collect();
+    }
+
+    /// The table a person reads at the end of a run.
+    pub fn table(&self) -> String {
+        let mut s = String::new();
+        let _ = writeln!(s, "{:.1} s simulated, final state {}", self.duration_s, self.final_state);
+        let _ = writeln!(s, "path: {}", self.path.join(" → "));
+        let _ = writeln!(s, "\n  state   time (s)  entered  agent steps");
+        for f in self.states.iter().filter(|f| f.entered > 0) {
+            let _ = writeln!(s, "  {:<6} {:>9.1}  {:>7}  {:>11}", f.state, f.seconds, f.entered, f.agent_steps);
+        }
+        if !self.rules_fired.is_empty() {
+            let _ = writeln!(s, "\n  rule                           fired");
+            for (r, n) in &self.rules_fired {
+                let _ = writeln!(s, "  {r:<30} {n:>5}");
+            }
+        }
+        let (mut out, mut suppressed, mut undelivered, mut stale) = (0, 0, 0, 0);
+        for c in self.agents.values() {
+            out += c.data_out;
+            suppressed += c.suppressed;
+            undelivered += c.undelivered;
+            stale += c.stale_inputs;
+        }
+        let refused: u64 = self.board.refused.values().sum();
+        let _ = writeln!(s, "\n  stream   messages  dropped");
+        let _ = writeln!(
+            s,
+            "  data     {:>8}  {} (waiting senders {suppressed}, sleeping or unlinked receivers {undelivered}, full queues {}, backlog at wake-up {stale})",
+            out,
+            suppressed + undelivered + self.bus.data_overflow + stale,
+            self.bus.data_overflow
+        );
+        let _ = writeln!(
+            s,
+            "  events   {:>8}  {} (refused {refused}, lost to a full queue {})",
+            self.board.accepted + refused + self.board.lost,
+            refused + self.board.lost,
+            self.board.lost
+        );
+        let _ = writeln!(s, "  status   {:>8}  0", self.board.status_sent);
+        if !self.board.refused.is_empty() {
+            let reasons: Vec<String> = self.board.refused.iter().map(|(k, v)| format!("{k}: {v}")).collect();
+            let _ = writeln!(s, "  refused events by reason: {}", reasons.join(", "));
+        }
+        s
+    }
+}
