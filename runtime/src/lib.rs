@@ -16,6 +16,7 @@ pub mod bulletinboard;
 pub mod bus;
 pub mod organise;
 pub mod record;
+pub mod replay;
 pub mod rete;
 pub mod sched;
 pub mod stack;

@@ -1,1 +1,354 @@
-//! The MCAP recorder (placeholder; written next).
+//! The Recorder agent of the paper, as an MCAP file that Foxglove and the
+//! `mcap` Python package read: JSON messages with JSON-schema schemas, zstd
+//! chunks, one channel per stream.
+//!
+//! | topic | schema | what |
+//! |---|---|---|
+//! | `/state` | `situ.State` | every change of the state at rest: `state` (Foxglove's State Transitions panel draws it), `from`, the rules that fired and why |
+//! | `/events` | `foxglove.Log` | every event as a log line (refused ones as warnings) |
+//! | `/diagnostics` | `foxglove.Log` | refusals, losses, cascade errors |
+//! | `/situ/events` | `situ.Event` | every event, structured (what `situ replay` reads) |
+//! | `/situ/ticks` | `situ.Tick` | heartbeats that fired rules (for replays) |
+//! | `/situ/data` | `situ.Data` | every data message's metadata: from, to, size, fate |
+//! | `/situ/modes` | `situ.Mode` | every change of an agent's mode or function |
+//!
+//! The bundle that ran is attached (`bundle.json`), so that a replay needs
+//! nothing else. Chunks are closed and the file flushed at least once a
+//! second (of wall time) while records come, so a process killed mid-run
+//! loses at most its last second of records; the file then has no summary,
+//! and readers that stream it (`situ replay`, `mcap` in Python with its
+//! non-seeking reader) read everything before the cut.
+
+use super::{DataRecord, EventRecord, Level, ModeRecord, Sink, Verdict};
+use crate::rete::{describe_fact, format_time, MatchedFact, StateChange};
+use mcap::records::MessageHeader;
+use serde_json::{json, Value as Json};
+use situ_compiler::bundle::{Content, FieldType, Value};
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::{self, BufWriter};
+use std::path::Path;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// Topic names, for readers.
+pub mod topics {
+    pub const STATE: &str = "/state";
+    pub const EVENTS_LOG: &str = "/events";
+    pub const DIAGNOSTICS: &str = "/diagnostics";
+    pub const EVENTS: &str = "/situ/events";
+    pub const TICKS: &str = "/situ/ticks";
+    pub const DATA: &str = "/situ/data";
+    pub const MODES: &str = "/situ/modes";
+}
+
+/// How often chunks are closed and the file flushed, at most.
+pub const FLUSH_EVERY: Duration = Duration::from_secs(1);
+
+const LOG_SCHEMA: &str = r#"{"title":"foxglove.Log","type":"object","properties":{"timestamp":{"type":"object","properties":{"sec":{"type":"integer","minimum":0},"nsec":{"type":"integer","minimum":0,"maximum":999999999}}},"level":{"type":"integer","description":"0 UNKNOWN, 1 DEBUG, 2 INFO, 3 WARNING, 4 ERROR, 5 FATAL"},"message":{"type":"string"},"name":{"type":"string"},"file":{"type":"string"},"line":{"type":"integer","minimum":0}}}"#;
+
+fn schema(title: &str, properties: Json) -> String {
+    json!({ "title": title, "type": "object", "properties": properties }).to_string()
+}
+
+struct Channels {
+    state: u16,
+    events_log: u16,
+    diagnostics: u16,
+    events: u16,
+    ticks: u16,
+    data: u16,
+    modes: u16,
+}
+
+/// Counts of messages written per topic.
+pub type Counts = BTreeMap<&'static str, u64>;
+
+pub struct McapRecorder {
+    writer: Option<mcap::Writer<BufWriter<File>>>,
+    content: Arc<Content>,
+    channels: Channels,
+    counts: Counts,
+    last_flush: Instant,
+    error: Option<io::Error>,
+}
+
+fn mcap_err(e: mcap::McapError) -> io::Error {
+    io::Error::other(e.to_string())
+}
+
+impl McapRecorder {
+    /// Starts a recording at `path` for the bundle `content` (its file bytes
+    /// in `bundle`, attached for replays).
+    pub fn create(path: &Path, content: Arc<Content>, bundle: &[u8]) -> io::Result<McapRecorder> {
+        let file = BufWriter::new(File::create(path)?);
+        let mut w = mcap::WriteOptions::new()
+            .compression(Some(mcap::Compression::Zstd))
+            .profile("")
+            .library(format!("situ {}", env!("CARGO_PKG_VERSION")))
+            .create(file)
+            .map_err(mcap_err)?;
+        let mut channel = |topic: &str, name: &str, schema_text: &str| -> io::Result<u16> {
+            let schema = w.add_schema(name, "jsonschema", schema_text.as_bytes()).map_err(mcap_err)?;
+            w.add_channel(schema, topic, "json", &BTreeMap::new()).map_err(mcap_err)
+        };
+        let time = json!({ "type": "integer", "description": "nanoseconds" });
+        let channels = Channels {
+            state: channel(
+                topics::STATE,
+                "situ.State",
+                &schema(
+                    "situ.State",
+                    json!({ "state": {"type": "string"}, "from": {"type": "string"}, "time_ns": time,
+                            "rules": {"type": "array", "items": {"type": "string"}}, "explain": {"type": "string"} }),
+                ),
+            )?,
+            events_log: channel(topics::EVENTS_LOG, "foxglove.Log", LOG_SCHEMA)?,
+            diagnostics: channel(topics::DIAGNOSTICS, "foxglove.Log", LOG_SCHEMA)?,
+            events: channel(
+                topics::EVENTS,
+                "situ.Event",
+                &schema(
+                    "situ.Event",
+                    json!({ "time_ns": time, "agent": {"type": "string"}, "event": {"type": "string"},
+                            "payload": {"type": "object"}, "urgent": {"type": "boolean"},
+                            "accepted": {"type": "boolean"}, "reason": {"type": "string"} }),
+                ),
+            )?,
+            ticks: channel(topics::TICKS, "situ.Tick", &schema("situ.Tick", json!({ "time_ns": time })))?,
+            data: channel(
+                topics::DATA,
+                "situ.Data",
+                &schema(
+                    "situ.Data",
+                    json!({ "time_ns": time, "from": {"type": "string"}, "to": {"type": "string"},
+                            "urgent": {"type": "boolean"}, "size": {"type": "integer"},
+                            "fate": {"type": "string", "enum": ["delivered", "suppressed", "to_sleeping", "unrouted"]} }),
+                ),
+            )?,
+            modes: channel(
+                topics::MODES,
+                "situ.Mode",
+                &schema(
+                    "situ.Mode",
+                    json!({ "time_ns": time, "agent": {"type": "string"}, "state": {"type": "string"},
+                            "mode": {"type": "string", "enum": ["running", "waiting", "sleeping"]},
+                            "function": {"type": "string"} }),
+                ),
+            )?,
+        };
+        w.attach(&mcap::Attachment {
+            log_time: 0,
+            create_time: 0,
+            name: "bundle.json".into(),
+            media_type: "application/json".into(),
+            data: std::borrow::Cow::Borrowed(bundle),
+        })
+        .map_err(mcap_err)?;
+        Ok(McapRecorder {
+            writer: Some(w),
+            content,
+            channels,
+            counts: Counts::new(),
+            last_flush: Instant::now(),
+            error: None,
+        })
+    }
+
+    /// Messages written per topic so far.
+    pub fn counts(&self) -> &Counts {
+        &self.counts
+    }
+
+    fn write(&mut self, channel: u16, topic: &'static str, time: u64, message: &Json) {
+        let Some(w) = self.writer.as_mut() else { return };
+        let header = MessageHeader { channel_id: channel, sequence: 0, log_time: time, publish_time: time };
+        let bytes = serde_json::to_vec(message).expect("JSON serializes");
+        if let Err(e) = w.write_to_known_channel(&header, &bytes) {
+            self.error.get_or_insert(mcap_err(e));
+            return;
+        }
+        *self.counts.entry(topic).or_default() += 1;
+        if self.last_flush.elapsed() >= FLUSH_EVERY {
+            let _ = self.flush();
+        }
+    }
+
+    fn agent(&self, a: u32) -> String {
+        self.content.agents.get(a as usize).map_or_else(|| format!("#{a}"), |x| x.name.clone())
+    }
+
+    fn log(&mut self, channel: u16, topic: &'static str, time: u64, level: u8, name: &str, message: &str) {
+        let msg = json!({
+            "timestamp": { "sec": time / 1_000_000_000, "nsec": time % 1_000_000_000 },
+            "level": level, "message": message, "name": name, "file": "", "line": 0,
+        });
+        self.write(channel, topic, time, &msg);
+    }
+}
+
+/// A payload as a JSON object of field names.
+fn payload_json(c: &Content, event: u32, payload: &[Value]) -> Json {
+    let Some(e) = c.events.get(event as usize) else {
+        return Json::Array(payload.iter().map(value_json).collect());
+    };
+    let mut map = serde_json::Map::new();
+    for (f, v) in e.fields.iter().zip(payload) {
+        let j = match (&f.ty, v) {
+            (FieldType::Symbols(s), Value::Symbol(i)) => json!(s.get(*i as usize).cloned().unwrap_or_default()),
+            _ => value_json(v),
+        };
+        map.insert(f.name.clone(), j);
+    }
+    Json::Object(map)
+}
+
+fn value_json(v: &Value) -> Json {
+    match v {
+        Value::F64(f) if f.is_finite() => json!(f),
+        Value::F64(f) => json!(f.to_string()),
+        Value::I64(i) => json!(i),
+        Value::Bool(b) => json!(b),
+        Value::Symbol(i) => json!(i),
+    }
+}
+
+impl Sink for McapRecorder {
+    fn event(&mut self, rec: &EventRecord) {
+        let c = self.content.clone();
+        let name = c.events.get(rec.event as usize).map_or_else(|| format!("#{}", rec.event), |e| e.name.clone());
+        let (accepted, reason) = match &rec.verdict {
+            Verdict::Accepted => (true, None),
+            Verdict::Refused(r) => (false, Some(r.clone())),
+        };
+        let mut msg = json!({
+            "time_ns": rec.time, "agent": self.agent(rec.agent), "event": name,
+            "payload": payload_json(&c, rec.event, &rec.payload), "urgent": rec.urgent, "accepted": accepted,
+        });
+        if let Some(r) = &reason {
+            msg["reason"] = json!(r);
+        }
+        self.write(self.channels.events, topics::EVENTS, rec.time, &msg);
+        let text = if (rec.event as usize) < c.events.len() && accepted {
+            let m = MatchedFact {
+                agent: rec.agent,
+                event: rec.event,
+                payload: rec.payload.clone(),
+                time: rec.time,
+                run: 1,
+            };
+            describe_fact(&c, &m)
+        } else {
+            format!("{name} refused: {}", reason.unwrap_or_default())
+        };
+        let agent = self.agent(rec.agent);
+        self.log(self.channels.events_log, topics::EVENTS_LOG, rec.time, if accepted { 2 } else { 3 }, &agent, &text);
+    }
+
+    fn change(&mut self, change: &StateChange) {
+        let c = self.content.clone();
+        let rules: Vec<&str> = change.firings.iter().map(|f| c.rules[f.rule as usize].name.as_str()).collect();
+        let msg = json!({
+            "state": c.states[change.to as usize].name, "from": c.states[change.from as usize].name,
+            "time_ns": change.time, "rules": rules, "explain": change.explain(&c),
+        });
+        self.write(self.channels.state, topics::STATE, change.time, &msg);
+    }
+
+    fn data(&mut self, rec: &DataRecord) {
+        let to = if rec.to == u32::MAX { String::new() } else { self.agent(rec.to) };
+        let msg = json!({
+            "time_ns": rec.time, "from": self.agent(rec.from), "to": to,
+            "urgent": rec.urgent, "size": rec.size, "fate": rec.fate,
+        });
+        self.write(self.channels.data, topics::DATA, rec.time, &msg);
+    }
+
+    fn mode(&mut self, rec: &ModeRecord) {
+        let msg = json!({
+            "time_ns": rec.time, "agent": self.agent(rec.agent),
+            "state": self.content.states[rec.state as usize].name,
+            "mode": rec.mode.adjective(), "function": rec.function.clone().unwrap_or_default(),
+        });
+        self.write(self.channels.modes, topics::MODES, rec.time, &msg);
+    }
+
+    fn diagnostic(&mut self, time: u64, level: Level, text: &str) {
+        let level = match level {
+            Level::Info => 2,
+            Level::Warning => 3,
+            Level::Error => 4,
+        };
+        let text = format!("{} {text}", format_time(time));
+        self.log(self.channels.diagnostics, topics::DIAGNOSTICS, time, level, "Bulletinboard", &text);
+    }
+
+    fn tick(&mut self, time: u64) {
+        self.write(self.channels.ticks, topics::TICKS, time, &json!({ "time_ns": time }));
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.last_flush = Instant::now();
+        if let Some(w) = self.writer.as_mut() {
+            w.flush().map_err(mcap_err)?;
+        }
+        match self.error.take() {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+
+    fn finish(&mut self) -> io::Result<()> {
+        if let Some(mut w) = self.writer.take() {
+            w.finish().map_err(mcap_err)?;
+        }
+        match self.error.take() {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+}
+
+impl Drop for McapRecorder {
+    fn drop(&mut self) {
+        // Never leave a file without its summary when we can help it.
+        let _ = self.finish();
+    }
+}
+
+/// Reads every message of a recording, whole or cut short: `(topic,
+/// log_time, JSON)`, in file order, and whether the file was cut short.
+pub fn read_messages(bytes: &[u8]) -> Result<(Vec<(String, u64, Json)>, bool), String> {
+    let stream = mcap::MessageStream::new_with_options(bytes, mcap::read::Options::IgnoreEndMagic.into())
+        .map_err(|e| format!("not an MCAP file: {e}"))?;
+    let mut out = Vec::new();
+    let mut cut = false;
+    for m in stream {
+        match m {
+            Ok(m) => {
+                let json: Json = serde_json::from_slice(&m.data).unwrap_or(Json::Null);
+                out.push((m.channel.topic.clone(), m.log_time, json));
+            }
+            Err(_) => {
+                cut = true;
+                break;
+            }
+        }
+    }
+    Ok((out, cut))
+}
+
+/// The bundle attached to a recording, if any.
+pub fn attached_bundle(bytes: &[u8]) -> Option<Vec<u8>> {
+    let stream = mcap::read::LinearReader::new_with_options(bytes, mcap::read::Options::IgnoreEndMagic.into()).ok()?;
+    for record in stream {
+        match record {
+            Ok(mcap::records::Record::Attachment { header, data, .. }) if header.name == "bundle.json" => {
+                return Some(data.into_owned());
+            }
+            Ok(_) => {}
+            Err(_) => break,
+        }
+    }
+    None
+}

@@ -154,3 +154,33 @@ forward! {
     flush() -> std::io::Result<()>;
     finish() -> std::io::Result<()>;
 }
+
+/// Several sinks fed the same records (a recording and a summary, say).
+pub struct Tee(pub Vec<Box<dyn Sink>>);
+
+impl Sink for Tee {
+    fn event(&mut self, rec: &EventRecord) {
+        self.0.iter_mut().for_each(|s| s.event(rec));
+    }
+    fn change(&mut self, change: &StateChange) {
+        self.0.iter_mut().for_each(|s| s.change(change));
+    }
+    fn data(&mut self, rec: &DataRecord) {
+        self.0.iter_mut().for_each(|s| s.data(rec));
+    }
+    fn mode(&mut self, rec: &ModeRecord) {
+        self.0.iter_mut().for_each(|s| s.mode(rec));
+    }
+    fn diagnostic(&mut self, time: u64, level: Level, text: &str) {
+        self.0.iter_mut().for_each(|s| s.diagnostic(time, level, text));
+    }
+    fn tick(&mut self, time: u64) {
+        self.0.iter_mut().for_each(|s| s.tick(time));
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.0.iter_mut().try_for_each(|s| s.flush())
+    }
+    fn finish(&mut self) -> std::io::Result<()> {
+        self.0.iter_mut().try_for_each(|s| s.finish())
+    }
+}
