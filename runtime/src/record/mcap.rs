@@ -316,9 +316,12 @@ impl Drop for McapRecorder {
     }
 }
 
-/// Reads every message of a recording, whole or cut short: `(topic,
-/// log_time, JSON)`, in file order, and whether the file was cut short.
-pub fn read_messages(bytes: &[u8]) -> Result<(Vec<(String, u64, Json)>, bool), String> {
+/// A recorded message: its topic, its log time (ns) and its JSON.
+pub type Recorded = (String, u64, Json);
+
+/// Reads every message of a recording, whole or cut short, in file order,
+/// and whether the file was cut short.
+pub fn read_messages(bytes: &[u8]) -> Result<(Vec<Recorded>, bool), String> {
     let stream = mcap::MessageStream::new_with_options(bytes, mcap::read::Options::IgnoreEndMagic.into())
         .map_err(|e| format!("not an MCAP file: {e}"))?;
     let mut out = Vec::new();
