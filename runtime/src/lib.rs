@@ -15,6 +15,7 @@ pub mod bench;
 pub mod bulletinboard;
 pub mod bus;
 pub mod organise;
+pub mod realtime;
 pub mod record;
 pub mod replay;
 pub mod rete;

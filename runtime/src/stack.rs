@@ -27,11 +27,14 @@ pub struct Shared {
     pub org: RwLock<Organisation>,
     pub bus: Arc<dyn Bus>,
     pub sink: Mutex<Option<Box<dyn Sink>>>,
+    /// Whether there is a sink (checked before building records).
+    pub recording: bool,
 }
 
 impl Shared {
     pub fn new(content: Arc<Content>, bus: Arc<dyn Bus>, sink: Option<Box<dyn Sink>>) -> Shared {
-        Shared { org: RwLock::new(Organisation::new(content.clone())), content, bus, sink: Mutex::new(sink) }
+        let recording = sink.is_some();
+        Shared { org: RwLock::new(Organisation::new(content.clone())), content, bus, sink: Mutex::new(sink), recording }
     }
 
     pub fn org(&self) -> std::sync::RwLockReadGuard<'_, Organisation> {
@@ -52,7 +55,17 @@ impl Shared {
     /// Who gets a datum `from` sends now: the agents it sends to, and the
     /// running agents that read from it (§10.6, the wiring of the moment).
     pub fn receivers(&self, org: &Organisation, from: u32) -> Vec<u32> {
-        let mut out: Vec<u32> = org.action(from).map(|a| a.to.clone()).unwrap_or_default();
+        let mut out = Vec::new();
+        self.receivers_into(org, from, &mut out);
+        out
+    }
+
+    /// As [`receivers`](Self::receivers), into a buffer.
+    pub fn receivers_into(&self, org: &Organisation, from: u32, out: &mut Vec<u32>) {
+        out.clear();
+        if let Some(a) = org.action(from) {
+            out.extend_from_slice(&a.to);
+        }
         for y in 0..self.content.agents.len() as u32 {
             if y != from && org.action(y).is_some_and(|a| a.mode == Mode::Running && a.from.contains(&from)) {
                 out.push(y);
@@ -60,7 +73,6 @@ impl Shared {
         }
         out.sort_unstable();
         out.dedup();
-        out
     }
 }
 
@@ -90,6 +102,7 @@ pub struct AgentRunner {
     inputs: Vec<Datum>,
     outputs: Vec<Outgoing>,
     reports: Vec<Report>,
+    receivers: Vec<u32>,
 }
 
 /// What a cycle produced that a scheduler cares about.
@@ -115,6 +128,7 @@ impl AgentRunner {
             inputs: Vec::new(),
             outputs: Vec::new(),
             reports: Vec::new(),
+            receivers: Vec::new(),
         }
     }
 
@@ -165,35 +179,41 @@ impl AgentRunner {
         // Data along the links of the moment.
         if !self.outputs.is_empty() {
             let org = shared.org();
-            let receivers = shared.receivers(&org, self.id);
-            for o in self.outputs.drain(..) {
-                let targets: Vec<u32> = match o.to {
-                    None => receivers.clone(),
-                    Some(t) if receivers.contains(&t) => vec![t],
-                    Some(_) => Vec::new(),
+            shared.receivers_into(&org, self.id, &mut self.receivers);
+            let mut outputs = std::mem::take(&mut self.outputs);
+            for o in outputs.drain(..) {
+                let single = [o.to.unwrap_or(u32::MAX)];
+                let targets: &[u32] = match o.to {
+                    None => &self.receivers,
+                    Some(t) if self.receivers.contains(&t) => &single,
+                    Some(_) => &[],
                 };
-                let fate_all = if mode == Mode::Waiting { Some(Fate::Suppressed) } else { None };
-                if targets.is_empty() || fate_all.is_some() {
-                    let fate = fate_all.unwrap_or(Fate::Unrouted);
+                if mode == Mode::Waiting || targets.is_empty() {
+                    let fate = if mode == Mode::Waiting { Fate::Suppressed } else { Fate::Unrouted };
                     match fate {
                         Fate::Suppressed => self.counters.suppressed += 1,
                         _ => self.counters.undelivered += 1,
                     }
-                    let rec = DataRecord {
-                        time: now,
-                        from: self.id,
-                        to: u32::MAX,
-                        urgent: o.urgent,
-                        size: o.body.size(),
-                        fate,
-                    };
-                    shared.record(|s| s.data(&rec));
+                    if shared.recording {
+                        let rec = DataRecord {
+                            time: now,
+                            from: self.id,
+                            to: u32::MAX,
+                            urgent: o.urgent,
+                            size: o.body.size(),
+                            fate,
+                        };
+                        shared.record(|s| s.data(&rec));
+                    }
                     continue;
                 }
-                for to in targets {
+                for &to in targets {
                     let fate = if org.mode(to) == Mode::Sleeping { Fate::ToSleeping } else { Fate::Delivered };
-                    let rec = DataRecord { time: now, from: self.id, to, urgent: o.urgent, size: o.body.size(), fate };
-                    shared.record(|s| s.data(&rec));
+                    if shared.recording {
+                        let rec =
+                            DataRecord { time: now, from: self.id, to, urgent: o.urgent, size: o.body.size(), fate };
+                        shared.record(|s| s.data(&rec));
+                    }
                     if fate == Fate::ToSleeping {
                         self.counters.undelivered += 1;
                         continue;
@@ -212,6 +232,7 @@ impl AgentRunner {
                     });
                 }
             }
+            self.outputs = outputs;
         }
         // Events to the Bulletinboard (running or waiting).
         for r in self.reports.drain(..) {

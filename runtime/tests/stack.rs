@@ -253,3 +253,41 @@ fn the_same_run_twice_is_the_same_run() {
     };
     assert_eq!(go(), go());
 }
+
+#[test]
+fn in_real_time_an_urgent_datum_interrupts_a_sleeping_receiver() {
+    use situ_runtime::realtime::{self, RealtimeConfig};
+    // Slow steps once a minute; the run may last 30 s at most. It can only
+    // react to Fast's datum if the urgent datum wakes it.
+    let src = "states { A initial B final }
+        agent Fast sensor { rate 50Hz function go table { _ => run go() to Slow } }
+        agent Slow processing { rate 0.0166Hz event GOT function react table { _ => run react() from Fast } }
+        rule got { when state == A and GOT then B }";
+    let c = content(src);
+    let sent = Arc::new(Mutex::new(0u32));
+    let s2 = sent.clone();
+    let agents = vec![
+        boxed("Fast", &["go"], move |cx| {
+            let mut n = s2.lock().unwrap();
+            *n += 1;
+            if *n == 5 {
+                cx.send_urgent(Body::local("brake"));
+            }
+        }),
+        boxed("Slow", &["react"], |cx| {
+            if cx.inputs().iter().any(|d| d.urgent) {
+                cx.report("GOT", &[]).unwrap();
+            }
+        }),
+    ];
+    let bound = agent::bind(&c, agents, true).unwrap();
+    let mut changes = Vec::new();
+    let summary =
+        realtime::run(c, bound, None, RealtimeConfig::default(), std::time::Duration::from_secs(30), &mut |ch| {
+            changes.push(ch.to)
+        });
+    assert_eq!(changes, [1], "A -> B");
+    assert_eq!(summary.final_state, "B");
+    assert_eq!(summary.agents["Slow"].steps, 2, "its first periodic step, then the urgent one");
+    assert!(summary.duration_s < 30.0);
+}

@@ -2,9 +2,10 @@
 //! variable per receiver so that real-time agents can sleep until their next
 //! step and still be woken by an urgent message.
 
-use super::{Bus, BusCounters, DataMsg, EventMsg, StatusMsg, Wake};
+use super::{Attention, Bus, BusCounters, DataMsg, Doorbell, EventMsg, StatusMsg, Wake};
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::Arc;
 use std::sync::{Condvar, Mutex, MutexGuard};
 use std::time::Instant;
 
@@ -31,6 +32,10 @@ struct Mailbox {
     status: Option<StatusMsg>,
     /// An urgent message arrived since the agent last waited.
     woken: bool,
+    /// Some input (data or status) arrived since the agent last waited.
+    input: bool,
+    /// Rung on every arrival (a worker thread's bell).
+    doorbell: Option<Arc<Doorbell>>,
 }
 
 #[derive(Default)]
@@ -103,11 +108,16 @@ impl Bus for InProc {
             bump(&self.counters.data_overflow);
         }
         queue.push_back(msg);
+        mb.input = true;
         if urgent {
             bump(&self.counters.urgent);
             mb.woken = true;
-            drop(mb);
-            slot.bell.notify_all();
+        }
+        let bell = mb.doorbell.clone();
+        drop(mb);
+        slot.bell.notify_all();
+        if let Some(b) = bell {
+            b.ring();
         }
     }
 
@@ -132,9 +142,35 @@ impl Bus for InProc {
 
     fn send_status(&self, msg: StatusMsg) {
         bump(&self.counters.status_sent);
+        // Each distinct bell once, after every mailbox has the status.
+        let mut bells: Vec<Arc<Doorbell>> = Vec::new();
         for slot in &self.boxes {
-            slot.lock().status = Some(msg);
+            let mut mb = slot.lock();
+            mb.status = Some(msg);
+            mb.input = true;
+            if let Some(b) = &mb.doorbell {
+                if !bells.iter().any(|x| Arc::ptr_eq(x, b)) {
+                    bells.push(b.clone());
+                }
+            }
+            drop(mb);
+            slot.bell.notify_all();
         }
+        for b in bells {
+            b.ring();
+        }
+    }
+
+    fn set_doorbell(&self, agent: u32, bell: Arc<Doorbell>) {
+        if let Some(slot) = self.boxes.get(agent as usize) {
+            slot.lock().doorbell = Some(bell);
+        }
+    }
+
+    fn attention(&self, agent: u32) -> Attention {
+        let Some(slot) = self.boxes.get(agent as usize) else { return Attention::default() };
+        let mut mb = slot.lock();
+        Attention { urgent: std::mem::take(&mut mb.woken), input: std::mem::take(&mut mb.input) }
     }
 
     fn recv_data(&self, agent: u32, out: &mut Vec<DataMsg>) {
@@ -143,6 +179,7 @@ impl Bus for InProc {
         out.extend(mb.urgent.drain(..));
         out.extend(mb.data.drain(..));
         mb.woken = false;
+        mb.input = false;
     }
 
     fn discard_data(&self, agent: u32) -> usize {
@@ -185,6 +222,25 @@ impl Bus for InProc {
         }
     }
 
+    fn wait_input(&self, agent: u32, deadline: Instant) -> Wake {
+        let Some(slot) = self.boxes.get(agent as usize) else { return Wake::Closed };
+        let mut mb = slot.lock();
+        loop {
+            if self.closed.load(Ordering::Acquire) {
+                return Wake::Closed;
+            }
+            if mb.input || mb.woken {
+                mb.input = false;
+                return if std::mem::take(&mut mb.woken) { Wake::Urgent } else { Wake::Deadline };
+            }
+            let now = Instant::now();
+            if now >= deadline {
+                return Wake::Deadline;
+            }
+            mb = slot.bell.wait_timeout(mb, deadline - now).unwrap_or_else(|p| p.into_inner()).0;
+        }
+    }
+
     fn wait_events(&self, deadline: Instant) -> Wake {
         let mut b = self.board.lock();
         loop {
@@ -208,8 +264,11 @@ impl Bus for InProc {
     fn close(&self) {
         self.closed.store(true, Ordering::Release);
         for slot in &self.boxes {
-            let _guard = slot.lock();
+            let mb = slot.lock();
             slot.bell.notify_all();
+            if let Some(b) = &mb.doorbell {
+                b.ring();
+            }
         }
         let _guard = self.board.lock();
         self.board.bell.notify_all();

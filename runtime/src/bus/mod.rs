@@ -69,6 +69,44 @@ pub enum Wake {
     Closed,
 }
 
+/// What arrived for an agent since it last looked (and is now cleared).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Attention {
+    pub urgent: bool,
+    /// Any data or a new status.
+    pub input: bool,
+}
+
+/// A bell several agents' mailboxes ring: a worker thread that steps those
+/// agents sleeps on it until their next period or until something arrives.
+#[derive(Default)]
+pub struct Doorbell {
+    rung: std::sync::Mutex<bool>,
+    bell: std::sync::Condvar,
+}
+
+impl Doorbell {
+    pub fn ring(&self) {
+        *self.rung.lock().unwrap_or_else(|p| p.into_inner()) = true;
+        self.bell.notify_all();
+    }
+
+    /// Sleeps until rung or `deadline`; returns whether it was rung.
+    pub fn wait_until(&self, deadline: Instant) -> bool {
+        let mut rung = self.rung.lock().unwrap_or_else(|p| p.into_inner());
+        loop {
+            if std::mem::take(&mut *rung) {
+                return true;
+            }
+            let now = Instant::now();
+            if now >= deadline {
+                return false;
+            }
+            rung = self.bell.wait_timeout(rung, deadline - now).unwrap_or_else(|p| p.into_inner()).0;
+        }
+    }
+}
+
 /// Counters of a bus's life.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
 pub struct BusCounters {
@@ -103,8 +141,15 @@ pub trait Bus: Send + Sync {
     /// Waits until `deadline` or an urgent message for the agent, whichever
     /// comes first (real-time runs).
     fn wait(&self, agent: u32, deadline: Instant) -> Wake;
+    /// Waits until `deadline` or any input for the agent: data (urgent or
+    /// not) or a new status (agents that step on input, in real time).
+    fn wait_input(&self, agent: u32, deadline: Instant) -> Wake;
     /// Waits until `deadline` or an event for the Bulletinboard.
     fn wait_events(&self, deadline: Instant) -> Wake;
+    /// Rings `bell` whenever something arrives for `agent`.
+    fn set_doorbell(&self, agent: u32, bell: std::sync::Arc<Doorbell>);
+    /// What arrived for the agent since it last looked; clears it.
+    fn attention(&self, agent: u32) -> Attention;
     /// Wakes every waiter with [`Wake::Closed`].
     fn close(&self);
     fn counters(&self) -> BusCounters;

@@ -1,0 +1,173 @@
+//! The real-time scheduler, on the wall clock (time is nanoseconds since
+//! the start): the agents are shared among a few worker threads (one per
+//! core by default), the Bulletinboard has a thread of its own.
+//!
+//! - An agent with a rate steps every period; an urgent datum interrupts
+//!   its worker's sleep (ROBIX's Recvagent interrupting its receiver) and the
+//!   agent steps at once. An agent without a rate steps when input arrives.
+//! - A worker sleeps on one bell that its agents' mailboxes ring, until the
+//!   next period of one of them: a status broadcast wakes a few workers, not
+//!   a thread per agent.
+//! - The Bulletinboard sleeps until an event arrives (urgent ones first) or
+//!   its heartbeat is due.
+//!
+//! The same agents, bus and Bulletinboard as in simulated time
+//! ([`crate::sched`]); only the clock and the threads differ. Runs are not
+//! reproducible bit for bit here: use simulated time for that.
+
+use crate::agent::Bound;
+use crate::bus::inproc::{Capacity, InProc};
+use crate::bus::{Bus, Doorbell};
+use crate::record::Sink;
+use crate::rete::StateChange;
+use crate::stack::{AgentRunner, BoardRunner, Shared};
+use crate::summary::Summary;
+use situ_compiler::bundle::Content;
+use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+#[derive(Debug, Clone)]
+pub struct RealtimeConfig {
+    pub heartbeat: Duration,
+    /// Rates (Hz) by agent name, over the rules file's `rate`.
+    pub rates: BTreeMap<String, f64>,
+    pub capacity: Capacity,
+    pub stop_on_final: bool,
+    /// Worker threads for the agents (0: one per core).
+    pub workers: usize,
+}
+
+impl Default for RealtimeConfig {
+    fn default() -> Self {
+        RealtimeConfig {
+            heartbeat: Duration::from_millis(10),
+            rates: BTreeMap::new(),
+            capacity: Capacity::default(),
+            stop_on_final: true,
+            workers: 0,
+        }
+    }
+}
+
+/// One agent as a worker sees it.
+struct Slot {
+    runner: AgentRunner,
+    period: Option<Duration>,
+    next: Instant,
+}
+
+/// Runs the stack on the wall clock for `duration` (or until a final state
+/// with `stop_on_final`); `on_change` sees every change of the state at rest
+/// (from the Bulletinboard's thread).
+pub fn run(
+    content: Arc<Content>,
+    agents: Bound,
+    sink: Option<Box<dyn Sink>>,
+    config: RealtimeConfig,
+    duration: Duration,
+    on_change: &mut (dyn FnMut(&StateChange) + Send),
+) -> Summary {
+    let bus: Arc<dyn Bus> = Arc::new(InProc::new(content.agents.len(), config.capacity));
+    run_on(content, agents, sink, config, duration, bus, on_change)
+}
+
+/// As [`run`], on a given bus.
+pub fn run_on(
+    content: Arc<Content>,
+    agents: Bound,
+    sink: Option<Box<dyn Sink>>,
+    config: RealtimeConfig,
+    duration: Duration,
+    bus: Arc<dyn Bus>,
+    on_change: &mut (dyn FnMut(&StateChange) + Send),
+) -> Summary {
+    let shared = Arc::new(Shared::new(content.clone(), bus.clone(), sink));
+    let start = Instant::now();
+    let clock = move || start.elapsed().as_nanos() as u64;
+    let stop = Arc::new(AtomicBool::new(false));
+    let counters = Arc::new(Mutex::new(Vec::new()));
+    let mut board = BoardRunner::new(content.clone());
+    let mut summary = Summary::new(&content);
+    board.start(&shared, 0);
+
+    let workers = match config.workers {
+        0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        n => n,
+    };
+    let mut groups: Vec<Vec<Slot>> = (0..workers).map(|_| Vec::new()).collect();
+    let mut k = 0;
+    for (i, imp) in agents.into_iter().enumerate() {
+        let Some(imp) = imp else { continue };
+        let def = &content.agents[i];
+        let hz = config.rates.get(&def.name).copied().or(def.rate_hz).filter(|h| h.is_finite() && *h > 0.0);
+        let period = hz.map(|h| Duration::from_nanos(((1e9 / h).round() as u64).max(1)));
+        groups[k % workers].push(Slot { runner: AgentRunner::new(i as u32, imp), period, next: start });
+        k += 1;
+    }
+
+    std::thread::scope(|scope| {
+        for mut group in groups.into_iter().filter(|g| !g.is_empty()) {
+            let (shared, stop, counters) = (shared.clone(), stop.clone(), counters.clone());
+            let bell = Arc::new(Doorbell::default());
+            for slot in &group {
+                shared.bus.set_doorbell(slot.runner.id, bell.clone());
+            }
+            scope.spawn(move || {
+                while !stop.load(Ordering::Acquire) {
+                    let now = Instant::now();
+                    for slot in &mut group {
+                        let attention = shared.bus.attention(slot.runner.id);
+                        let due = slot.period.is_some_and(|_| now >= slot.next);
+                        if let (true, Some(p)) = (due, slot.period) {
+                            slot.next += p;
+                            if slot.next < now {
+                                // Fell behind: skip the missed periods.
+                                slot.next = now + p;
+                            }
+                        }
+                        let on_input = slot.period.is_none() && attention.input;
+                        if due || attention.urgent || on_input {
+                            slot.runner.cycle(&shared, clock());
+                        }
+                    }
+                    let next = group.iter().filter(|s| s.period.is_some()).map(|s| s.next).min();
+                    bell.wait_until(next.unwrap_or_else(|| Instant::now() + Duration::from_millis(100)));
+                }
+                let mut c = counters.lock().unwrap_or_else(|p| p.into_inner());
+                c.extend(group.iter().map(|s| (s.runner.id, s.runner.counters)));
+            });
+        }
+        // The Bulletinboard, on this thread.
+        let end = start + duration;
+        let mut next_beat = start + config.heartbeat;
+        loop {
+            let now = Instant::now();
+            if now >= end || stop.load(Ordering::Acquire) {
+                break;
+            }
+            let _ = shared.bus.wait_events(next_beat.min(end));
+            let mut changes = board.pump(&shared, clock());
+            if Instant::now() >= next_beat {
+                next_beat += config.heartbeat;
+                changes.extend(board.tick(&shared, clock()));
+            }
+            for c in &changes {
+                summary.change(c);
+                on_change(c);
+                if config.stop_on_final && content.states[c.to as usize].is_final {
+                    stop.store(true, Ordering::Release);
+                }
+            }
+        }
+        stop.store(true, Ordering::Release);
+        shared.bus.close();
+    });
+    let agents = std::mem::take(&mut *counters.lock().unwrap_or_else(|p| p.into_inner()));
+    summary.finish(clock(), board.board.state(), &board.counters, agents, shared.bus.counters());
+    shared.record(|s| {
+        let _ = s.finish();
+    });
+    summary
+}
