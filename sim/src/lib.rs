@@ -1,0 +1,22 @@
+//! `situ-sim`: the reference agent stack of situ, simulated.
+//!
+//! Plain, deterministic parts with no dependency on the runtime, each with an
+//! API a wrapper calls once per tick:
+//! - [`world`]: roads (a petgraph graph with geometry), cross-country areas,
+//!   static and moving obstacles, and the queries sensors need;
+//! - [`scenario`]: TOML scenarios, validated into a [`world::World`];
+//! - [`vehicle`]: the tricycle model of eq. (1) of Dafflon et al.;
+//! - [`sensors`]: RFCCD, STCCD, LADAR and Localization of Zhang & Zhu, each
+//!   returning the event of `rules/outdoor.situ` it reports;
+//! - [`fusion`], [`gpl`], [`lpl`], [`drive`]: the processing agents;
+//! - [`control`]: target reaching, elliptic limit cycles and the single
+//!   Lyapunov control law (eqs. 2–15); [`ugv`]: Dafflon's closed loop with
+//!   the hard switch and the multi-agent merge (eqs. 16–19);
+//! - [`outdoor`]: a closed loop of the outdoor stack with a simple built-in
+//!   situation logic (a stand-in for the Bulletinboard);
+//! - [`metrics`] and [`plot`]: what a run measured, and its pictures.
+#![deny(missing_docs)]
+
+pub mod geom;
+pub mod vehicle;
+pub mod world;
