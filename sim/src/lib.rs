@@ -19,4 +19,5 @@
 
 pub mod geom;
 pub mod vehicle;
+pub mod scenario;
 pub mod world;
