@@ -17,7 +17,10 @@
 //! - [`metrics`] and [`plot`]: what a run measured, and its pictures.
 #![deny(missing_docs)]
 
+pub mod control;
 pub mod geom;
+pub mod metrics;
+pub mod noise;
 pub mod vehicle;
 pub mod scenario;
 pub mod world;
