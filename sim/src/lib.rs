@@ -23,4 +23,5 @@ pub mod metrics;
 pub mod noise;
 pub mod vehicle;
 pub mod scenario;
+pub mod ugv;
 pub mod world;
