@@ -23,5 +23,6 @@ pub mod metrics;
 pub mod noise;
 pub mod vehicle;
 pub mod scenario;
+pub mod sensors;
 pub mod ugv;
 pub mod world;
