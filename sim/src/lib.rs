@@ -19,6 +19,7 @@
 
 pub mod control;
 pub mod geom;
+pub mod gpl;
 pub mod metrics;
 pub mod noise;
 pub mod vehicle;
