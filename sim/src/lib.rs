@@ -18,8 +18,10 @@
 #![deny(missing_docs)]
 
 pub mod control;
+pub mod fusion;
 pub mod geom;
 pub mod gpl;
+pub mod lpl;
 pub mod metrics;
 pub mod noise;
 pub mod vehicle;
