@@ -468,7 +468,7 @@ mod tests {
         assert!((p.target.pose.x - 60.0).abs() < 1e-9, "10 m ahead at 10 m/s (the path starts at x = 5)");
         assert_eq!(p.speed, 10.0);
         // Before the turn of radius 40: sqrt(2 × 40) ≈ 8.9 m/s at most there.
-        let near = PlanInput { s: 290.0, pose: Pose::new(295.0, -1.75, 0.0), ..input };
+        let near = PlanInput { s: 293.0, pose: Pose::new(298.0, -1.75, 0.0), ..input };
         let t = lpl.plrt(&near);
         assert!(t.speed < 9.5 && t.event == PlanEvent::Turn, "{t:?}");
     }
