@@ -18,6 +18,7 @@
 #![deny(missing_docs)]
 
 pub mod control;
+pub mod drive;
 pub mod fusion;
 pub mod geom;
 pub mod gpl;
@@ -25,6 +26,7 @@ pub mod lpl;
 pub mod metrics;
 pub mod noise;
 pub mod vehicle;
+pub mod outdoor;
 pub mod scenario;
 pub mod sensors;
 pub mod ugv;

@@ -176,6 +176,10 @@ pub struct Window {
     pub s_out: f64,
     /// The lateral offset of the pass (m, left positive).
     pub offset: f64,
+    /// Length of the ramp into the pass (m): the configured ramp, shortened
+    /// when the obstacle was seen late so that the ramp starts ahead of the
+    /// target (no jump of the target).
+    pub ramp_in: f64,
     /// On road or cross-country.
     pub kind: EdgeKind,
 }
@@ -261,7 +265,7 @@ impl Lpl {
         let mut best = (0.0, base);
         for w in &self.windows {
             let wgt = if s < w.s_in {
-                smoothstep((s - (w.s_in - r)) / r)
+                smoothstep((s - (w.s_in - w.ramp_in)) / w.ramp_in)
             } else if s <= w.s_out + lag {
                 1.0
             } else {
@@ -276,7 +280,7 @@ impl Lpl {
 
     /// Updates the passing windows from the obstacles; `Err` with the edge
     /// when an obstacle leaves no pass.
-    fn update_windows(&mut self, input: &PlanInput<'_>, kind: EdgeKind) -> Result<(), EdgeIndex> {
+    fn update_windows(&mut self, input: &PlanInput<'_>, kind: EdgeKind, lookahead: f64) -> Result<(), EdgeIndex> {
         let world = input.world;
         let veh = &world.vehicle;
         let hw = veh.width / 2.0;
@@ -342,7 +346,10 @@ impl Lpl {
                     w.s_out = w.s_out.max(s_out);
                     w.offset = offset;
                 }
-                None => self.windows.push(Window { track: o.track, s_in, s_out, offset, kind }),
+                None => {
+                    let ramp_in = (s_in - (input.s + lookahead)).clamp(5.0, self.cfg.ramp);
+                    self.windows.push(Window { track: o.track, s_in, s_out, offset, ramp_in, kind })
+                }
             }
         }
         Ok(())
@@ -360,7 +367,7 @@ impl Lpl {
         let mut blocked = None;
         if kind.avoids() {
             let terrain = if kind == PlanKind::RoadObstacle { EdgeKind::Road } else { EdgeKind::CrossCountry };
-            if let Err(e) = self.update_windows(input, terrain) {
+            if let Err(e) = self.update_windows(input, terrain, lookahead) {
                 blocked = Some(e);
             }
         }
@@ -393,7 +400,7 @@ impl Lpl {
         }
         let remaining = (path.length - s).max(0.0);
         v = v.min((2.0 * cfg.decel * (remaining - 0.5).max(0.0)).sqrt());
-        let in_window = self.windows.iter().any(|w| s + lookahead >= w.s_in - r && s <= w.s_out + lookahead + r);
+        let in_window = self.windows.iter().any(|w| s + lookahead >= w.s_in - w.ramp_in && s <= w.s_out + lookahead + r);
         let event = if let Some(_e) = blocked {
             PlanEvent::Failed { reason: FailReason::Blocked }
         } else if in_window {
@@ -407,7 +414,11 @@ impl Lpl {
         } else {
             PlanEvent::Straight
         };
-        let target = Target { pose: Pose::new(pos.x, pos.y, heading), v, curvature: path.curvature(st) };
+        // The curvature feed-forward, averaged over a lookahead around the
+        // target: roads here have no clothoids, and a step of curvature at
+        // an arc's start would be a step of the steering command.
+        let curvature = (-2..=2).map(|i| path.curvature(st + lookahead * i as f64 / 4.0)).sum::<f64>() / 5.0;
+        let target = Target { pose: Pose::new(pos.x, pos.y, heading), v, curvature };
         LocalPlan { target, speed: v, lookahead, event, blocked }
     }
 

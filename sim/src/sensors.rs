@@ -15,7 +15,9 @@
 //! The obstacle sensors are mounted at the front bumper, centred; their
 //! `distance` is measured along the vehicle's swept corridor (the arc of its
 //! current curvature, as wide as the vehicle plus 0.3 m each side), so an
-//! obstacle beside the lane being passed is not "ahead".
+//! obstacle beside the lane being passed is not "ahead". Noise (σ): LADAR
+//! 0.05 m on positions and distances, 0.02 m on heights; STCCD 0.15 m and
+//! 0.03 m.
 
 use crate::geom::{convex_hull, v2, Pose, Vec2};
 use crate::noise::Noise;
@@ -206,7 +208,7 @@ pub fn front_mount(state: &VehicleState, front: f64) -> Pose {
     Pose::new(p.x, p.y, state.pose.theta)
 }
 
-fn detections(hits: Vec<CorridorHit>, sigma: f64, noise: &mut Noise) -> Vec<Detection> {
+fn detections(hits: Vec<CorridorHit>, sigma: f64, height_sigma: f64, noise: &mut Noise) -> Vec<Detection> {
     hits.into_iter()
         .map(|h| {
             let shift = v2(noise.normal(sigma), noise.normal(sigma));
@@ -216,7 +218,7 @@ fn detections(hits: Vec<CorridorHit>, sigma: f64, noise: &mut Noise) -> Vec<Dete
                 distance: h.corridor.map(|d| (d + d_noise).max(0.0)),
                 range: (h.range + d_noise).max(0.0),
                 polygon: convex_hull(&h.polygon.iter().map(|p| p + shift).collect::<Vec<_>>()),
-                height: (h.height + noise.normal(sigma)).max(0.0),
+                height: (h.height + noise.normal(height_sigma)).max(0.0),
                 width: (h.width + noise.normal(sigma)).max(0.0),
             }
         })
@@ -291,7 +293,7 @@ impl Ladar {
         let pose = front_mount(state, world.vehicle.front);
         let corridor = swept_corridor(world, state, self.range, self.margin);
         let hits = world.obstacles_seen(&pose, views, self.range, self.fov, &corridor, &mut self.scratch);
-        let detections = detections(hits, self.sigma, &mut self.noise);
+        let detections = detections(hits, self.sigma, 0.02, &mut self.noise);
         let clearance = world.vehicle.clearance;
         let pick = |tall: bool| {
             detections
@@ -346,7 +348,7 @@ impl Stccd {
         let hits = world.obstacles_seen(&pose, views, self.range, self.fov, &corridor, &mut self.scratch);
         let min_h = self.min_height;
         let detections: Vec<Detection> =
-            detections(hits, self.sigma, &mut self.noise).into_iter().filter(|d| d.height >= min_h).collect();
+            detections(hits, self.sigma, 0.03, &mut self.noise).into_iter().filter(|d| d.height >= min_h).collect();
         let event = detections
             .iter()
             .filter(|d| d.distance.is_some())
