@@ -27,6 +27,7 @@ pub mod metrics;
 pub mod noise;
 pub mod vehicle;
 pub mod outdoor;
+pub mod plot;
 pub mod scenario;
 pub mod sensors;
 pub mod ugv;
