@@ -22,7 +22,8 @@ fn main() {
         },
     };
     if sc.world.vehicle == situ_sim::vehicle::VehicleParams::urban() {
-        let table = ugv::compare(&sc.world, &[ugv::Strategy::HardSwitch, ugv::Strategy::Merge], 1, &ugv::UgvConfig::default());
+        let table =
+            ugv::compare(&sc.world, &[ugv::Strategy::HardSwitch, ugv::Strategy::Merge], 1, &ugv::UgvConfig::default());
         println!("{table}");
         for m in &table.runs {
             if let Err(e) = plot::write_run(&out.join(&m.controller), &sc.world, m) {

@@ -218,7 +218,8 @@ impl Ellipse {
             hy = hy.max(d.dot(&w).abs());
         }
         let k = poly.iter().map(|p| ((p - c).dot(&u) / hx).hypot((p - c).dot(&w) / hy)).fold(1.0, f64::max);
-        let (a, b, omega) = if hx >= hy { (k * hx, k * hy, omega) } else { (k * hy, k * hx, omega + std::f64::consts::FRAC_PI_2) };
+        let (a, b, omega) =
+            if hx >= hy { (k * hx, k * hy, omega) } else { (k * hy, k * hx, omega + std::f64::consts::FRAC_PI_2) };
         Ellipse { center: c, a, b, omega: wrap_angle(omega) }
     }
 }
@@ -355,7 +356,8 @@ mod tests {
             veh.state.v = 1.0;
             let mut min_gap = f64::INFINITY;
             let mut swept = 0.0;
-            let mut last = (veh.state.pose.pos() - enclosing.center).y.atan2((veh.state.pose.pos() - enclosing.center).x);
+            let mut last =
+                (veh.state.pose.pos() - enclosing.center).y.atan2((veh.state.pose.pos() - enclosing.center).x);
             for _ in 0..1600 {
                 let input = limit_cycle(&veh.state.pose, &cycle, dir, params.max_speed / 2.0);
                 let cmd = control_law(&input, &gains, &params, params.max_speed / 2.0);
@@ -369,7 +371,10 @@ mod tests {
             }
             assert!(min_gap > 0.3, "{dir:?}: never closer than 0.3 m, was {min_gap:.2}");
             let expected_sign = -dir.m();
-            assert!(swept * expected_sign > 2.0 * std::f64::consts::TAU, "{dir:?}: went round twice, swept {swept:.1} rad");
+            assert!(
+                swept * expected_sign > 2.0 * std::f64::consts::TAU,
+                "{dir:?}: went round twice, swept {swept:.1} rad"
+            );
         }
     }
 }

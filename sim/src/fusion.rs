@@ -131,10 +131,12 @@ pub fn merge(ladar: &[Detection], stereo: &[Detection]) -> Vec<FusedObstacle> {
             (a, b) => a.or(b),
         };
     }
-    by.into_values().map(|mut o| {
-        o.polygon = convex_hull(&o.polygon);
-        o
-    }).collect()
+    by.into_values()
+        .map(|mut o| {
+            o.polygon = convex_hull(&o.polygon);
+            o
+        })
+        .collect()
 }
 
 /// The nearest obstacle that matters: in the corridor within `range`, and
@@ -188,7 +190,14 @@ mod tests {
     use crate::geom::{rect_polygon, v2};
 
     fn det(track: usize, distance: Option<f64>, height: f64, x: f64) -> Detection {
-        Detection { track, distance, range: distance.unwrap_or(10.0), polygon: rect_polygon(v2(x, 0.0), 1.0, 1.0, 0.0), height, width: 1.0 }
+        Detection {
+            track,
+            distance,
+            range: distance.unwrap_or(10.0),
+            polygon: rect_polygon(v2(x, 0.0), 1.0, 1.0, 0.0),
+            height,
+            width: 1.0,
+        }
     }
 
     #[test]
@@ -203,10 +212,18 @@ mod tests {
         let road = fuse_road(&RfccdEvent::Straight, &l, &FusionConfig::default());
         assert_eq!(road.event, FusionEvent::RoadObstacle { distance: 12.0 });
         assert_eq!(road.event.name(), "FURO");
-        let clear = fuse_road(&RfccdEvent::Turn { curvature: 0.03, left: true }, &[det(0, None, 1.0, 20.0)], &FusionConfig::default());
+        let clear = fuse_road(
+            &RfccdEvent::Turn { curvature: 0.03, left: true },
+            &[det(0, None, 1.0, 20.0)],
+            &FusionConfig::default(),
+        );
         assert_eq!(clear.event.name(), "FURT");
         let terrain = fuse_terrain(&l, &s, &FusionConfig::default());
-        assert_eq!(terrain.event, FusionEvent::CrossCountryObstacle { distance: 8.0 }, "stereo's intraversable area counts");
+        assert_eq!(
+            terrain.event,
+            FusionEvent::CrossCountryObstacle { distance: 8.0 },
+            "stereo's intraversable area counts"
+        );
         assert_eq!(fuse_terrain(&[], &[], &FusionConfig::default()).event.name(), "FUCN");
         let low = fuse_terrain(&[det(0, Some(5.0), 0.2, 10.0)], &[], &FusionConfig::default());
         assert_eq!(low.event.name(), "FUCN", "off-road tyres take 0.2 m");

@@ -172,7 +172,9 @@ pub fn convex_hull(points: &[Vec2]) -> Vec<Vec2> {
         let iter: Box<dyn Iterator<Item = &Vec2>> =
             if pass == 0 { Box::new(pts.iter()) } else { Box::new(pts.iter().rev()) };
         for &p in iter {
-            while hull.len() >= start + 2 && cross(hull[hull.len() - 1] - hull[hull.len() - 2], p - hull[hull.len() - 2]) <= 0.0 {
+            while hull.len() >= start + 2
+                && cross(hull[hull.len() - 1] - hull[hull.len() - 2], p - hull[hull.len() - 2]) <= 0.0
+            {
                 hull.pop();
             }
             hull.push(p);
@@ -261,7 +263,7 @@ impl Piece {
     pub fn arc_between(a: Vec2, b: Vec2, radius: f64, left: bool) -> Option<Piece> {
         let chord = b - a;
         let c = chord.norm();
-        if !(radius > 0.0) || c == 0.0 || radius < c / 2.0 - 1e-9 {
+        if radius.is_nan() || radius <= 0.0 || c == 0.0 || radius < c / 2.0 - 1e-9 {
             return None;
         }
         let h = (radius * radius - c * c / 4.0).max(0.0).sqrt();

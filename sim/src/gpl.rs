@@ -271,9 +271,9 @@ impl Gpl {
             GplEvent::CrossCountry
         } else if path.junctions.iter().any(|&j| j >= s - 1.0 && j - s <= self.cfg.branch_ahead) {
             GplEvent::Branch
-        } else if (0..=((self.cfg.turn_ahead / 2.0) as usize))
-            .any(|k| path.curvature(s + 2.0 * k as f64).abs() >= 0.002 && path.kind(s + 2.0 * k as f64) == EdgeKind::Road)
-        {
+        } else if (0..=((self.cfg.turn_ahead / 2.0) as usize)).any(|k| {
+            path.curvature(s + 2.0 * k as f64).abs() >= 0.002 && path.kind(s + 2.0 * k as f64) == EdgeKind::Road
+        }) {
             GplEvent::Turn
         } else {
             GplEvent::Straight
@@ -288,7 +288,12 @@ fn edge_cost(world: &World, e: EdgeIndex, cfg: &GplConfig) -> f64 {
 }
 
 /// A* from `pose` to the world's goal avoiding `blocked`.
-pub fn plan_path(world: &World, pose: &Pose, blocked: &BTreeSet<EdgeIndex>, cfg: &GplConfig) -> Result<GlobalPath, GplError> {
+pub fn plan_path(
+    world: &World,
+    pose: &Pose,
+    blocked: &BTreeSet<EdgeIndex>,
+    cfg: &GplConfig,
+) -> Result<GlobalPath, GplError> {
     let net = &world.roads;
     let g = &net.graph;
     let (e0, pr0) = net.nearest_edge(pose.pos(), None).ok_or(GplError::NoRoads)?;
@@ -396,7 +401,11 @@ mod tests {
         let mut gpl = Gpl::default();
         let path = gpl.plan(&w, &w.start).expect("a path").clone();
         let ids: Vec<&str> = path.pieces.iter().map(|p| w.roads.graph[p.edge].id.as_str()).collect();
-        assert_eq!(ids, ["r1", "t1", "r2", "t2", "r4", "c1", "c2"], "through the junction to the east, not the dead end");
+        assert_eq!(
+            ids,
+            ["r1", "t1", "r2", "t2", "r4", "c1", "c2"],
+            "through the junction to the east, not the dead end"
+        );
         assert!((path.end() - w.goal.position).norm() < 1e-6);
         assert_eq!(path.junctions.len(), 1);
         assert_eq!(path.kind_changes.len(), 1);

@@ -290,7 +290,8 @@ impl Lpl {
             if o.height <= veh.clearance || o.polygon.is_empty() {
                 continue;
             }
-            let (mut smin, mut smax, mut lmin, mut lmax) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+            let (mut smin, mut smax, mut lmin, mut lmax) =
+                (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
             for p in &o.polygon {
                 let (s, l) = input.path.project(*p, input.s, 80.0);
                 smin = smin.min(s);
@@ -373,7 +374,9 @@ impl Lpl {
         }
         let st = s + lookahead;
         let off = self.offset(input.world, path, st, lookahead);
-        let d_off = (self.offset(input.world, path, st + 0.5, lookahead) - self.offset(input.world, path, st - 0.5, lookahead)) / 1.0;
+        let d_off = (self.offset(input.world, path, st + 0.5, lookahead)
+            - self.offset(input.world, path, st - 0.5, lookahead))
+            / 1.0;
         let heading = wrap_angle(path.heading(st) + d_off.atan());
         let pos = path.point(st) + unit(path.heading(st) + FRAC_PI_2) * off;
         // Speed: the plan's cap, turns ahead, the goal.
@@ -400,16 +403,23 @@ impl Lpl {
         }
         let remaining = (path.length - s).max(0.0);
         v = v.min((2.0 * cfg.decel * (remaining - 0.5).max(0.0)).sqrt());
-        let in_window = self.windows.iter().any(|w| s + lookahead >= w.s_in - w.ramp_in && s <= w.s_out + lookahead + r);
+        let in_window =
+            self.windows.iter().any(|w| s + lookahead >= w.s_in - w.ramp_in && s <= w.s_out + lookahead + r);
         let event = if let Some(_e) = blocked {
             PlanEvent::Failed { reason: FailReason::Blocked }
         } else if in_window {
-            if path.kind(s) == EdgeKind::Road { PlanEvent::RoadObstacle } else { PlanEvent::CrossCountryObstacle }
+            if path.kind(s) == EdgeKind::Road {
+                PlanEvent::RoadObstacle
+            } else {
+                PlanEvent::CrossCountryObstacle
+            }
         } else if path.kind(s) == EdgeKind::CrossCountry {
             PlanEvent::CrossCountry
         } else if path.junctions.iter().any(|&j| j >= s - 5.0 && j - s <= 30.0) {
             PlanEvent::Branch
-        } else if (0..=8).any(|i| path.curvature(s + 2.0 * i as f64).abs() >= 0.002 && path.kind(s + 2.0 * i as f64) == EdgeKind::Road) {
+        } else if (0..=8).any(|i| {
+            path.curvature(s + 2.0 * i as f64).abs() >= 0.002 && path.kind(s + 2.0 * i as f64) == EdgeKind::Road
+        }) {
             PlanEvent::Turn
         } else {
             PlanEvent::Straight
@@ -472,7 +482,14 @@ mod tests {
         let mut gpl = Gpl::default();
         let path = gpl.plan(&w, &w.start).expect("path").clone();
         let mut lpl = Lpl::default();
-        let input = PlanInput { world: &w, pose: Pose::new(50.0, -1.75, 0.0), speed: 10.0, path: &path, s: 45.0, obstacles: &[] };
+        let input = PlanInput {
+            world: &w,
+            pose: Pose::new(50.0, -1.75, 0.0),
+            speed: 10.0,
+            path: &path,
+            s: 45.0,
+            obstacles: &[],
+        };
         let p = lpl.plrs(&input);
         assert_eq!(p.event, PlanEvent::Straight);
         assert!((p.target.pose.y + 1.75).abs() < 1e-9, "right lane");
@@ -491,7 +508,14 @@ mod tests {
         let path = gpl.plan(&w, &w.start).expect("path").clone();
         let mut lpl = Lpl::default();
         let obs = [obstacle(0, 200.0, -1.75, 1.8)];
-        let input = PlanInput { world: &w, pose: Pose::new(175.0, -1.75, 0.0), speed: 5.0, path: &path, s: 170.0, obstacles: &obs };
+        let input = PlanInput {
+            world: &w,
+            pose: Pose::new(175.0, -1.75, 0.0),
+            speed: 5.0,
+            path: &path,
+            s: 170.0,
+            obstacles: &obs,
+        };
         let p = lpl.plro(&input);
         assert_eq!(p.event, PlanEvent::RoadObstacle);
         assert_eq!(lpl.windows.len(), 1);
@@ -512,7 +536,14 @@ mod tests {
         let path = gpl.plan(&w, &w.start).expect("path").clone();
         let mut lpl = Lpl::default();
         let obs = [obstacle(0, 200.0, 0.0, 6.5)];
-        let input = PlanInput { world: &w, pose: Pose::new(175.0, -1.75, 0.0), speed: 5.0, path: &path, s: 170.0, obstacles: &obs };
+        let input = PlanInput {
+            world: &w,
+            pose: Pose::new(175.0, -1.75, 0.0),
+            speed: 5.0,
+            path: &path,
+            s: 170.0,
+            obstacles: &obs,
+        };
         let p = lpl.plro(&input);
         assert_eq!(p.event, PlanEvent::Failed { reason: FailReason::Blocked });
         assert_eq!(p.event.fields(), vec![("reason", Value::Symbol("blocked"))]);

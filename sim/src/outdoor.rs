@@ -16,7 +16,7 @@
 //! 6. the vehicle moves; metrics, collisions, the goal.
 
 use crate::drive::Drive;
-use crate::fusion::{fuse_road, fuse_terrain, FusionConfig, FusionEvent, FusionOutput, FusedObstacle};
+use crate::fusion::{fuse_road, fuse_terrain, FusedObstacle, FusionConfig, FusionEvent, FusionOutput};
 use crate::gpl::{Gpl, GplEvent, GplReport};
 use crate::lpl::{FailReason, LocalPlan, Lpl, PlanEvent, PlanInput, PlanKind};
 use crate::metrics::{Metrics, Recorder, Sample};
@@ -163,9 +163,11 @@ impl SimpleSituation {
         let laobs = |d: f64, h: f64| matches!(ev.ladar, LadarEvent::Obstacle { distance, height } if distance < d && height > h);
         let stobs = |d: f64| matches!(ev.stccd, StccdEvent::Obstacle { distance, .. } if distance < d);
         let gpl = ev.gpl;
-        let next = if s.driving() && matches!(ev.lpl, Some(PlanEvent::Failed { .. })) {
-            EM
-        } else if s.driving() && (laobs(5.0, 0.15) || ev.localization == LocalizationEvent::Lost) {
+        let next = if s.driving()
+            && (matches!(ev.lpl, Some(PlanEvent::Failed { .. }))
+                || laobs(5.0, 0.15)
+                || ev.localization == LocalizationEvent::Lost)
+        {
             EM
         } else if s.driving() && matches!(gpl, Some(GplEvent::Goal { remaining }) if remaining < 2.0) {
             GL
@@ -175,17 +177,43 @@ impl SimpleSituation {
             RO
         } else if s == CN && (laobs(20.0, 0.3) || stobs(20.0)) {
             CO
-        } else if s == RO && self.laobn >= 3 && !stobs(30.0) && ev.fusion == Some(FusionEvent::RoadStraight) && ev.lpl == Some(PlanEvent::Straight) {
+        } else if s == RO
+            && self.laobn >= 3
+            && !stobs(30.0)
+            && ev.fusion == Some(FusionEvent::RoadStraight)
+            && ev.lpl == Some(PlanEvent::Straight)
+        {
             RS
-        } else if s == RO && self.laobn >= 3 && !stobs(30.0) && ev.fusion == Some(FusionEvent::RoadTurn) && ev.lpl == Some(PlanEvent::Turn) {
+        } else if s == RO
+            && self.laobn >= 3
+            && !stobs(30.0)
+            && ev.fusion == Some(FusionEvent::RoadTurn)
+            && ev.lpl == Some(PlanEvent::Turn)
+        {
             RT
-        } else if s == RO && self.laobn >= 3 && !stobs(30.0) && ev.fusion == Some(FusionEvent::RoadBranch) && ev.lpl == Some(PlanEvent::Branch) {
+        } else if s == RO
+            && self.laobn >= 3
+            && !stobs(30.0)
+            && ev.fusion == Some(FusionEvent::RoadBranch)
+            && ev.lpl == Some(PlanEvent::Branch)
+        {
             RB
-        } else if s == RO && matches!(ev.fusion, Some(FusionEvent::CrossCountryObstacle { .. })) && ev.lpl == Some(PlanEvent::CrossCountryObstacle) {
+        } else if s == RO
+            && matches!(ev.fusion, Some(FusionEvent::CrossCountryObstacle { .. }))
+            && ev.lpl == Some(PlanEvent::CrossCountryObstacle)
+        {
             CO
-        } else if s == CO && ev.fusion == Some(FusionEvent::CrossCountry) && ev.lpl == Some(PlanEvent::CrossCountry) && self.laobn >= 3 && self.stobn >= 1 {
+        } else if s == CO
+            && ev.fusion == Some(FusionEvent::CrossCountry)
+            && ev.lpl == Some(PlanEvent::CrossCountry)
+            && self.laobn >= 3
+            && self.stobn >= 1
+        {
             CN
-        } else if s == CO && matches!(ev.fusion, Some(FusionEvent::RoadObstacle { .. })) && ev.lpl == Some(PlanEvent::RoadObstacle) {
+        } else if s == CO
+            && matches!(ev.fusion, Some(FusionEvent::RoadObstacle { .. }))
+            && ev.lpl == Some(PlanEvent::RoadObstacle)
+        {
             RO
         } else if s == IT && self.lofix >= 10 {
             RD
@@ -199,7 +227,8 @@ impl SimpleSituation {
             RS
         } else if matches!(s, RS | RB) && self.rfrt >= 2 {
             RT
-        } else if matches!(s, RS | RT) && matches!(ev.rfccd, RfccdEvent::Branch { .. }) && gpl == Some(GplEvent::Branch) {
+        } else if matches!(s, RS | RT) && matches!(ev.rfccd, RfccdEvent::Branch { .. }) && gpl == Some(GplEvent::Branch)
+        {
             RB
         } else if matches!(s, RS | RT | RB) && gpl == Some(GplEvent::CrossCountry) && self.rfrn >= 3 {
             CN

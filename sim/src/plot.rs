@@ -81,12 +81,13 @@ pub fn trajectory_svg(world: &World, samples: &[Sample], title: &str) -> Result<
         hi = crate::geom::v2(hi.x.max(s.x + 2.0), hi.y.max(s.y + 2.0));
     }
     let (w_m, h_m) = ((hi.x - lo.x).max(1.0), (hi.y - lo.y).max(1.0));
-    // Equal scales on both axes: the plot area keeps the world's aspect.
+    // Equal scales on both axes: the plot area (the picture less the
+    // margins, the label areas and the caption) keeps the world's aspect.
     let width = 1200u32;
-    let plot_w = (width - 90) as f64;
-    let scale = plot_w / w_m;
-    let height = ((h_m * scale) as u32 + 110).clamp(260, 1400);
-    let scale = scale.min((height - 110) as f64 / h_m);
+    let (extra_w, extra_h) = (65u32, 85u32);
+    let scale = (width - extra_w) as f64 / w_m;
+    let height = ((h_m * scale) as u32 + extra_h).clamp(260, 1400);
+    let scale = scale.min((height - extra_h) as f64 / h_m);
     let mut buf = String::new();
     {
         let root = SVGBackend::with_string(&mut buf, (width, height)).into_drawing_area();
@@ -96,7 +97,10 @@ pub fn trajectory_svg(world: &World, samples: &[Sample], title: &str) -> Result<
             .margin(10)
             .x_label_area_size(35)
             .y_label_area_size(45)
-            .build_cartesian_2d(lo.x..lo.x + (width - 90) as f64 / scale, lo.y..lo.y + (height - 110) as f64 / scale)
+            .build_cartesian_2d(
+                lo.x..lo.x + (width - extra_w) as f64 / scale,
+                lo.y..lo.y + (height - extra_h) as f64 / scale,
+            )
             .map_err(err)?;
         chart.configure_mesh().x_desc("x (m)").y_desc("y (m)").light_line_style(WHITE).draw().map_err(err)?;
         for a in &world.areas {
@@ -134,7 +138,9 @@ pub fn trajectory_svg(world: &World, samples: &[Sample], title: &str) -> Result<
             let pts: Vec<(f64, f64)> = samples[a..=b].iter().map(|s| (s.x, s.y)).collect();
             let series = chart.draw_series(LineSeries::new(pts, c.stroke_width(2))).map_err(err)?;
             if !legend_done.contains(&label) {
-                series.label(label.clone()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(3)));
+                series
+                    .label(label.clone())
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(3)));
                 legend_done.push(label);
             }
         }
@@ -188,7 +194,11 @@ pub fn timeline_svg(samples: &[Sample], title: &str) -> Result<String, PlotError
             let px_per_s = 1100.0 / t_end;
             if (t1 - t0) * px_per_s > 8.0 * label.len() as f64 {
                 chart
-                    .draw_series(std::iter::once(Text::new(label.clone(), (t0 + 0.3 / px_per_s * 10.0, 0.7), ("sans-serif", 13).into_font().color(&WHITE))))
+                    .draw_series(std::iter::once(Text::new(
+                        label.clone(),
+                        (t0 + 0.3 / px_per_s * 10.0, 0.7),
+                        ("sans-serif", 13).into_font().color(&WHITE),
+                    )))
                     .map_err(err)?;
             }
         }

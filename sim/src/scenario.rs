@@ -398,7 +398,10 @@ fn build(f: ScenarioFile) -> Result<Scenario, ScenarioError> {
     };
     positive("road.lane_width", f.road.lane_width)?;
     if f.road.lanes == 0 {
-        return Err(ScenarioError::Invalid { place: "road.lanes".into(), message: "a road needs at least one lane".into() });
+        return Err(ScenarioError::Invalid {
+            place: "road.lanes".into(),
+            message: "a road needs at least one lane".into(),
+        });
     }
     check_unique("road.nodes", f.road.nodes.iter().map(|n| n.id.as_str()))?;
     check_unique("road.edges", f.road.edges.iter().map(|e| e.id.as_str()))?;
@@ -414,17 +417,24 @@ fn build(f: ScenarioFile) -> Result<Scenario, ScenarioError> {
     }
     let mut areas = Vec::new();
     for (i, a) in f.areas.iter().enumerate() {
-        areas.push(Area { id: a.id.clone(), polygon: polygon(&format!("areas[{i}] (\"{}\").polygon", a.id), &a.polygon)? });
+        areas.push(Area {
+            id: a.id.clone(),
+            polygon: polygon(&format!("areas[{i}] (\"{}\").polygon", a.id), &a.polygon)?,
+        });
     }
     let mut edge_places = Vec::new();
     for (i, e) in f.road.edges.iter().enumerate() {
         let place = format!("road.edges[{i}] (\"{}\")", e.id);
-        let a = *by_id
-            .get(e.from.as_str())
-            .ok_or_else(|| ScenarioError::UnknownNode { place: place.clone(), field: "from", node: e.from.clone() })?;
-        let b = *by_id
-            .get(e.to.as_str())
-            .ok_or_else(|| ScenarioError::UnknownNode { place: place.clone(), field: "to", node: e.to.clone() })?;
+        let a = *by_id.get(e.from.as_str()).ok_or_else(|| ScenarioError::UnknownNode {
+            place: place.clone(),
+            field: "from",
+            node: e.from.clone(),
+        })?;
+        let b = *by_id.get(e.to.as_str()).ok_or_else(|| ScenarioError::UnknownNode {
+            place: place.clone(),
+            field: "to",
+            node: e.to.clone(),
+        })?;
         if a == b {
             return Err(ScenarioError::Invalid { place, message: "`from` and `to` are the same node".into() });
         }
@@ -450,8 +460,8 @@ fn build(f: ScenarioFile) -> Result<Scenario, ScenarioError> {
                     place: format!("{place}.turn"),
                     message: "missing: an arc needs `turn = \"left\"` or `\"right\"`".into(),
                 })?;
-                let piece = Piece::arc_between(pa, pb, r, turn == TurnFile::Left).ok_or_else(|| {
-                    ScenarioError::Invalid {
+                let piece =
+                    Piece::arc_between(pa, pb, r, turn == TurnFile::Left).ok_or_else(|| ScenarioError::Invalid {
                         place: format!("{place}.radius"),
                         message: format!(
                             "radius {r} m is shorter than half the distance between {} and {} ({:.2} m)",
@@ -459,8 +469,7 @@ fn build(f: ScenarioFile) -> Result<Scenario, ScenarioError> {
                             e.to,
                             (pb - pa).norm() / 2.0
                         ),
-                    }
-                })?;
+                    })?;
                 (EdgeKind::Road, piece)
             }
         };
@@ -526,7 +535,12 @@ fn build(f: ScenarioFile) -> Result<Scenario, ScenarioError> {
         } else if let Some(r) = &o.rect {
             let l = positive(&format!("{place}.rect.length"), r.length)?;
             let w = positive(&format!("{place}.rect.width"), r.width)?;
-            rect_polygon(v2(finite(&place, r.x)?, finite(&place, r.y)?), l, w, finite(&place, r.heading_deg)?.to_radians())
+            rect_polygon(
+                v2(finite(&place, r.x)?, finite(&place, r.y)?),
+                l,
+                w,
+                finite(&place, r.heading_deg)?.to_radians(),
+            )
         } else {
             unreachable!("exactly one shape was checked above")
         };
@@ -542,7 +556,10 @@ fn build(f: ScenarioFile) -> Result<Scenario, ScenarioError> {
                 let speed = positive(&format!("{place}.motion.speed"), m.speed)?;
                 let mut wps = Vec::new();
                 for p in &m.path {
-                    wps.push(v2(finite(&format!("{place}.motion.path"), p[0])?, finite(&format!("{place}.motion.path"), p[1])?));
+                    wps.push(v2(
+                        finite(&format!("{place}.motion.path"), p[0])?,
+                        finite(&format!("{place}.motion.path"), p[1])?,
+                    ));
                 }
                 // The polygon is given where the obstacle is at the first waypoint.
                 Motion::Path { waypoints: wps, speed, repeat: m.repeat }
@@ -626,7 +643,10 @@ fn build(f: ScenarioFile) -> Result<Scenario, ScenarioError> {
     let (ga, _) = world.roads.graph.edge_endpoints(goal_edge).unwrap_or_default();
     if !reach.contains(&ga) {
         return Err(ScenarioError::Unreachable {
-            message: format!("no road or track leads from the start to the goal's road \"{}\"", world.roads.graph[goal_edge].id),
+            message: format!(
+                "no road or track leads from the start to the goal's road \"{}\"",
+                world.roads.graph[goal_edge].id
+            ),
         });
     }
 

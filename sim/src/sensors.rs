@@ -75,10 +75,9 @@ impl Event for RfccdEvent {
     }
     fn fields(&self) -> Vec<(&'static str, Value)> {
         match *self {
-            RfccdEvent::Turn { curvature, left } => vec![
-                ("curvature", Value::F64(curvature)),
-                ("side", Value::Symbol(if left { "left" } else { "right" })),
-            ],
+            RfccdEvent::Turn { curvature, left } => {
+                vec![("curvature", Value::F64(curvature)), ("side", Value::Symbol(if left { "left" } else { "right" }))]
+            }
             RfccdEvent::Branch { distance } => vec![("distance", Value::F64(distance))],
             _ => vec![],
         }
@@ -240,7 +239,12 @@ pub struct Rfccd {
 impl Rfccd {
     /// The camera with its default figures and a seed.
     pub fn new(seed: u64) -> Self {
-        Rfccd { lookahead: RoadLookahead::default(), curvature_sigma: 0.05, distance_sigma: 0.5, noise: Noise::new(seed, 11) }
+        Rfccd {
+            lookahead: RoadLookahead::default(),
+            curvature_sigma: 0.05,
+            distance_sigma: 0.5,
+            noise: Noise::new(seed, 11),
+        }
     }
 
     /// One frame (`lines_far()` / `lines_near()`): the road ahead of the vehicle.
@@ -283,7 +287,14 @@ pub struct Ladar {
 impl Ladar {
     /// The LADAR with its default figures (40 m, 180°) and a seed.
     pub fn new(seed: u64) -> Self {
-        Ladar { range: 40.0, fov: std::f64::consts::PI, margin: 0.3, sigma: 0.05, noise: Noise::new(seed, 12), scratch: Vec::new() }
+        Ladar {
+            range: 40.0,
+            fov: std::f64::consts::PI,
+            margin: 0.3,
+            sigma: 0.05,
+            noise: Noise::new(seed, 12),
+            scratch: Vec::new(),
+        }
     }
 
     /// One scan (`detect()`). The event is LAOBS for the nearest obstacle in

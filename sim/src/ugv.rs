@@ -113,7 +113,12 @@ pub fn lidar_scan(pose: &Pose, views: &[ObstacleView], cfg: &UgvConfig, noise: &
         let shift = v2(noise.normal(cfg.lidar_sigma), noise.normal(cfg.lidar_sigma));
         ellipse.center += shift;
         let distance = ellipse.distance(pose.pos());
-        out.push(LidarObstacle { index: o.index, ellipse, outline: seen.iter().map(|p| p + shift).collect(), distance });
+        out.push(LidarObstacle {
+            index: o.index,
+            ellipse,
+            outline: seen.iter().map(|p| p + shift).collect(),
+            distance,
+        });
     }
     out
 }
@@ -185,7 +190,13 @@ pub fn reach(params: &VehicleParams) -> f64 {
 
 /// The Selector agent's `select()`: which obstacle hinders the movement
 /// toward the target, and on which side.
-pub fn select(pose: &Pose, target: &Pose, seen: &[LidarObstacle], params: &VehicleParams, cfg: &UgvConfig) -> Selection {
+pub fn select(
+    pose: &Pose,
+    target: &Pose,
+    seen: &[LidarObstacle],
+    params: &VehicleParams,
+    cfg: &UgvConfig,
+) -> Selection {
     let p = pose.pos();
     let tp = target.pos();
     let mut best: Option<Hinder> = None;
@@ -269,7 +280,13 @@ impl HardSwitch {
 }
 
 /// The command of the controller the hard switch selected.
-pub fn hard_switch_command(mode: &Mode, pose: &Pose, target: &Target, params: &VehicleParams, cfg: &UgvConfig) -> Command {
+pub fn hard_switch_command(
+    mode: &Mode,
+    pose: &Pose,
+    target: &Target,
+    params: &VehicleParams,
+    cfg: &UgvConfig,
+) -> Command {
     match mode {
         Mode::Reaching => control_law(&target_reaching(pose, target), &cfg.gains, params, params.max_speed),
         Mode::Avoid { dir, cycle, .. } => {
@@ -356,7 +373,15 @@ impl Merge {
     /// nearest obstacle (eq. 16), moves the particles in the force field of
     /// the target, each other and the obstacle spots `spots` (vehicle frame;
     /// eqs. 17–19), and reads the command off their centre of mass.
-    pub fn command(&mut self, follow: &Command, avoid: &Command, d: f64, spots: &[Vec2], params: &VehicleParams, dt: f64) -> Command {
+    pub fn command(
+        &mut self,
+        follow: &Command,
+        avoid: &Command,
+        d: f64,
+        spots: &[Vec2],
+        params: &VehicleParams,
+        dt: f64,
+    ) -> Command {
         let mp = self.params;
         let f = blend_weight(d);
         let mut t = self.point(avoid) * f + self.point(follow) * (1.0 - f);
@@ -370,7 +395,7 @@ impl Merge {
         let n = self.pos.len();
         let mut acc = vec![Vec2::zeros(); n];
         for _ in 0..mp.substeps.max(1) {
-            for i in 0..n {
+            for (i, acc_i) in acc.iter_mut().enumerate() {
                 let pi = self.pos[i];
                 // Eq. (17): linear attraction to the target.
                 let mut a = (t - pi) * mp.attraction;
@@ -388,13 +413,13 @@ impl Merge {
                     let r = d.norm().max(0.3);
                     a += d * (mp.obstacle / (r * r * r));
                 }
-                acc[i] = a - self.vel[i] * mp.damping;
+                *acc_i = a - self.vel[i] * mp.damping;
             }
-            for i in 0..n {
-                self.vel[i] += acc[i] * h;
-                self.pos[i] += self.vel[i] * h;
-                if self.pos[i].norm() > mp.perception {
-                    self.pos[i] = self.pos[i].normalize() * mp.perception;
+            for ((p, v), a) in self.pos.iter_mut().zip(self.vel.iter_mut()).zip(&acc) {
+                *v += a * h;
+                *p += *v * h;
+                if p.norm() > mp.perception {
+                    *p = p.normalize() * mp.perception;
                 }
             }
         }
@@ -575,7 +600,16 @@ impl fmt::Display for Comparison {
         writeln!(
             f,
             "{:<12} {:>12} {:>10} {:>7} {:>12} {:>7} {:>8} {:>8} {:>10} {:>8}",
-            "strategy", "max |dγ/dt|", "rms dγ/dt", "top v", "top v near", "mean v", "closest", "min TTC", "collisions", "goal at"
+            "strategy",
+            "max |dγ/dt|",
+            "rms dγ/dt",
+            "top v",
+            "top v near",
+            "mean v",
+            "closest",
+            "min TTC",
+            "collisions",
+            "goal at"
         )?;
         writeln!(
             f,
@@ -631,4 +665,63 @@ pub fn compare(world: &World, strategies: &[Strategy], seed: u64, cfg: &UgvConfi
         runs.push(m);
     }
     Comparison { scenario: world.name.clone(), seed, rows, runs }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn hinder(side: Side, distance: f64) -> Selection {
+        let cycle = Ellipse { center: v2(5.0, 0.0), a: 2.0, b: 2.0, omega: 0.0 };
+        Selection { hinder: Some(Hinder { index: 0, side, cycle, distance }), nearest: distance, influence: 1.5 }
+    }
+
+    fn free() -> Selection {
+        Selection { hinder: None, nearest: 15.0, influence: 1.5 }
+    }
+
+    #[test]
+    fn hard_switch_mirrors_the_rules() {
+        let mut hs = HardSwitch::default();
+        assert_eq!(hs.step(&hinder(Side::Left, 4.0)).label(), "Reaching", "waits for the radius of influence");
+        assert_eq!(hs.step(&hinder(Side::Left, 1.2)).label(), "AvoidCCW", "left: counter-clockwise");
+        assert_eq!(hs.step(&hinder(Side::Right, 1.0)).label(), "AvoidCCW", "no flip mid-avoidance");
+        hs.step(&free());
+        assert_eq!(hs.step(&free()).label(), "AvoidCCW");
+        assert_eq!(hs.step(&free()).label(), "Reaching", "FREE x3");
+        assert_eq!(hs.step(&hinder(Side::Right, 1.0)).label(), "AvoidCW", "right: clockwise");
+    }
+
+    #[test]
+    fn selection_finds_the_hindering_obstacle_and_its_side() {
+        let params = VehicleParams::urban();
+        let cfg = UgvConfig::default();
+        let mut views = Vec::new();
+        let world = crate::scenario::dafflon_4().world;
+        world.obstacles_at(0.0, &mut views);
+        let mut noise = Noise::new(1, 1);
+        let pose = Pose::new(5.0, 0.0, 0.0);
+        let seen = lidar_scan(&pose, &views, &cfg, &mut noise);
+        assert!(!seen.is_empty());
+        let sel = select(&pose, &Pose::new(60.0, 0.0, 0.0), &seen, &params, &cfg);
+        let h = sel.hinder.expect("O1 hinders");
+        assert_eq!(world.obstacles[h.index].id, "O1");
+        assert_eq!(h.side, Side::Left, "O1 is at y = +0.5");
+        // Aim beside it: nothing hinders.
+        let sel = select(&pose, &Pose::new(12.0, -8.0, 0.0), &seen, &params, &cfg);
+        assert!(sel.hinder.is_none());
+    }
+
+    #[test]
+    fn merge_without_obstacles_gives_the_follow_command() {
+        let params = VehicleParams::urban();
+        let mut m = Merge::new(MergeParams::default());
+        let follow = Command { v: 1.5, steer: 0.2 };
+        let mut cmd = Command::default();
+        for _ in 0..200 {
+            cmd = m.command(&follow, &follow, f64::INFINITY, &[], &params, 0.05);
+        }
+        assert!((cmd.v - 1.5).abs() < 0.01 && (cmd.steer - 0.2).abs() < 0.01, "{cmd:?}");
+        assert!(blend_weight(0.0) == 1.0 && blend_weight(2.0) == 1.0 / 3.0);
+    }
 }

@@ -10,7 +10,7 @@
 //! road surface.
 
 use crate::geom::{
-    contains, densify, dist_point_polygon, polygons_intersect, polygon_distance, unit, v2, wrap_angle, Piece, Pose,
+    contains, densify, dist_point_polygon, polygon_distance, polygons_intersect, unit, v2, wrap_angle, Piece, Pose,
     Vec2,
 };
 use crate::vehicle::VehicleParams;
@@ -123,7 +123,9 @@ impl RoadNetwork {
     /// Whether a point is on the road surface.
     pub fn on_road(&self, p: Vec2) -> bool {
         let hw = self.half_width();
-        self.graph.edge_references().any(|e| e.weight().kind == EdgeKind::Road && e.weight().piece.project(p).distance <= hw)
+        self.graph
+            .edge_references()
+            .any(|e| e.weight().kind == EdgeKind::Road && e.weight().piece.project(p).distance <= hw)
     }
 }
 
@@ -540,7 +542,8 @@ impl World {
         let mut best: Option<(f64, usize)> = None;
         for o in views.iter().filter(|o| o.height > self.vehicle.clearance) {
             // Bounding circles bound the distance from below: skip hopeless ones.
-            let lower = (o.center - c).norm() - o.radius - (self.vehicle.front + self.vehicle.rear).hypot(self.vehicle.width);
+            let lower =
+                (o.center - c).norm() - o.radius - (self.vehicle.front + self.vehicle.rear).hypot(self.vehicle.width);
             if best.is_some_and(|(d, _)| lower > d) {
                 continue;
             }
@@ -648,22 +651,55 @@ mod tests {
         let c = g.add_node(RoadNode { id: "C".into(), position: v2(130.0, 30.0) });
         let d = g.add_node(RoadNode { id: "D".into(), position: v2(-50.0, 0.0) });
         let e = g.add_node(RoadNode { id: "E".into(), position: v2(0.0, -50.0) });
-        g.add_edge(a, b, RoadEdge { id: "ab".into(), kind: EdgeKind::Road, piece: Piece::Line { a: v2(0.0, 0.0), b: v2(100.0, 0.0) } });
+        g.add_edge(
+            a,
+            b,
+            RoadEdge {
+                id: "ab".into(),
+                kind: EdgeKind::Road,
+                piece: Piece::Line { a: v2(0.0, 0.0), b: v2(100.0, 0.0) },
+            },
+        );
         let arc = Piece::arc_between(v2(100.0, 0.0), v2(130.0, 30.0), 30.0, true).expect("arc");
         g.add_edge(b, c, RoadEdge { id: "bc".into(), kind: EdgeKind::Road, piece: arc });
-        g.add_edge(d, a, RoadEdge { id: "da".into(), kind: EdgeKind::Road, piece: Piece::Line { a: v2(-50.0, 0.0), b: v2(0.0, 0.0) } });
-        g.add_edge(a, e, RoadEdge { id: "ae".into(), kind: EdgeKind::Road, piece: Piece::Line { a: v2(0.0, 0.0), b: v2(0.0, -50.0) } });
+        g.add_edge(
+            d,
+            a,
+            RoadEdge {
+                id: "da".into(),
+                kind: EdgeKind::Road,
+                piece: Piece::Line { a: v2(-50.0, 0.0), b: v2(0.0, 0.0) },
+            },
+        );
+        g.add_edge(
+            a,
+            e,
+            RoadEdge {
+                id: "ae".into(),
+                kind: EdgeKind::Road,
+                piece: Piece::Line { a: v2(0.0, 0.0), b: v2(0.0, -50.0) },
+            },
+        );
         World {
             name: "small".into(),
             roads: RoadNetwork { graph: g, lane_width: 3.5, lanes: 2 },
             areas: vec![Area { id: "field".into(), polygon: rect_polygon(v2(50.0, 50.0), 40.0, 40.0, 0.0) }],
             obstacles: vec![
-                Obstacle { id: "box".into(), polygon: rect_polygon(v2(60.0, 0.0), 2.0, 2.0, 0.0), height: 1.0, motion: Motion::Static },
+                Obstacle {
+                    id: "box".into(),
+                    polygon: rect_polygon(v2(60.0, 0.0), 2.0, 2.0, 0.0),
+                    height: 1.0,
+                    motion: Motion::Static,
+                },
                 Obstacle {
                     id: "walker".into(),
                     polygon: circle_polygon(v2(70.0, 10.0), 0.5, 8),
                     height: 1.8,
-                    motion: Motion::Path { waypoints: vec![v2(70.0, 10.0), v2(70.0, -10.0)], speed: 1.0, repeat: Repeat::PingPong },
+                    motion: Motion::Path {
+                        waypoints: vec![v2(70.0, 10.0), v2(70.0, -10.0)],
+                        speed: 1.0,
+                        repeat: Repeat::PingPong,
+                    },
                 },
             ],
             gps_outages: vec![],

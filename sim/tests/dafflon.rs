@@ -18,7 +18,12 @@ fn merge_is_smoother_and_faster_than_the_hard_switch_and_safe() {
         assert!(r.time_to_goal.is_some(), "{}: reaches the target", r.strategy);
     }
     // Smaller steering-rate peaks (the paper's Fig. 5: no discontinuity).
-    assert!(merge.max_steer_rate * 5.0 < hard.max_steer_rate, "steering-rate peaks: {} vs {}", merge.max_steer_rate, hard.max_steer_rate);
+    assert!(
+        merge.max_steer_rate * 5.0 < hard.max_steer_rate,
+        "steering-rate peaks: {} vs {}",
+        merge.max_steer_rate,
+        hard.max_steer_rate
+    );
     assert!(merge.rms_steer_rate < hard.rms_steer_rate);
     // Speed: both reach vmax on the free stretch (the top speed is capped
     // there); the merge keeps its speed among the obstacles, so its mean

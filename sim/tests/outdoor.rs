@@ -23,7 +23,10 @@ fn top_speed_in(m: &situ_sim::metrics::Metrics, states: &[&str]) -> f64 {
 fn default_mission_reaches_the_goal_through_every_state() {
     let m = run_mission(scenario::outdoor_default().world, 1, 600.0);
     let s = &m.summary;
-    println!("time to goal {:?} s, {:.0} m, closest {:?} m ({:?}), min TTC {:?} s", s.time_to_goal, s.distance, s.closest_distance, s.closest_obstacle, s.min_ttc);
+    println!(
+        "time to goal {:?} s, {:.0} m, closest {:?} m ({:?}), min TTC {:?} s",
+        s.time_to_goal, s.distance, s.closest_distance, s.closest_obstacle, s.min_ttc
+    );
     let seq: Vec<&str> = m.architecture.transitions.iter().map(|(_, st)| st.as_str()).collect();
     println!("states: {}", seq.join(" → "));
     for (st, t) in &m.architecture.time_in_state {
