@@ -25,6 +25,10 @@
 //! # rect = { x = .., y = .., length = .., width = .., heading_deg = .. }
 //! # motion = { path = [[x, y], ...], speed = 1.0, repeat = "ping_pong" }  # moving
 //!
+//! [[gps_outages]]               # optional: Localization reports LOLOST inside
+//! id = "tunnel"
+//! polygon = [[40.0, -5.0], [60.0, -5.0], [60.0, 5.0], [40.0, 5.0]]
+//!
 //! [start]
 //! x = 5.0
 //! y = -1.75
@@ -674,6 +678,40 @@ fn reachable(g: &UnGraph<RoadNode, RoadEdge>, from: NodeIndex) -> std::collectio
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn moving_obstacles_and_outages_parse() {
+        let text = r#"
+name = "walker"
+[road]
+lane_width = 3.5
+nodes = [{ id = "A", x = 0.0, y = 0.0 }, { id = "B", x = 100.0, y = 0.0 }]
+edges = [{ id = "ab", from = "A", to = "B", kind = "straight" }]
+[[obstacles]]
+id = "walker"
+height = 1.8
+circle = { x = 50.0, y = 8.0, radius = 0.4 }
+motion = { path = [[50.0, 8.0], [50.0, -8.0]], speed = 1.2, repeat = "loop" }
+[[gps_outages]]
+id = "tunnel"
+polygon = [[70.0, -5.0], [80.0, -5.0], [80.0, 5.0], [70.0, 5.0]]
+[start]
+x = 5.0
+y = -1.75
+heading_deg = 0.0
+[goal]
+x = 95.0
+y = -1.75
+"#;
+        let s = parse(text).expect("valid");
+        let o = &s.world.obstacles[0];
+        assert!((o.offset_at(10.0) - v2(0.0, -12.0)).norm() < 1e-9);
+        assert!((o.offset_at(15.0) - v2(0.0, -2.0)).norm() < 1e-9, "18 m along a 16 m path: looped");
+        assert!(!s.world.gps_fix(v2(75.0, 0.0)) && s.world.gps_fix(v2(60.0, 0.0)));
+        let bad = text.replace("speed = 1.2", "speed = -1.0");
+        let e = parse(&bad).expect_err("negative speed");
+        assert_eq!(e.to_string(), "obstacles[0] (\"walker\").motion.speed: must be a positive number, not -1");
+    }
 
     #[test]
     fn builtins_parse() {
