@@ -1,0 +1,727 @@
+//! Dafflon et al.'s urban UGV in closed loop: vehicle + LIDAR + action
+//! selection + elementary controllers + the single control law, with the two
+//! ways of choosing between the controllers: the **hard switch** (the
+//! situation rules of `rules/ugv.situ`, mirrored by [`HardSwitch`]) and the
+//! **multi-agent merge** of eqs. (16)–(19) ([`Merge`]).
+//!
+//! Per tick (20 Hz) a wrapper calls [`lidar_scan`] (the Lidar agent),
+//! [`select`] (the Selector agent: which obstacle hinders, on which side),
+//! then either [`HardSwitch::step`] and [`hard_switch_command`], or
+//! [`Merge::command`]; and [`crate::vehicle::Vehicle::step`].
+//!
+//! Constants the paper leaves out (CHOICE):
+//! - the limit cycle around an obstacle is its enclosing ellipse grown by half
+//!   the vehicle's width plus [`UgvConfig::safety_margin`] (0.6 m);
+//! - an obstacle *hinders* when the segment vehicle → target cuts that
+//!   ellipse (by more than 5% of its level, ahead of the vehicle); the switch
+//!   to avoidance happens when the vehicle is within the radius of influence,
+//!   [`UgvConfig::influence`] (1.5 m) of the limit-cycle ellipse, and back
+//!   to target reaching after 3 selections (0.15 s) with nothing hindering;
+//! - the direction: an obstacle left of the vehicle → target line is passed
+//!   on its right, counter-clockwise (m = −1), and the other way round;
+//! - the merge: 12 particles of unit mass, commands become points by a
+//!   horizon τ = 2 s (a command (v, γ) is the point τ·v·(cos γ, sin γ) of the
+//!   vehicle frame, so that a point gives back its command: γ = its angle,
+//!   v = its length / τ), a circular frustum of 6 m, attraction βg = 4 s⁻²,
+//!   agent repulsion α = 0.3, obstacle spots every 0.5 m of the obstacles'
+//!   outlines with Δo·mo = 4, viscous damping 4 s⁻¹, 5 sub-steps per
+//!   tick (semi-implicit Euler). Particles persist from tick to tick.
+
+use crate::control::{control_law, limit_cycle, target_reaching, Direction, Ellipse, Gains, Target};
+use crate::geom::{cross, densify, unit, v2, Pose, Vec2};
+use crate::metrics::{Metrics, Recorder, Sample};
+use crate::noise::Noise;
+use crate::vehicle::{Command, Vehicle, VehicleParams};
+use crate::world::{ObstacleView, World};
+use serde::Serialize;
+use std::fmt;
+
+/// The closed loop's settings.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct UgvConfig {
+    /// Control period (s): 20 Hz.
+    pub dt: f64,
+    /// LIDAR range (m).
+    pub lidar_range: f64,
+    /// LIDAR field of view (rad).
+    pub lidar_fov: f64,
+    /// LIDAR noise on the fitted ellipse's centre (m, σ).
+    pub lidar_sigma: f64,
+    /// Margin added to the enclosing ellipse beyond half the vehicle's width (m).
+    pub safety_margin: f64,
+    /// Radius of influence beyond the limit-cycle ellipse (m).
+    pub influence: f64,
+    /// Target reaching: the velocity wanted at the target (m/s).
+    pub target_speed: f64,
+    /// The run stops after this long (s).
+    pub max_time: f64,
+    /// Gains of the control law.
+    pub gains: Gains,
+}
+
+impl Default for UgvConfig {
+    fn default() -> Self {
+        UgvConfig {
+            dt: 0.05,
+            lidar_range: 15.0,
+            lidar_fov: 270f64.to_radians(),
+            lidar_sigma: 0.02,
+            safety_margin: 0.3,
+            influence: 1.5,
+            target_speed: 0.3,
+            max_time: 120.0,
+            gains: Gains::urban(),
+        }
+    }
+}
+
+/// One obstacle as the LIDAR agent reports it: its enclosing ellipse.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LidarObstacle {
+    /// The world's obstacle index (the simulation's track id).
+    pub index: usize,
+    /// The fitted enclosing ellipse (noisy).
+    pub ellipse: Ellipse,
+    /// The outline points seen (world frame), for the merge's repulsive spots.
+    pub outline: Vec<Vec2>,
+    /// Distance from the vehicle to the ellipse (m).
+    pub distance: f64,
+}
+
+/// The Lidar agent's `scan()`: obstacles in range and field of view, each
+/// fitted with an enclosing ellipse (centre noise σ = `lidar_sigma`).
+pub fn lidar_scan(pose: &Pose, views: &[ObstacleView], cfg: &UgvConfig, noise: &mut Noise) -> Vec<LidarObstacle> {
+    let mut out = Vec::new();
+    let mut pts = Vec::new();
+    for o in views {
+        if (o.center - pose.pos()).norm() - o.radius > cfg.lidar_range {
+            continue;
+        }
+        densify(&o.polygon, 0.5, &mut pts);
+        let seen: Vec<Vec2> = pts
+            .iter()
+            .copied()
+            .filter(|p| {
+                let l = pose.to_local(*p);
+                l.norm() <= cfg.lidar_range && l.y.atan2(l.x).abs() <= cfg.lidar_fov / 2.0
+            })
+            .collect();
+        if seen.is_empty() {
+            continue;
+        }
+        let mut ellipse = Ellipse::enclosing(&o.polygon);
+        let shift = v2(noise.normal(cfg.lidar_sigma), noise.normal(cfg.lidar_sigma));
+        ellipse.center += shift;
+        let distance = ellipse.distance(pose.pos());
+        out.push(LidarObstacle {
+            index: o.index,
+            ellipse,
+            outline: seen.iter().map(|p| p + shift).collect(),
+            distance,
+        });
+    }
+    out
+}
+
+/// The side of the vehicle → target line an obstacle is on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Side {
+    /// Left of the line.
+    Left,
+    /// Right of the line.
+    Right,
+}
+
+/// An obstacle that hinders the way to the target (the HINDER event).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Hinder {
+    /// The world's obstacle index.
+    pub index: usize,
+    /// Its side of the vehicle → target line.
+    pub side: Side,
+    /// The limit-cycle ellipse around it.
+    pub cycle: Ellipse,
+    /// Distance from the vehicle to the limit-cycle ellipse (m).
+    pub distance: f64,
+}
+
+impl Hinder {
+    /// The avoidance direction for this side (the rule `avoid_ccw`/`avoid_cw`).
+    pub fn direction(&self) -> Direction {
+        match self.side {
+            Side::Left => Direction::CounterClockwise,
+            Side::Right => Direction::Clockwise,
+        }
+    }
+}
+
+/// The Selector agent's output for one tick.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Selection {
+    /// The nearest hindering obstacle, if any (HINDER, else FREE).
+    pub hinder: Option<Hinder>,
+    /// Distance to the nearest obstacle's enclosing ellipse (the OBS event;
+    /// the LIDAR range when none).
+    pub nearest: f64,
+    /// Radius of influence beyond the limit-cycle ellipse (HINDER's
+    /// `influence`, m): avoidance starts when the hindering obstacle's
+    /// [`Hinder::distance`] is within it.
+    pub influence: f64,
+}
+
+/// How deep the segment `p`→`q` goes into an ellipse (1 − the smallest level
+/// along it, ≤ 0 when it misses) and where (fraction of the segment).
+fn penetration(e: &Ellipse, p: Vec2, q: Vec2) -> (f64, f64) {
+    let (a, b, c) = e.coefficients();
+    let (p0, d) = (p - e.center, q - p);
+    // level(t) = A x² + B y² + C x y along p0 + t d: a quadratic in t.
+    let qa = a * d.x * d.x + b * d.y * d.y + c * d.x * d.y;
+    let qb = 2.0 * a * p0.x * d.x + 2.0 * b * p0.y * d.y + c * (p0.x * d.y + p0.y * d.x);
+    let t = if qa > 0.0 { (-qb / (2.0 * qa)).clamp(0.0, 1.0) } else { 0.0 };
+    (1.0 - e.level(p + d * t), t)
+}
+
+/// How far the vehicle's outline reaches from its reference point (the
+/// rear-axle centre the controllers steer): to a front corner.
+pub fn reach(params: &VehicleParams) -> f64 {
+    params.front.max(params.rear).hypot(params.width / 2.0)
+}
+
+/// The Selector agent's `select()`: which obstacle hinders the movement
+/// toward the target, and on which side.
+pub fn select(
+    pose: &Pose,
+    target: &Pose,
+    seen: &[LidarObstacle],
+    params: &VehicleParams,
+    cfg: &UgvConfig,
+) -> Selection {
+    let p = pose.pos();
+    let tp = target.pos();
+    let mut best: Option<Hinder> = None;
+    let mut nearest = cfg.lidar_range;
+    for o in seen {
+        nearest = nearest.min(o.distance);
+        let cycle = o.ellipse.grown(reach(params) + cfg.safety_margin);
+        let (depth, t) = penetration(&cycle, p, tp);
+        if depth > 0.05 && t > 0.0 {
+            let side = if cross(tp - p, cycle.center - p) > 0.0 { Side::Left } else { Side::Right };
+            let h = Hinder { index: o.index, side, cycle, distance: cycle.distance(p) };
+            if best.is_none_or(|b| h.distance < b.distance) {
+                best = Some(h);
+            }
+        }
+    }
+    Selection { hinder: best, nearest, influence: cfg.influence }
+}
+
+/// Which controller drives (the states of `rules/ugv.situ`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub enum Mode {
+    /// Target reaching.
+    Reaching,
+    /// Obstacle avoidance on the limit cycle of an obstacle.
+    Avoid {
+        /// Clockwise or counter-clockwise.
+        dir: Direction,
+        /// The limit cycle followed.
+        cycle: Ellipse,
+        /// The world's index of the obstacle orbited.
+        index: usize,
+    },
+}
+
+impl Mode {
+    /// The state name of `rules/ugv.situ`.
+    pub fn label(&self) -> &'static str {
+        match self {
+            Mode::Reaching => "Reaching",
+            Mode::Avoid { dir: Direction::Clockwise, .. } => "AvoidCW",
+            Mode::Avoid { dir: Direction::CounterClockwise, .. } => "AvoidCCW",
+        }
+    }
+}
+
+/// The hard switch: the situation rules `avoid_ccw`, `avoid_cw` and
+/// `way_free` of `rules/ugv.situ` as a function of the selections.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct HardSwitch {
+    /// The controller in charge.
+    pub mode: Mode,
+    /// FREE selections in a row.
+    pub free_run: u32,
+}
+
+impl Default for HardSwitch {
+    fn default() -> Self {
+        HardSwitch { mode: Mode::Reaching, free_run: 0 }
+    }
+}
+
+impl HardSwitch {
+    /// Updates the mode from one selection and returns it. Reaching →
+    /// avoidance when a hindering obstacle is within its radius of influence
+    /// (direction by its side); avoidance → reaching after 3 FREE in a row;
+    /// the direction never flips mid-avoidance, the orbited ellipse follows
+    /// the nearest hindering obstacle.
+    pub fn step(&mut self, sel: &Selection) -> Mode {
+        self.free_run = if sel.hinder.is_none() { self.free_run + 1 } else { 0 };
+        self.mode = match (self.mode, sel.hinder) {
+            (Mode::Reaching, Some(h)) if h.distance <= sel.influence => {
+                Mode::Avoid { dir: h.direction(), cycle: h.cycle, index: h.index }
+            }
+            (Mode::Avoid { .. }, None) if self.free_run >= 3 => Mode::Reaching,
+            (Mode::Avoid { dir, .. }, Some(h)) => Mode::Avoid { dir, cycle: h.cycle, index: h.index },
+            (m, _) => m,
+        };
+        self.mode
+    }
+}
+
+/// The command of the controller the hard switch selected.
+pub fn hard_switch_command(
+    mode: &Mode,
+    pose: &Pose,
+    target: &Target,
+    params: &VehicleParams,
+    cfg: &UgvConfig,
+) -> Command {
+    match mode {
+        Mode::Reaching => control_law(&target_reaching(pose, target), &cfg.gains, params, params.max_speed),
+        Mode::Avoid { dir, cycle, .. } => {
+            // vT = vmax / 2 during avoidance (Section 2.2.2).
+            let v_t = params.max_speed / 2.0;
+            control_law(&limit_cycle(pose, cycle, *dir, v_t), &cfg.gains, params, params.max_speed)
+        }
+    }
+}
+
+/// The merge's constants (see the module doc).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct MergeParams {
+    /// Number of particles.
+    pub agents: usize,
+    /// Horizon τ turning commands into points (s).
+    pub tau: f64,
+    /// Radius of the perception frustum (m).
+    pub perception: f64,
+    /// βg·m: attraction to the target (1/s²).
+    pub attraction: f64,
+    /// α·mi·mj: repulsion between particles.
+    pub repulsion: f64,
+    /// Δo·m·mo: repulsion by each obstacle spot.
+    pub obstacle: f64,
+    /// Spacing of the obstacle spots (m).
+    pub spot_spacing: f64,
+    /// Viscous damping (1/s).
+    pub damping: f64,
+    /// Integration sub-steps per tick.
+    pub substeps: u32,
+}
+
+impl Default for MergeParams {
+    fn default() -> Self {
+        MergeParams {
+            agents: 12,
+            tau: 2.0,
+            perception: 6.0,
+            attraction: 4.0,
+            repulsion: 0.3,
+            obstacle: 4.0,
+            spot_spacing: 0.5,
+            damping: 4.0,
+            substeps: 5,
+        }
+    }
+}
+
+/// The multi-agent merge of eqs. (16)–(19).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Merge {
+    /// Constants.
+    pub params: MergeParams,
+    /// Particle positions (vehicle frame, m).
+    pub pos: Vec<Vec2>,
+    /// Particle velocities (m/s).
+    pub vel: Vec<Vec2>,
+    /// The last blended target T (vehicle frame), for pictures.
+    pub last_target: Vec2,
+    /// The last f(d).
+    pub last_f: f64,
+}
+
+/// f of eq. (16): f(x) = 1 / (1 + 0.5 x²).
+pub fn blend_weight(d: f64) -> f64 {
+    1.0 / (1.0 + 0.5 * d * d)
+}
+
+impl Merge {
+    /// A swarm on a small circle ahead of the vehicle (deterministic).
+    pub fn new(params: MergeParams) -> Self {
+        let n = params.agents.max(1);
+        let pos = (0..n).map(|i| v2(1.0, 0.0) + unit(std::f64::consts::TAU * i as f64 / n as f64) * 0.5).collect();
+        Merge { params, pos, vel: vec![Vec2::zeros(); n], last_target: Vec2::zeros(), last_f: 0.0 }
+    }
+
+    fn point(&self, cmd: &Command) -> Vec2 {
+        unit(cmd.steer) * (self.params.tau * cmd.v)
+    }
+
+    /// One tick: blends the path-following command `follow` (target
+    /// reaching) and the avoidance command `avoid` by the distance `d` to the
+    /// nearest obstacle (eq. 16), moves the particles in the force field of
+    /// the target, each other and the obstacle spots `spots` (vehicle frame;
+    /// eqs. 17–19), and reads the command off their centre of mass.
+    pub fn command(
+        &mut self,
+        follow: &Command,
+        avoid: &Command,
+        d: f64,
+        spots: &[Vec2],
+        params: &VehicleParams,
+        dt: f64,
+    ) -> Command {
+        let mp = self.params;
+        let f = blend_weight(d);
+        let mut t = self.point(avoid) * f + self.point(follow) * (1.0 - f);
+        // Keep the target on the frustum's border when out of range.
+        if t.norm() > mp.perception {
+            t = t.normalize() * mp.perception;
+        }
+        self.last_target = t;
+        self.last_f = f;
+        let h = dt / mp.substeps.max(1) as f64;
+        let n = self.pos.len();
+        let mut acc = vec![Vec2::zeros(); n];
+        for _ in 0..mp.substeps.max(1) {
+            for (i, acc_i) in acc.iter_mut().enumerate() {
+                let pi = self.pos[i];
+                // Eq. (17): linear attraction to the target.
+                let mut a = (t - pi) * mp.attraction;
+                // Eq. (18): r⁻² repulsion between particles.
+                for j in 0..n {
+                    if i != j {
+                        let d = pi - self.pos[j];
+                        let r = d.norm().max(0.1);
+                        a += d * (mp.repulsion / (r * r * r));
+                    }
+                }
+                // Eq. (19): repulsion by the obstacle spots in the frustum.
+                for s in spots {
+                    let d = pi - s;
+                    let r = d.norm().max(0.3);
+                    a += d * (mp.obstacle / (r * r * r));
+                }
+                *acc_i = a - self.vel[i] * mp.damping;
+            }
+            for ((p, v), a) in self.pos.iter_mut().zip(self.vel.iter_mut()).zip(&acc) {
+                *v += a * h;
+                *p += *v * h;
+                if p.norm() > mp.perception {
+                    *p = p.normalize() * mp.perception;
+                }
+            }
+        }
+        let mean = self.pos.iter().fold(Vec2::zeros(), |a, p| a + p) / n as f64;
+        let steer = mean.y.atan2(mean.x).clamp(-params.max_steer, params.max_steer);
+        let v = if mean.x > 0.0 { (mean.norm() / mp.tau).clamp(0.0, params.max_speed) } else { 0.0 };
+        Command { v, steer }
+    }
+}
+
+/// How the controllers are chosen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Strategy {
+    /// The hard switch of `rules/ugv.situ`.
+    HardSwitch,
+    /// The multi-agent merge.
+    Merge,
+}
+
+impl Strategy {
+    /// The name used on the command line (`hard-switch`, `merge`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Strategy::HardSwitch => "hard-switch",
+            Strategy::Merge => "merge",
+        }
+    }
+
+    /// Parses a command-line name.
+    pub fn parse(s: &str) -> Option<Strategy> {
+        match s {
+            "hard-switch" => Some(Strategy::HardSwitch),
+            "merge" => Some(Strategy::Merge),
+            _ => None,
+        }
+    }
+}
+
+/// One closed-loop run of the UGV on a world; stops at the goal, at the
+/// first collision (as in the paper), or after `cfg.max_time`.
+pub fn run(world: &World, strategy: Strategy, seed: u64, cfg: &UgvConfig) -> Metrics {
+    let params = world.vehicle;
+    let mut veh = Vehicle::new(params, world.start);
+    let goal_heading = world.goal.heading.unwrap_or(0.0);
+    let target = Target {
+        pose: Pose::new(world.goal.position.x, world.goal.position.y, goal_heading),
+        v: cfg.target_speed,
+        curvature: 0.0,
+    };
+    let mut noise = Noise::new(seed, 1);
+    let mut rec = Recorder::new(&world.name, strategy.name(), seed, cfg.dt);
+    let mut views = Vec::new();
+    world.obstacles_at(0.0, &mut views);
+    let mut switch = HardSwitch::default();
+    let mut merge = Merge::new(MergeParams::default());
+    let steps = (cfg.max_time / cfg.dt).round() as u64;
+    for k in 0..=steps {
+        let t = k as f64 * cfg.dt;
+        world.obstacles_at(t, &mut views);
+        let pose = veh.state.pose;
+        let seen = lidar_scan(&pose, &views, cfg, &mut noise);
+        let sel = select(&pose, &target.pose, &seen, &params, cfg);
+        let (cmd, label) = match strategy {
+            Strategy::HardSwitch => {
+                let mode = switch.step(&sel);
+                (hard_switch_command(&mode, &pose, &target, &params, cfg), mode.label())
+            }
+            Strategy::Merge => {
+                let follow = control_law(&target_reaching(&pose, &target), &cfg.gains, &params, params.max_speed);
+                let avoid = match sel.hinder {
+                    Some(h) => control_law(
+                        &limit_cycle(&pose, &h.cycle, h.direction(), params.max_speed / 2.0),
+                        &cfg.gains,
+                        &params,
+                        params.max_speed,
+                    ),
+                    None => follow,
+                };
+                // d of eq. (16): the distance to the nearest limit-cycle
+                // ellipse (it holds the vehicle's reach and the margin).
+                let grow = reach(&params) + cfg.safety_margin;
+                let d = seen.iter().map(|o| o.ellipse.grown(grow).distance(pose.pos())).fold(f64::INFINITY, f64::min);
+                let spots: Vec<Vec2> = seen
+                    .iter()
+                    .flat_map(|o| o.outline.iter())
+                    .map(|p| pose.to_local(*p))
+                    .filter(|p| p.norm() <= merge.params.perception)
+                    .collect();
+                (merge.command(&follow, &avoid, d, &spots, &params, cfg.dt), "Merge")
+            }
+        };
+        let closest = world.closest_obstacle(&pose, &views);
+        let ttc = world.time_to_collision(&pose, veh.state.v, &views, 20.0);
+        let closest_name = closest.map(|(_, i)| world.obstacles[i].id.as_str());
+        rec.record(
+            Sample {
+                t,
+                x: pose.x,
+                y: pose.y,
+                theta: pose.theta,
+                v: veh.state.v,
+                steer: veh.state.steer,
+                v_cmd: cmd.v,
+                steer_cmd: cmd.steer,
+                closest: closest.map(|c| c.0),
+                ttc,
+                label: label.into(),
+            },
+            closest_name,
+        );
+        if let Some(i) = world.collision(&pose, &views) {
+            rec.collision(t, &world.obstacles[i].id);
+            break;
+        }
+        if (pose.pos() - target.pose.pos()).norm() <= world.goal.tolerance {
+            rec.goal(t);
+            break;
+        }
+        veh.step(cmd, cfg.dt);
+    }
+    rec.finish()
+}
+
+/// "Near an obstacle": within this distance of the vehicle's outline (m).
+pub const NEAR: f64 = 2.0;
+
+/// One row of the comparison table.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ComparisonRow {
+    /// Strategy name.
+    pub strategy: String,
+    /// Largest |steering rate| of the commands (rad/s).
+    pub max_steer_rate: f64,
+    /// RMS steering rate of the commands (rad/s).
+    pub rms_steer_rate: f64,
+    /// Top commanded speed (m/s).
+    pub max_speed: f64,
+    /// Top commanded speed while an obstacle is within [`NEAR`] of the
+    /// vehicle's outline (m/s): "moving near obstacles at a greater speed".
+    pub max_speed_near: f64,
+    /// Mean speed (m/s).
+    pub mean_speed: f64,
+    /// Closest distance to an obstacle (m).
+    pub closest_distance: f64,
+    /// Smallest time to collision (s).
+    pub min_ttc: Option<f64>,
+    /// Number of collisions.
+    pub collisions: usize,
+    /// Time to goal (s).
+    pub time_to_goal: Option<f64>,
+}
+
+/// Dafflon et al.'s comparison: one row per strategy.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Comparison {
+    /// Scenario name.
+    pub scenario: String,
+    /// Noise seed.
+    pub seed: u64,
+    /// The rows, in the order asked.
+    pub rows: Vec<ComparisonRow>,
+    /// The runs' metrics, in the same order.
+    #[serde(skip)]
+    pub runs: Vec<Metrics>,
+}
+
+impl Comparison {
+    /// The row of a strategy.
+    pub fn row(&self, s: Strategy) -> Option<&ComparisonRow> {
+        self.rows.iter().find(|r| r.strategy == s.name())
+    }
+}
+
+impl fmt::Display for Comparison {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "scenario {} (seed {})", self.scenario, self.seed)?;
+        writeln!(
+            f,
+            "{:<12} {:>12} {:>10} {:>7} {:>12} {:>7} {:>8} {:>8} {:>10} {:>8}",
+            "strategy",
+            "max |dγ/dt|",
+            "rms dγ/dt",
+            "top v",
+            "top v near",
+            "mean v",
+            "closest",
+            "min TTC",
+            "collisions",
+            "goal at"
+        )?;
+        writeln!(
+            f,
+            "{:<12} {:>12} {:>10} {:>7} {:>12} {:>7} {:>8} {:>8} {:>10} {:>8}",
+            "", "(rad/s)", "(rad/s)", "(m/s)", "(m/s)", "(m/s)", "(m)", "(s)", "", "(s)"
+        )?;
+        for r in &self.rows {
+            let opt = |o: Option<f64>| o.map_or("-".to_string(), |v| format!("{v:.2}"));
+            writeln!(
+                f,
+                "{:<12} {:>12.3} {:>10.3} {:>7.2} {:>12.2} {:>7.2} {:>8.2} {:>8} {:>10} {:>8}",
+                r.strategy,
+                r.max_steer_rate,
+                r.rms_steer_rate,
+                r.max_speed,
+                r.max_speed_near,
+                r.mean_speed,
+                r.closest_distance,
+                opt(r.min_ttc),
+                r.collisions,
+                opt(r.time_to_goal)
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// Runs each strategy on a world with the same seed and tabulates the
+/// metrics (`situ run rules/ugv.situ --scenario dafflon-4 --compare hard-switch,merge`).
+pub fn compare(world: &World, strategies: &[Strategy], seed: u64, cfg: &UgvConfig) -> Comparison {
+    let mut rows = Vec::new();
+    let mut runs = Vec::new();
+    for &s in strategies {
+        let m = run(world, s, seed, cfg);
+        let sum = &m.summary;
+        rows.push(ComparisonRow {
+            strategy: s.name().into(),
+            max_steer_rate: sum.max_steer_rate,
+            rms_steer_rate: sum.rms_steer_rate,
+            max_speed: sum.max_speed,
+            max_speed_near: m
+                .samples
+                .iter()
+                .filter(|s| s.closest.is_some_and(|c| c < NEAR))
+                .map(|s| s.v_cmd)
+                .fold(0.0, f64::max),
+            mean_speed: sum.mean_speed,
+            closest_distance: sum.closest_distance.unwrap_or(f64::INFINITY),
+            min_ttc: sum.min_ttc,
+            collisions: sum.collisions.len(),
+            time_to_goal: sum.time_to_goal,
+        });
+        runs.push(m);
+    }
+    Comparison { scenario: world.name.clone(), seed, rows, runs }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn hinder(side: Side, distance: f64) -> Selection {
+        let cycle = Ellipse { center: v2(5.0, 0.0), a: 2.0, b: 2.0, omega: 0.0 };
+        Selection { hinder: Some(Hinder { index: 0, side, cycle, distance }), nearest: distance, influence: 1.5 }
+    }
+
+    fn free() -> Selection {
+        Selection { hinder: None, nearest: 15.0, influence: 1.5 }
+    }
+
+    #[test]
+    fn hard_switch_mirrors_the_rules() {
+        let mut hs = HardSwitch::default();
+        assert_eq!(hs.step(&hinder(Side::Left, 4.0)).label(), "Reaching", "waits for the radius of influence");
+        assert_eq!(hs.step(&hinder(Side::Left, 1.2)).label(), "AvoidCCW", "left: counter-clockwise");
+        assert_eq!(hs.step(&hinder(Side::Right, 1.0)).label(), "AvoidCCW", "no flip mid-avoidance");
+        hs.step(&free());
+        assert_eq!(hs.step(&free()).label(), "AvoidCCW");
+        assert_eq!(hs.step(&free()).label(), "Reaching", "FREE x3");
+        assert_eq!(hs.step(&hinder(Side::Right, 1.0)).label(), "AvoidCW", "right: clockwise");
+    }
+
+    #[test]
+    fn selection_finds_the_hindering_obstacle_and_its_side() {
+        let params = VehicleParams::urban();
+        let cfg = UgvConfig::default();
+        let mut views = Vec::new();
+        let world = crate::scenario::dafflon_4().world;
+        world.obstacles_at(0.0, &mut views);
+        let mut noise = Noise::new(1, 1);
+        let pose = Pose::new(5.0, 0.0, 0.0);
+        let seen = lidar_scan(&pose, &views, &cfg, &mut noise);
+        assert!(!seen.is_empty());
+        let sel = select(&pose, &Pose::new(60.0, 0.0, 0.0), &seen, &params, &cfg);
+        let h = sel.hinder.expect("O1 hinders");
+        assert_eq!(world.obstacles[h.index].id, "O1");
+        assert_eq!(h.side, Side::Left, "O1 is at y = +0.5");
+        // Aim beside it: nothing hinders.
+        let sel = select(&pose, &Pose::new(12.0, -8.0, 0.0), &seen, &params, &cfg);
+        assert!(sel.hinder.is_none());
+    }
+
+    #[test]
+    fn merge_without_obstacles_gives_the_follow_command() {
+        let params = VehicleParams::urban();
+        let mut m = Merge::new(MergeParams::default());
+        let follow = Command { v: 1.5, steer: 0.2 };
+        let mut cmd = Command::default();
+        for _ in 0..200 {
+            cmd = m.command(&follow, &follow, f64::INFINITY, &[], &params, 0.05);
+        }
+        assert!((cmd.v - 1.5).abs() < 0.01 && (cmd.steer - 0.2).abs() < 0.01, "{cmd:?}");
+        assert!(blend_weight(0.0) == 1.0 && blend_weight(2.0) == 1.0 / 3.0);
+    }
+}
