@@ -8,10 +8,13 @@
 //! - [`bulletinboard`]: the Bulletinboard of Zhang & Zhu (2005) around it:
 //!   posting events, the state history, subscriptions, explanations, hot swap;
 //! - [`stream`]: seeded random event streams and their text form, for
-//!   benchmarks and differential tests.
+//!   benchmarks and differential tests;
+//! - [`verify`]: `situ test`: scenario tests, and properties checked by
+//!   random search with shrinking and by exhaustive exploration.
 
 pub mod bench;
 pub mod bulletinboard;
 pub mod organise;
 pub mod rete;
 pub mod stream;
+pub mod verify;
