@@ -115,7 +115,7 @@ enum Command {
         #[arg(long, default_value_t = 256)]
         cases: u32,
         /// Events per random run.
-        #[arg(long, default_value_t = 40)]
+        #[arg(long, default_value_t = 120)]
         length: usize,
         /// The most events the exhaustive exploration goes from the start.
         #[arg(long, default_value_t = 12)]
