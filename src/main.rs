@@ -127,6 +127,22 @@ enum Command {
         #[arg(long)]
         stats: bool,
     },
+    /// Export the abstraction and the properties of a rule file to another tool.
+    Export {
+        /// A Promela model for spin (one property per `-DPROP=k`).
+        #[arg(long, required = true)]
+        promela: bool,
+        file: PathBuf,
+        /// Write here instead of standard output.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// The most events the exploration goes from the start.
+        #[arg(long, default_value_t = 12)]
+        depth: usize,
+        /// The most abstract states.
+        #[arg(long, default_value_t = 20_000)]
+        max_states: usize,
+    },
 }
 
 fn main() -> ExitCode {
@@ -154,6 +170,9 @@ fn main() -> ExitCode {
                 max_states,
                 stats,
             })
+        }
+        Command::Export { promela: _, file, output, depth, max_states } => {
+            cmd::export::run(&file, output.as_ref(), depth, max_states)
         }
         Command::Graph { file, view, state, format, output } => {
             cmd::graph::run(&file, view, state.as_deref(), format, output.as_ref())

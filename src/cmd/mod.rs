@@ -4,6 +4,7 @@ pub mod bench;
 pub mod build;
 pub mod check;
 pub mod explain;
+pub mod export;
 pub mod fmt;
 pub mod graph;
 pub mod program;

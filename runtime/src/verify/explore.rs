@@ -40,19 +40,19 @@ pub struct Limits {
 }
 
 #[derive(Debug, Clone)]
-struct Node {
-    depth: u32,
-    expanded: bool,
+pub(super) struct Node {
+    pub(super) depth: u32,
+    pub(super) expanded: bool,
     /// The rules did not come to rest here (a cascade): every run that
     /// reaches it fails.
-    error: Option<String>,
+    pub(super) error: Option<String>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-struct Edge {
-    to: u32,
-    gap: u8,
-    letter: u32,
+pub(super) struct Edge {
+    pub(super) to: u32,
+    pub(super) gap: u8,
+    pub(super) letter: u32,
 }
 
 /// The explored abstract state graph.
@@ -60,11 +60,11 @@ pub struct Graph {
     content: Arc<Content>,
     pub alphabet: Alphabet,
     properties: usize,
-    nodes: Vec<Node>,
+    pub(super) nodes: Vec<Node>,
     /// Per node, its premise and consequent values, two bits per property.
     bits: Vec<bool>,
-    succ: Vec<(u32, u32)>,
-    edges: Vec<Edge>,
+    pub(super) succ: Vec<(u32, u32)>,
+    pub(super) edges: Vec<Edge>,
     /// Every node was expanded.
     pub closed: bool,
     /// Every run of up to this many events is in the graph.
@@ -198,7 +198,7 @@ impl Graph {
         self.nodes.iter().map(|n| n.depth as usize).max().unwrap_or(0)
     }
 
-    fn point(&self, node: u32, property: usize) -> (bool, bool) {
+    pub(super) fn point(&self, node: u32, property: usize) -> (bool, bool) {
         let at = (node as usize * self.properties + property) * 2;
         (self.bits[at], self.bits[at + 1])
     }

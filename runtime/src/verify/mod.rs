@@ -7,6 +7,7 @@
 //!   point along a run by a small monitor whose state is part of the search;
 //! - [`random`] searches runs at random (proptest, guided by the rules) and
 //!   shrinks a failing run to a minimal one;
+//! - [`promela`] writes the explored abstraction as a Promela model for spin;
 //! - [`explore`] explores a finite abstraction of the system breadth first
 //!   ([`abstraction`]): it proves a property, or finds its shortest
 //!   counterexample, or says up to which depth it found none.
@@ -18,6 +19,7 @@
 pub mod abstraction;
 pub mod explore;
 pub mod monitor;
+pub mod promela;
 pub mod random;
 pub mod scenario;
 
