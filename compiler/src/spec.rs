@@ -7,7 +7,7 @@
 //! §10.9), so that the runtime posts exactly what the reference describes.
 
 use crate::bundle::{self, Mode, Test as FieldTest, Value};
-use crate::model::{self, Model};
+use crate::model;
 use crate::{rete, Checked};
 use serde::Serialize;
 
@@ -47,10 +47,17 @@ pub struct TestSpec {
 #[derive(Debug, Clone, Serialize)]
 pub enum TestStep {
     /// Set the state and facts (stamped at 0) without firing rules or FSMs.
-    Given { state: Option<u32>, facts: Vec<GivenFact> },
+    Given {
+        state: Option<u32>,
+        facts: Vec<GivenFact>,
+    },
     /// Post these events, in order, at these times.
-    On { events: Vec<Posted> },
-    Expect { expectations: Vec<Expect> },
+    On {
+        events: Vec<Posted>,
+    },
+    Expect {
+        expectations: Vec<Expect>,
+    },
 }
 
 /// A fact set by `given`: the event with run length `run`, at time 0.
@@ -121,12 +128,22 @@ pub enum Pred {
     Bool(bool),
     /// The state is one of these (sorted).
     State(Vec<u32>),
-    Mode { agent: u32, mode: Mode },
-    Link { from: u32, to: u32 },
+    Mode {
+        agent: u32,
+        mode: Mode,
+    },
+    Link {
+        from: u32,
+        to: u32,
+    },
     Stale(u32),
     /// The latest live fact of the event's agent is this event, passes the
     /// tests (on its own fields) and has run length `min_run` or more.
-    Event { event: u32, tests: Vec<FieldTest>, min_run: u64 },
+    Event {
+        event: u32,
+        tests: Vec<FieldTest>,
+        min_run: u64,
+    },
 }
 
 impl Pred {
@@ -160,7 +177,7 @@ pub fn lower(checked: &Checked) -> Spec {
     };
     let model = &checked.model;
     let tests = model.tests.iter().map(|t| test(t, &place)).collect();
-    let properties = model.properties.iter().map(|p| property(model, p, &place)).collect();
+    let properties = model.properties.iter().map(|p| property(p, &place)).collect();
     Spec { tests, properties }
 }
 
@@ -196,9 +213,9 @@ fn test(t: &model::Test, place: &dyn Fn(model::Origin) -> Place) -> TestSpec {
                 }
                 TestStep::On { events: posted }
             }
-            model::TestStep::Expect { expectations, .. } => TestStep::Expect {
-                expectations: expectations.iter().map(|e| expectation(e, place)).collect(),
-            },
+            model::TestStep::Expect { expectations, .. } => {
+                TestStep::Expect { expectations: expectations.iter().map(|e| expectation(e, place)).collect() }
+            }
         })
         .collect();
     TestSpec { name: t.name.clone(), place: place(t.origin), steps }
@@ -240,22 +257,22 @@ fn expectation(e: &model::Expectation, place: &dyn Fn(model::Origin) -> Place) -
     Expect { what, place: place(*origin) }
 }
 
-fn property(model: &Model, p: &model::Property, place: &dyn Fn(model::Origin) -> Place) -> PropertySpec {
+fn property(p: &model::Property, place: &dyn Fn(model::Origin) -> Place) -> PropertySpec {
     let (premise, consequent) = match &p.formula {
-        model::Formula::Now(q) => (None, Consequent::Now(pred(model, q))),
+        model::Formula::Now(q) => (None, Consequent::Now(pred(q))),
         model::Formula::Implies { premise, consequent } => {
             let c = match consequent {
-                model::Consequent::Now(q) => Consequent::Now(pred(model, q)),
-                model::Consequent::Next(q) => Consequent::Next(pred(model, q)),
+                model::Consequent::Now(q) => Consequent::Now(pred(q)),
+                model::Consequent::Next(q) => Consequent::Next(pred(q)),
                 model::Consequent::Eventually { pred: q, bound } => Consequent::Eventually {
-                    pred: pred(model, q),
+                    pred: pred(q),
                     bound: bound.map(|b| match b {
                         model::Bound::Events(n) => Bound::Events(n),
                         model::Bound::Nanos(n) => Bound::Nanos(n),
                     }),
                 },
             };
-            (Some(pred(model, premise)), c)
+            (Some(pred(premise)), c)
         }
     };
     PropertySpec {
@@ -267,20 +284,18 @@ fn property(model: &Model, p: &model::Property, place: &dyn Fn(model::Origin) ->
     }
 }
 
-fn pred(model: &Model, p: &model::Pred) -> Pred {
+fn pred(p: &model::Pred) -> Pred {
     match p {
-        model::Pred::Or(ps) => Pred::Or(ps.iter().map(|p| pred(model, p)).collect()),
-        model::Pred::And(ps) => Pred::And(ps.iter().map(|p| pred(model, p)).collect()),
-        model::Pred::Not(q) => Pred::Not(Box::new(pred(model, q))),
+        model::Pred::Or(ps) => Pred::Or(ps.iter().map(pred).collect()),
+        model::Pred::And(ps) => Pred::And(ps.iter().map(pred).collect()),
+        model::Pred::Not(q) => Pred::Not(Box::new(pred(q))),
         model::Pred::Bool(b) => Pred::Bool(*b),
         model::Pred::State(set) => Pred::State(set.states.iter().map(|s| s.0).collect()),
         model::Pred::Mode { agent, mode } => Pred::Mode { agent: agent.0, mode: bundle::build::mode(*mode) },
         model::Pred::Link { from, to } => Pred::Link { from: from.0, to: to.0 },
         model::Pred::Stale(a) => Pred::Stale(a.0),
-        model::Pred::Event { pattern, .. } => Pred::Event {
-            event: pattern.event.0,
-            tests: rete::pattern_alone(pattern),
-            min_run: pattern.run_length,
-        },
+        model::Pred::Event { pattern, .. } => {
+            Pred::Event { event: pattern.event.0, tests: rete::pattern_alone(pattern), min_run: pattern.run_length }
+        }
     }
 }

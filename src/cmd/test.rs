@@ -66,7 +66,9 @@ impl PropertyResult {
                 _ => None,
             }
         }
-        of(&self.exhaustive).map(|c| ("exhaustive, shortest", c)).or_else(|| of(&self.random).map(|c| ("random, shrunk", c)))
+        of(&self.exhaustive)
+            .map(|c| ("exhaustive, shortest", c))
+            .or_else(|| of(&self.random).map(|c| ("random, shrunk", c)))
     }
 }
 

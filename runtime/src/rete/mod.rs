@@ -299,7 +299,13 @@ impl Engine {
         }
         let n = self.content.events.get(slot.event as usize).map_or(0, |e| e.fields.len());
         let at = self.net.payload_at[agent as usize] as usize;
-        Some(FactView { event: slot.event, payload: &self.payload[at..at + n], time: slot.time, run: slot.run, seq: slot.seq })
+        Some(FactView {
+            event: slot.event,
+            payload: &self.payload[at..at + n],
+            time: slot.time,
+            run: slot.run,
+            seq: slot.seq,
+        })
     }
 
     /// Makes `self` a copy of `other` (an engine of the same bundle),

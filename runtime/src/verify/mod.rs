@@ -80,9 +80,9 @@ impl System {
             Pred::Stale(agent) => self.engine.is_stale(*agent),
             Pred::Event { event, tests, min_run } => {
                 let agent = self.content().events[*event as usize].agent;
-                self.engine
-                    .fact_view(agent)
-                    .is_some_and(|f| f.event == *event && f.run >= *min_run && tests.iter().all(|t| passes(t, f.payload)))
+                self.engine.fact_view(agent).is_some_and(|f| {
+                    f.event == *event && f.run >= *min_run && tests.iter().all(|t| passes(t, f.payload))
+                })
             }
         }
     }
@@ -135,9 +135,9 @@ pub fn show_event(c: &Content, event: u32, payload: &[Value]) -> String {
 
 /// A duration as situ writes it, exactly: `500ms`, `300000001ns`.
 pub fn show_duration(ns: u64) -> String {
-    if ns % 1_000_000 == 0 {
+    if ns / 1_000_000 * 1_000_000 == ns {
         format!("{}ms", ns / 1_000_000)
-    } else if ns % 1_000 == 0 {
+    } else if ns / 1_000 * 1_000 == ns {
         format!("{}us", ns / 1_000)
     } else {
         format!("{ns}ns")
@@ -244,15 +244,28 @@ impl Counterexample {
 pub enum Verdict {
     /// It holds on every run: the abstract space was explored whole and the
     /// abstraction is exact for this program.
-    Proved { states: usize },
+    Proved {
+        states: usize,
+    },
     /// No counterexample in the whole abstract space, but the abstraction
     /// samples something (time gaps, values compared with variables): see `note`.
-    Exhausted { states: usize, note: String },
+    Exhausted {
+        states: usize,
+        note: String,
+    },
     /// No counterexample among the runs explored: up to `depth` events (exhaustive),
     /// or `runs` random runs.
-    Bounded { depth: usize, states: usize, note: String },
+    Bounded {
+        depth: usize,
+        states: usize,
+        note: String,
+    },
     /// No counterexample in `runs` random runs of up to `length` events.
-    NotFound { runs: u64, length: usize, steps: u64 },
+    NotFound {
+        runs: u64,
+        length: usize,
+        steps: u64,
+    },
     Failed(Counterexample),
 }
 

@@ -131,8 +131,7 @@ impl Monitor {
             (Kind::Eventually { events, nanos }, true) => {
                 if st.pending {
                     self.advance(st, gap);
-                    let expired =
-                        nanos.is_some_and(|d| st.nanos > d) || events.is_some_and(|n| st.events > n);
+                    let expired = nanos.is_some_and(|d| st.nanos > d) || events.is_some_and(|n| st.events > n);
                     if expired {
                         *st = MonitorState::default();
                     } else if q {

@@ -107,7 +107,15 @@ const GAP_OPTIONS: usize = 3;
 
 impl RunTree {
     fn new(run: Vec<RunStep>, alphabet: Arc<Alphabet>) -> RunTree {
-        RunTree { current: run, previous: None, alphabet, phase: Phase::Remove, cursor: 0, removed_in_pass: false, passes: 0 }
+        RunTree {
+            current: run,
+            previous: None,
+            alphabet,
+            phase: Phase::Remove,
+            cursor: 0,
+            removed_in_pass: false,
+            passes: 0,
+        }
     }
 
     /// The next candidate at or after the cursor, if any.
@@ -272,13 +280,13 @@ pub fn search(content: &Arc<Content>, alphabet: &Arc<Alphabet>, property: &Prope
     seed[..8].copy_from_slice(&s.seed.to_le_bytes());
     let mut runner = TestRunner::new_with_rng(config, TestRng::from_seed(RngAlgorithm::ChaCha, &seed));
     let steps = Cell::new(0u64);
-    let result = runner.run(&strategy, |run| {
-        check_run(content, property, &run, &steps).map_err(|(_, why)| TestCaseError::fail(why))
-    });
+    let result = runner
+        .run(&strategy, |run| check_run(content, property, &run, &steps).map_err(|(_, why)| TestCaseError::fail(why)));
     match result {
         Ok(()) => Verdict::NotFound { runs: s.cases as u64, length: s.length, steps: steps.get() },
         Err(TestError::Fail(_, run)) => {
-            let (point, reason) = check_run(content, property, &run, &steps).err().unwrap_or((run.len(), String::new()));
+            let (point, reason) =
+                check_run(content, property, &run, &steps).err().unwrap_or((run.len(), String::new()));
             let run = &run[..point.min(run.len())];
             Verdict::Failed(Counterexample::replay(content, run, point, reason))
         }

@@ -91,7 +91,14 @@ fn check(sys: &System, what: Expected) -> Option<String> {
         Expected::Mode { agent: a, mode } => {
             let found = sys.org.mode(a);
             (found != mode).then(|| {
-                format!("expected {} {}, found {} {} in {}", agent(a), mode.adjective(), agent(a), found.adjective(), state(sys.engine.state()))
+                format!(
+                    "expected {} {}, found {} {} in {}",
+                    agent(a),
+                    mode.adjective(),
+                    agent(a),
+                    found.adjective(),
+                    state(sys.engine.state())
+                )
             })
         }
         Expected::Runs { agent: a, function } => {
