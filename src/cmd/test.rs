@@ -11,6 +11,7 @@ use situ_compiler::render;
 use situ_compiler::spec::{self, PropertySpec, TestSpec};
 use situ_runtime::verify::abstraction::Alphabet;
 use situ_runtime::verify::explore::{Graph, Limits};
+use situ_runtime::verify::monitor::Monitor;
 use situ_runtime::verify::random::{self, Search};
 use situ_runtime::verify::{scenario, show_event, Counterexample, Verdict};
 use std::path::PathBuf;
@@ -66,9 +67,14 @@ impl PropertyResult {
                 _ => None,
             }
         }
-        of(&self.exhaustive)
-            .map(|c| ("exhaustive, shortest", c))
-            .or_else(|| of(&self.random).map(|c| ("random, shrunk", c)))
+        let how = |c: &Counterexample| {
+            if c.reason.contains("repeat forever") {
+                "exhaustive, a lasso"
+            } else {
+                "exhaustive, shortest"
+            }
+        };
+        of(&self.exhaustive).map(|c| (how(c), c)).or_else(|| of(&self.random).map(|c| ("random, shrunk", c)))
     }
 }
 
@@ -144,6 +150,14 @@ pub fn run(args: Args) -> u8 {
                     .iter()
                     .filter_map(|(name, v)| v.as_ref().map(|v| format!("{name}: {}", v.summary())))
                     .collect();
+                let lines = match (&r.random, args.engine) {
+                    (None, Engine::Both | Engine::Random) => {
+                        let mut l = lines;
+                        l.push("random: not run (an unbounded `eventually` is decided on infinite runs)".into());
+                        l
+                    }
+                    _ => lines,
+                };
                 if human {
                     println!("property \"{}\" ... {}", p.name, if r.failed() { "FAILED" } else { "ok" });
                     for l in &lines {
@@ -212,7 +226,10 @@ fn check_properties(args: &Args, content: &Arc<Content>, props: &[&PropertySpec]
         .enumerate()
         .map(|(i, p)| {
             let exhaustive = graph.as_ref().map(|g| g.check(i, p));
-            let random = (args.engine != Engine::Exhaustive).then(|| {
+            // Unbounded `eventually` is decided on infinite runs: not by random runs.
+            let m = Monitor::new(p);
+            let decided = !m.is_liveness() || m.never;
+            let random = (args.engine != Engine::Exhaustive && decided).then(|| {
                 let start = Instant::now();
                 let v = random::search(
                     content,

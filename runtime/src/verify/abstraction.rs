@@ -421,7 +421,9 @@ fn candidates(ty: &FieldType, consts: &[f64], two: bool) -> Vec<Value> {
                 }
             } else {
                 let (lo, hi) = (cs[0], cs[cs.len() - 1]);
-                out.push(lo.floor() - 1.0);
+                // Below the smallest constant: 0 when it is positive (most
+                // quantities are), else the integer below.
+                out.push(if lo > 0.0 { 0.0 } else { lo.floor() - 1.0 });
                 if two {
                     out.push(lo.floor() - 2.0);
                 }

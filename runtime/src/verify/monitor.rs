@@ -85,9 +85,7 @@ impl Monitor {
     pub fn step(&self, st: &mut MonitorState, p: bool, q: bool, gap: u64) -> Option<String> {
         match (self.kind, self.never) {
             (Kind::Now, false) => (p && !q).then(|| "the premise holds and the consequent does not".into()),
-            (Kind::Now, true) => {
-                (!p || q).then(|| "the formula holds (a `never` property must hold at no point)".into())
-            }
+            (Kind::Now, true) => (!p || q).then(|| "it holds here (a `never` property must hold at no point)".into()),
             (Kind::Next, never) => {
                 let mut out = None;
                 if st.pending {
