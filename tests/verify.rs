@@ -7,7 +7,7 @@
 //!   checker finds one too, shrunk to at most N + 2 events (unbounded
 //!   `eventually` is left to the exhaustive checker);
 //! - `//~ PROVED`: the exhaustive checker proves it (closed space, exact
-//!   abstraction);
+//!   abstraction), and the random checker finds no counterexample;
 //! - `//~ EXHAUSTED`: no counterexample in the whole abstract space, whose
 //!   time gaps are sampled.
 //!
@@ -81,6 +81,13 @@ fn planted_bugs_are_found_and_correct_properties_proved() {
                 (Expect::Fails(n), Verdict::Failed(c)) if c.steps.len() == n => {}
                 (Expect::Proved, Verdict::Proved { .. }) | (Expect::Exhausted, Verdict::Exhausted { .. }) => {}
                 _ => failures.push(format!("{name}: expected {want:?}, exhaustive found {got:?}")),
+            }
+            if want == Expect::Proved && !liveness(p) {
+                // What is proved, the random checker cannot break.
+                let r = random::search(&content, &alphabet, p, Search { seed: 11, cases: 300, length: 30 });
+                if r.failed() {
+                    failures.push(format!("{name}: proved, yet the random checker found {}", r.summary()));
+                }
             }
             if let (Expect::Fails(n), false) = (want, liveness(p)) {
                 let r = random::search(&content, &alphabet, p, Search { seed: 7, cases: 2000, length: 30 });

@@ -73,6 +73,9 @@ pub struct Alphabet {
     pub samples: Vec<String>,
 }
 
+/// The most gaps (an edge stores its gap's index in a byte).
+const MAX_GAPS: usize = 255;
+
 /// The most letters one event may have; more are cut (and said).
 const MAX_LETTERS_PER_EVENT: usize = 512;
 
@@ -162,9 +165,13 @@ impl Alphabet {
         let age_cap = thresholds.iter().map(|t| t.last().map_or(0, |m| m.saturating_add(1))).collect();
         let mut gaps = vec![0u64];
         gaps.extend(durations.iter().map(|d| d.saturating_add(1)));
+        let mut samples = Vec::new();
+        if gaps.len() > MAX_GAPS {
+            gaps.truncate(MAX_GAPS);
+            samples.push(format!("only the {MAX_GAPS} shortest gaps are explored"));
+        }
 
         // Linked fields: groups by union-find, and their merged constants.
-        let mut samples = Vec::new();
         let index: Vec<usize> = c
             .events
             .iter()
