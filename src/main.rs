@@ -96,6 +96,53 @@ enum Command {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
+    /// Run the tests and check the properties of rule files; exit 0 all hold, 1 a failure, 2 usage or I/O.
+    Test {
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Only the tests and properties whose name contains this.
+        #[arg(long)]
+        filter: Option<String>,
+        #[arg(long, value_enum, default_value_t = cmd::test::Format::Human)]
+        format: cmd::test::Format,
+        /// Which checkers look at the properties.
+        #[arg(long, value_enum, default_value_t = cmd::test::Engine::Both)]
+        engine: cmd::test::Engine,
+        /// The seed of the random search.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Random runs per property.
+        #[arg(long, default_value_t = 256)]
+        cases: u32,
+        /// Events per random run.
+        #[arg(long, default_value_t = 120)]
+        length: usize,
+        /// The most events the exhaustive exploration goes from the start.
+        #[arg(long, default_value_t = 12)]
+        depth: usize,
+        /// The most abstract states the exhaustive exploration makes.
+        #[arg(long, default_value_t = 20_000)]
+        max_states: usize,
+        /// Print the size and time of the exploration and the random search.
+        #[arg(long)]
+        stats: bool,
+    },
+    /// Export the abstraction and the properties of a rule file to another tool.
+    Export {
+        /// A Promela model for spin (one property per `-DPROP=k`).
+        #[arg(long, required = true)]
+        promela: bool,
+        file: PathBuf,
+        /// Write here instead of standard output.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// The most events the exploration goes from the start.
+        #[arg(long, default_value_t = 12)]
+        depth: usize,
+        /// The most abstract states.
+        #[arg(long, default_value_t = 20_000)]
+        max_states: usize,
+    },
 }
 
 fn main() -> ExitCode {
@@ -109,6 +156,23 @@ fn main() -> ExitCode {
         }
         Command::Bench { file, events, seed, stream_in, stream_out, states_out, no_reset } => {
             cmd::bench::run(cmd::bench::Args { file, events, seed, stream_in, stream_out, states_out, no_reset })
+        }
+        Command::Test { files, filter, format, engine, seed, cases, length, depth, max_states, stats } => {
+            cmd::test::run(cmd::test::Args {
+                files,
+                filter,
+                format,
+                engine,
+                seed,
+                cases,
+                length,
+                depth,
+                max_states,
+                stats,
+            })
+        }
+        Command::Export { promela: _, file, output, depth, max_states } => {
+            cmd::export::run(&file, output.as_ref(), depth, max_states)
         }
         Command::Graph { file, view, state, format, output } => {
             cmd::graph::run(&file, view, state.as_deref(), format, output.as_ref())

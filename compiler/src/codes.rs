@@ -58,6 +58,7 @@ codes! {
     NEVER_STALE = "E0114", Error, "stale test on an agent that never goes stale";
     FSM_INITIAL = "E0115", Error, "not exactly one initial FSM state";
     SELF_LINK = "E0116", Error, "agent links to itself";
+    TEST_TIME_ORDER = "E0117", Error, "test event earlier than the previous one";
     TYPE_MISMATCH = "E0201", Error, "type mismatch";
     UNKNOWN_SYMBOL = "E0202", Error, "unknown symbol";
     BAD_OPERATOR = "E0203", Error, "operator does not apply to this type";

@@ -36,6 +36,7 @@ pub mod render;
 mod resolve;
 pub mod rete;
 pub mod source;
+pub mod spec;
 
 pub use load::RootError;
 pub use loader::Loader;

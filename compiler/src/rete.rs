@@ -243,6 +243,25 @@ fn ranges(p: &Pattern) -> Vec<Test> {
         .collect()
 }
 
+/// The tests of a pattern that stands alone (a property's event atom): its
+/// variables are local, so every test is on its own fact (alpha tests).
+pub fn pattern_alone(p: &Pattern) -> Vec<Test> {
+    let mut sites: HashMap<VarId, (usize, u32)> = HashMap::new();
+    for t in &p.tests {
+        if let FieldCheck::Bind(v) = t.check {
+            sites.entry(v).or_insert((0, t.field as u32));
+        }
+    }
+    let mut alpha = vec![Vec::new()];
+    let mut beta = vec![Vec::new()];
+    for c in comparisons(p, 0, &|v| sites.get(&v).copied()) {
+        place(c, 0, &mut alpha, &mut beta, &|_| 0);
+    }
+    let mut tests = std::mem::take(&mut alpha[0]);
+    tests.extend(ranges(p));
+    tests
+}
+
 /// `a op b` is `b flip(op) a`.
 fn flip(op: Cmp) -> Cmp {
     match op {

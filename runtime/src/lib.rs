@@ -8,7 +8,9 @@
 //! - [`bulletinboard`]: the Bulletinboard of Zhang & Zhu (2005) around it:
 //!   posting events, the state history, subscriptions, explanations, hot swap;
 //! - [`stream`]: seeded random event streams and their text form, for
-//!   benchmarks and differential tests.
+//!   benchmarks and differential tests;
+//! - [`verify`]: `situ test`: scenario tests, and properties checked by
+//!   random search with shrinking and by exhaustive exploration.
 
 pub mod agent;
 pub mod bench;
@@ -23,3 +25,4 @@ pub mod sched;
 pub mod stack;
 pub mod stream;
 pub mod summary;
+pub mod verify;

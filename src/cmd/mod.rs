@@ -4,9 +4,11 @@ pub mod bench;
 pub mod build;
 pub mod check;
 pub mod explain;
+pub mod export;
 pub mod fmt;
 pub mod graph;
 pub mod program;
+pub mod test;
 
 use std::io::IsTerminal;
 use std::path::Path;

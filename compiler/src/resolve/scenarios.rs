@@ -16,6 +16,8 @@ pub(super) fn test(cx: &mut Cx, file: FileId, test: &ast::Test) {
     }
     let mut steps = Vec::new();
     let mut ok = true;
+    // The time of the latest posted event (§10.9), for E0117.
+    let mut last: Option<(u64, ast::Span)> = None;
     for clause in &test.clauses {
         let step = match clause {
             ast::TestClause::Given { items, span } => {
@@ -38,6 +40,9 @@ pub(super) fn test(cx: &mut Cx, file: FileId, test: &ast::Test) {
             ast::TestClause::On { events, span } => {
                 let facts: Vec<EventFact> = events.iter().filter_map(|e| event_fact(cx, file, e)).collect();
                 ok &= facts.len() == events.len();
+                for (fact, e) in facts.iter().zip(events) {
+                    ok &= time_order(cx, file, fact, e, &mut last);
+                }
                 TestStep::On { events: facts, origin: Cx::origin(file, *span) }
             }
             ast::TestClause::Expect { expectations, span } => {
@@ -51,6 +56,48 @@ pub(super) fn test(cx: &mut Cx, file: FileId, test: &ast::Test) {
     if ok {
         cx.model.tests.push(Test { name: test.name.value.clone(), steps, origin });
     }
+}
+
+/// E0117: an event stamped `at` a time before the previous posted event.
+/// Advances `last` to the time of the fact's last copy.
+fn time_order(
+    cx: &mut Cx,
+    file: FileId,
+    fact: &EventFact,
+    e: &ast::EventInstance,
+    last: &mut Option<(u64, ast::Span)>,
+) -> bool {
+    let mut at = last.map_or(0, |(t, _)| t);
+    let times = crate::spec::post_times(&mut at, fact);
+    let first = times.first().copied().unwrap_or(at);
+    let ok = match *last {
+        Some((previous, span)) if first < previous => {
+            let show = |ns: u64| format!("{}ms", ns as f64 / 1e6);
+            cx.diags.push(
+                Diagnostic::error(
+                    codes::TEST_TIME_ORDER,
+                    format!(
+                        "`{}` is posted at {}, before the previous event ({})",
+                        e.event.name,
+                        show(first),
+                        show(previous)
+                    ),
+                    file,
+                    e.span,
+                    "earlier than the previous event",
+                )
+                .with_label(file, span, format!("posted at {}", show(previous)))
+                .with_help(format!(
+                    "time only moves forward in a test: stamp it `at {}` or later, or move it before the earlier event",
+                    show(previous)
+                )),
+            );
+            false
+        }
+        _ => true,
+    };
+    *last = Some((at, e.span));
+    ok
 }
 
 /// A concrete event: every field given once, each of the right type.

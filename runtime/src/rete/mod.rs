@@ -54,6 +54,17 @@ pub struct MatchedFact {
     pub run: u64,
 }
 
+/// An agent's live fact, borrowed from the working memory.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FactView<'a> {
+    pub event: u32,
+    pub payload: &'a [Value],
+    pub time: u64,
+    pub run: u64,
+    /// The posting sequence number: a later report has a larger one.
+    pub seq: u64,
+}
+
 /// One rule firing.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Firing {
@@ -277,6 +288,51 @@ impl Engine {
     pub fn fact(&self, agent: u32) -> Option<MatchedFact> {
         let slot = self.slots.get(agent as usize)?;
         (slot.event != NONE).then(|| self.snapshot(agent))
+    }
+
+    /// An agent's live fact without copying it: event, payload, time, run
+    /// length and posting sequence number (recency).
+    pub fn fact_view(&self, agent: u32) -> Option<FactView<'_>> {
+        let slot = self.slots.get(agent as usize)?;
+        if slot.event == NONE {
+            return None;
+        }
+        let n = self.content.events.get(slot.event as usize).map_or(0, |e| e.fields.len());
+        let at = self.net.payload_at[agent as usize] as usize;
+        Some(FactView {
+            event: slot.event,
+            payload: &self.payload[at..at + n],
+            time: slot.time,
+            run: slot.run,
+            seq: slot.seq,
+        })
+    }
+
+    /// Makes `self` a copy of `other` (an engine of the same bundle),
+    /// reusing `self`'s buffers: the explorer of `verify` copies an engine
+    /// per successor it tries.
+    pub fn copy_from(&mut self, other: &Engine) {
+        if !Arc::ptr_eq(&self.content, &other.content) {
+            *self = other.clone();
+            return;
+        }
+        self.state = other.state;
+        self.slots.clone_from(&other.slots);
+        self.payload.clone_from(&other.payload);
+        self.stale.clone_from(&other.stale);
+        self.now = other.now;
+        self.seq = other.seq;
+        self.stale_at.clone_from(&other.stale_at);
+        self.window_at.clone_from(&other.window_at);
+        self.next_deadline = other.next_deadline;
+        self.alpha_mem.clone_from(&other.alpha_mem);
+        self.beta_tok.clone_from(&other.beta_tok);
+        self.dirty.clone_from(&other.dirty);
+        self.dirty_lo = other.dirty_lo;
+        self.dirty_hi = other.dirty_hi;
+        self.active.clone_from(&other.active);
+        self.active_pos.clone_from(&other.active_pos);
+        self.cascade_limit = other.cascade_limit;
     }
 
     /// Whether the agent's fact has expired.

@@ -1,0 +1,144 @@
+//! Golden tests of `situ test`: they run the real binary on the repository's
+//! rule files and on small files with planted bugs, and check exit codes,
+//! the summary line, failure reports with places, counterexamples that
+//! replay as tests, and the JSON form.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn situ(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_situ")).args(args).env("NO_COLOR", "1").output().expect("the binary runs")
+}
+
+fn code(o: &Output) -> i32 {
+    o.status.code().expect("exited normally, not by a signal")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8(o.stdout.clone()).expect("UTF-8 output")
+}
+
+fn write(dir: &Path, name: &str, content: &str) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, content).expect("temp file written");
+    path.display().to_string()
+}
+
+/// A small stack with one failing test and one failing property.
+const BUGGY: &str = r#"states { Ready initial Armed Fired final }
+agent Btn interface { event ARM event FIRE event SAFE }
+agent Lamp actuator { function glow table { Armed => run glow()  _ => sleep } }
+rule arm { when state == Ready and ARM then Armed }
+rule safe { when state == Armed and SAFE then Ready }
+rule fire { when state in {Ready, Armed} and FIRE then Fired }
+test "arming lights the lamp" {
+    on ARM
+    expect state Armed, Lamp running
+}
+test "a safe button does not fire" {
+    on SAFE, FIRE
+    expect state Ready, Lamp sleeping
+}
+property "firing needs arming" { always (state == Ready -> next state != Fired) }
+property "the lamp glows when armed" { always (state == Armed -> Lamp running) }
+"#;
+
+#[test]
+fn the_papers_stacks_pass_their_tests_and_properties() {
+    for file in ["rules/outdoor.situ", "rules/ugv.situ"] {
+        let o = situ(&["test", file]);
+        let out = stdout(&o);
+        assert_eq!(code(&o), 0, "{file}:\n{out}");
+        let last = out.lines().last().unwrap_or_default();
+        assert!(last.ends_with(" passed, 0 failed"), "{last}");
+        assert!(!out.contains("FAILED"), "{out}");
+    }
+}
+
+#[test]
+fn failures_name_their_place_and_what_was_found() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "buggy.situ", BUGGY);
+    let o = situ(&["test", &file, "--engine", "exhaustive"]);
+    let out = stdout(&o);
+    assert_eq!(code(&o), 1, "{out}");
+    assert!(out.contains("test \"arming lights the lamp\" ... ok"), "{out}");
+    assert!(out.contains("test \"a safe button does not fire\" ... FAILED"), "{out}");
+    assert!(out.contains(&format!("{file}:13:12: expected state Ready, found Fired")), "{out}");
+    assert!(!out.contains("expected Lamp sleeping"), "the lamp sleeps in Fired: {out}");
+    assert!(out.contains("property \"firing needs arming\" ... FAILED"), "{out}");
+    assert!(out.contains("counterexample (exhaustive, shortest, 1 events)"), "{out}");
+    assert!(out.contains("Ready -> Fired   fired `fire`"), "{out}");
+    assert!(out.contains("property \"the lamp glows when armed\" ... ok"), "{out}");
+    assert!(out.contains("proved"), "{out}");
+    assert_eq!(out.lines().last(), Some("2 passed, 2 failed"), "{out}");
+}
+
+#[test]
+fn a_counterexample_replays_as_a_test() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "buggy.situ", BUGGY);
+    let o = situ(&["test", &file, "--filter", "firing", "--engine", "random", "--cases", "500"]);
+    let out = stdout(&o);
+    assert_eq!(code(&o), 1, "{out}");
+    let start = out.find("    test \"counterexample").expect("a test block");
+    let block: String =
+        out[start..].lines().take_while(|l| l.starts_with("    ")).map(|l| format!("{}\n", &l[4..])).collect();
+    assert!(block.trim_end().ends_with('}'), "{block}");
+    let replay = write(dir.path(), "replay.situ", &format!("{BUGGY}\n{block}"));
+    let o = situ(&["test", &replay, "--filter", "counterexample"]);
+    assert_eq!(code(&o), 0, "{}\n{block}", stdout(&o));
+    assert_eq!(stdout(&o).lines().last(), Some("1 passed, 0 failed"));
+}
+
+#[test]
+fn json_gives_one_object_per_result() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "buggy.situ", BUGGY);
+    let o = situ(&["test", &file, "--format", "json", "--engine", "exhaustive"]);
+    assert_eq!(code(&o), 1);
+    let lines: Vec<serde_json::Value> =
+        stdout(&o).lines().map(|l| serde_json::from_str(l).expect("a JSON object per line")).collect();
+    assert_eq!(lines.len(), 4);
+    let kinds: Vec<&str> = lines.iter().map(|l| l["kind"].as_str().unwrap()).collect();
+    assert_eq!(kinds, ["test", "test", "property", "property"]);
+    assert_eq!(lines[1]["passed"], false);
+    assert_eq!(lines[1]["failures"][0]["place"], format!("{file}:13:12"));
+    assert_eq!(lines[2]["exhaustive"]["verdict"], "failed");
+    assert_eq!(lines[2]["counterexample"]["events"][0]["event"], "FIRE");
+    assert_eq!(lines[2]["counterexample"]["events"][0]["state"], "Fired");
+    assert_eq!(lines[3]["exhaustive"]["verdict"], "proved");
+}
+
+#[test]
+fn filter_selects_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "buggy.situ", BUGGY);
+    let o = situ(&["test", &file, "--filter", "lamp"]);
+    assert_eq!(code(&o), 0, "{}", stdout(&o));
+    assert_eq!(stdout(&o).lines().last(), Some("2 passed, 0 failed"));
+}
+
+#[test]
+fn a_file_with_errors_fails_with_its_diagnostics() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(
+        dir.path(),
+        "bad.situ",
+        "states { IT initial RS }\nagent A sensor { event GO }\nrule go { when state == IT and GO then RS }\n\
+         test \"late\" { on GO at 50ms, GO at 20ms expect state RS }\n\
+         property \"unknown\" { always (state == RQ) }\n",
+    );
+    let o = situ(&["test", &file]);
+    let out = stdout(&o);
+    assert_eq!(code(&o), 1, "{out}");
+    assert!(out.contains("situ::E0117") && out.contains("situ::E0101"), "{out}");
+    assert_eq!(out.lines().last(), Some("0 passed, 1 failed"));
+}
+
+#[test]
+fn usage_and_io_errors_exit_2() {
+    assert_eq!(code(&situ(&["test", "no/such/file.situ"])), 2);
+    assert_eq!(code(&situ(&["test"])), 2);
+    assert_eq!(code(&situ(&["test", "rules/outdoor.situ", "--engine", "magic"])), 2);
+}
