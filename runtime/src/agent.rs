@@ -120,6 +120,7 @@ pub struct Context<'a> {
     pub(crate) now: u64,
     pub(crate) state: u32,
     pub(crate) mode: Mode,
+    pub(crate) safe: bool,
     pub(crate) function: Option<&'a str>,
     pub(crate) inputs: &'a [Datum],
     pub(crate) outputs: &'a mut Vec<Outgoing>,
@@ -140,6 +141,12 @@ impl<'a> Context<'a> {
     /// Running or waiting (sleeping agents are not stepped).
     pub fn mode(&self) -> Mode {
         self.mode
+    }
+
+    /// Whether the stack is in safe mode (the Bulletinboard fell silent):
+    /// the agent waits whatever its table says; an actuator should stop.
+    pub fn safe_mode(&self) -> bool {
+        self.safe
     }
 
     /// The function the table or FSM chose for this state.

@@ -16,6 +16,7 @@ pub mod agent;
 pub mod bench;
 pub mod bulletinboard;
 pub mod bus;
+pub mod demo;
 pub mod organise;
 pub mod realtime;
 pub mod record;

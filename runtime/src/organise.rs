@@ -21,6 +21,9 @@ pub struct Organisation {
     state: u32,
     /// Per agent, its FSM's current state (0 for agents without an FSM).
     fsm: Vec<u32>,
+    /// Safe mode: the Bulletinboard is gone; every agent that would run
+    /// waits (reports events, sends no data).
+    safe: bool,
 }
 
 /// An FSM that moved: the agent, and its FSM states before and after.
@@ -42,7 +45,7 @@ impl Organisation {
                 _ => 0,
             })
             .collect();
-        Organisation { state: content.initial, content, fsm }
+        Organisation { state: content.initial, content, fsm, safe: false }
     }
 
     pub fn content(&self) -> &Arc<Content> {
@@ -109,7 +112,21 @@ impl Organisation {
     }
 
     pub fn mode(&self, agent: u32) -> Mode {
-        self.action(agent).map_or(Mode::Sleeping, |a| a.mode)
+        match self.action(agent).map_or(Mode::Sleeping, |a| a.mode) {
+            Mode::Running if self.safe => Mode::Waiting,
+            m => m,
+        }
+    }
+
+    /// Enters or leaves safe mode: while the Bulletinboard is silent, no
+    /// agent runs (they wait: they still report events, their data outputs
+    /// are dropped, and actuators see [`Organisation::safe`] and stop).
+    pub fn set_safe(&mut self, safe: bool) {
+        self.safe = safe;
+    }
+
+    pub fn safe(&self) -> bool {
+        self.safe
     }
 
     /// The name of the function the agent runs (or waits with) now.
@@ -140,7 +157,7 @@ impl Organisation {
     pub fn links(&self) -> Vec<(u32, u32)> {
         let mut out = Vec::new();
         for agent in 0..self.content.agents.len() as u32 {
-            if let Some(a) = self.action(agent).filter(|a| a.mode == Mode::Running) {
+            if let Some(a) = self.action(agent).filter(|_| self.mode(agent) == Mode::Running) {
                 out.extend(a.from.iter().map(|&x| (x, agent)));
                 out.extend(a.to.iter().map(|&y| (agent, y)));
             }
@@ -152,7 +169,7 @@ impl Organisation {
 
     pub fn has_link(&self, from: u32, to: u32) -> bool {
         let written = |agent: u32, other: u32, outgoing: bool| {
-            self.action(agent).filter(|a| a.mode == Mode::Running).is_some_and(|a| {
+            self.action(agent).filter(|_| self.mode(agent) == Mode::Running).is_some_and(|a| {
                 if outgoing {
                     a.to.contains(&other)
                 } else {

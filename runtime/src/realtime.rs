@@ -1,5 +1,5 @@
 //! The real-time scheduler, on the wall clock (time is nanoseconds since
-//! the start): the agents are shared among a few worker threads (one per
+//! the Unix epoch, shared by the processes of a stack): the agents are shared among a few worker threads (one per
 //! core by default), the Bulletinboard has a thread of its own.
 //!
 //! - An agent with a rate steps every period; an urgent datum interrupts
@@ -37,6 +37,14 @@ pub struct RealtimeConfig {
     pub stop_on_final: bool,
     /// Worker threads for the agents (0: one per core).
     pub workers: usize,
+    /// Whether this process hosts the Bulletinboard (else it follows the
+    /// status another process broadcasts).
+    pub board: bool,
+    /// How often the Bulletinboard repeats its status when nothing changes.
+    pub status_every: Duration,
+    /// A process without the Bulletinboard enters safe mode when no status
+    /// came for this long, and leaves it when one comes.
+    pub safe_after: Duration,
 }
 
 impl Default for RealtimeConfig {
@@ -47,6 +55,9 @@ impl Default for RealtimeConfig {
             capacity: Capacity::default(),
             stop_on_final: true,
             workers: 0,
+            board: true,
+            status_every: Duration::from_millis(200),
+            safe_after: Duration::from_millis(600),
         }
     }
 }
@@ -83,14 +94,21 @@ pub fn run_on(
     bus: Arc<dyn Bus>,
     on_change: &mut (dyn FnMut(&StateChange) + Send),
 ) -> Summary {
-    let shared = Arc::new(Shared::new(content.clone(), bus.clone(), sink));
+    let mut shared = Shared::new(content.clone(), bus.clone(), sink);
+    shared.remote_board = !config.board;
+    let shared = Arc::new(shared);
+    // Time is the wall clock (ns since the Unix epoch), so that processes
+    // of one stack on synchronised hosts share it; it never goes back here.
     let start = Instant::now();
-    let clock = move || start.elapsed().as_nanos() as u64;
+    let epoch = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_nanos() as u64);
+    let clock = move || epoch + start.elapsed().as_nanos() as u64;
     let stop = Arc::new(AtomicBool::new(false));
     let counters = Arc::new(Mutex::new(Vec::new()));
     let mut board = BoardRunner::new(content.clone());
-    let mut summary = Summary::new(&content);
-    board.start(&shared, 0);
+    let mut summary = Summary::new(&content).starting_at(epoch);
+    if config.board {
+        board.start(&shared, epoch);
+    }
 
     let workers = match config.workers {
         0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
@@ -106,6 +124,7 @@ pub fn run_on(
         groups[k % workers].push(Slot { runner: AgentRunner::new(i as u32, imp), period, next: start });
         k += 1;
     }
+    let local: Vec<u32> = groups.iter().flatten().map(|s| s.runner.id).collect();
 
     std::thread::scope(|scope| {
         for mut group in groups.into_iter().filter(|g| !g.is_empty()) {
@@ -139,25 +158,35 @@ pub fn run_on(
                 c.extend(group.iter().map(|s| (s.runner.id, s.runner.counters)));
             });
         }
-        // The Bulletinboard, on this thread.
-        let end = start + duration;
-        let mut next_beat = start + config.heartbeat;
-        loop {
-            let now = Instant::now();
-            if now >= end || stop.load(Ordering::Acquire) {
-                break;
-            }
-            let _ = shared.bus.wait_events(next_beat.min(end));
-            let mut changes = board.pump(&shared, clock());
-            if Instant::now() >= next_beat {
-                next_beat += config.heartbeat;
-                changes.extend(board.tick(&shared, clock()));
-            }
-            for c in &changes {
-                summary.change(c);
-                on_change(c);
-                if config.stop_on_final && content.states[c.to as usize].is_final {
-                    stop.store(true, Ordering::Release);
+        if !config.board {
+            follow(&shared, &local, &config, start + duration, &stop, &mut summary, on_change, &clock);
+        } else {
+            // The Bulletinboard, on this thread.
+            let end = start + duration;
+            let mut next_beat = start + config.heartbeat;
+            let mut next_status = start + config.status_every;
+            loop {
+                let now = Instant::now();
+                if now >= end || stop.load(Ordering::Acquire) {
+                    break;
+                }
+                let _ = shared.bus.wait_events(next_beat.min(end));
+                let mut changes = board.pump(&shared, clock());
+                let now = Instant::now();
+                if now >= next_beat {
+                    next_beat += config.heartbeat;
+                    changes.extend(board.tick(&shared, clock()));
+                }
+                if now >= next_status {
+                    next_status = now + config.status_every;
+                    board.reassure(&shared, clock());
+                }
+                for c in &changes {
+                    summary.change(c);
+                    on_change(c);
+                    if config.stop_on_final && content.states[c.to as usize].is_final {
+                        stop.store(true, Ordering::Release);
+                    }
                 }
             }
         }
@@ -165,9 +194,69 @@ pub fn run_on(
         shared.bus.close();
     });
     let agents = std::mem::take(&mut *counters.lock().unwrap_or_else(|p| p.into_inner()));
-    summary.finish(clock(), board.board.state(), &board.counters, agents, shared.bus.counters());
+    let state = if config.board { board.board.state() } else { shared.org().state() };
+    summary.finish(clock(), state, &board.counters, agents, shared.bus.counters());
     shared.record(|s| {
         let _ = s.finish();
     });
     summary
+}
+
+/// A process without the Bulletinboard: its organisation follows the status
+/// broadcast from afar, and falls into safe mode when it stops coming.
+#[allow(clippy::too_many_arguments)]
+fn follow(
+    shared: &Shared,
+    local: &[u32],
+    config: &RealtimeConfig,
+    end: Instant,
+    stop: &AtomicBool,
+    summary: &mut Summary,
+    on_change: &mut (dyn FnMut(&StateChange) + Send),
+    clock: &dyn Fn() -> u64,
+) {
+    let Some(&probe) = local.first() else { return };
+    let (mut seq, mut heard, mut last_seen) = (0u64, 0u64, Instant::now());
+    let mut safe = false;
+    while Instant::now() < end && !stop.load(Ordering::Acquire) {
+        std::thread::sleep(Duration::from_millis(5));
+        let Some(status) = shared.bus.status(probe) else {
+            continue;
+        };
+        if status.time != heard || status.seq != seq {
+            heard = status.time;
+            last_seen = Instant::now();
+            if safe {
+                safe = false;
+                shared.org_mut().set_safe(false);
+                shared.record(|s| {
+                    s.diagnostic(clock(), crate::record::Level::Warning, "the Bulletinboard is back: safe mode ends")
+                });
+            }
+        }
+        if status.seq != seq {
+            seq = status.seq;
+            let from = shared.org().state();
+            if from != status.state {
+                shared.org_mut().on_state(status.state);
+                let change = StateChange { from, to: status.state, time: status.time, firings: Vec::new() };
+                summary.change(&change);
+                on_change(&change);
+                if config.stop_on_final && shared.content.states[status.state as usize].is_final {
+                    stop.store(true, Ordering::Release);
+                }
+            }
+        }
+        if !safe && last_seen.elapsed() > config.safe_after {
+            safe = true;
+            shared.org_mut().set_safe(true);
+            shared.record(|s| {
+                s.diagnostic(
+                    clock(),
+                    crate::record::Level::Error,
+                    "no status from the Bulletinboard: safe mode (every agent waits)",
+                )
+            });
+        }
+    }
 }

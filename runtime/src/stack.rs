@@ -29,19 +29,29 @@ pub struct Shared {
     pub sink: Mutex<Option<Box<dyn Sink>>>,
     /// Whether there is a sink (checked before building records).
     pub recording: bool,
+    /// The Bulletinboard is in another process: the FSMs of this process's
+    /// agents follow their own events here.
+    pub remote_board: bool,
 }
 
 impl Shared {
     pub fn new(content: Arc<Content>, bus: Arc<dyn Bus>, sink: Option<Box<dyn Sink>>) -> Shared {
         let recording = sink.is_some();
-        Shared { org: RwLock::new(Organisation::new(content.clone())), content, bus, sink: Mutex::new(sink), recording }
+        Shared {
+            org: RwLock::new(Organisation::new(content.clone())),
+            content,
+            bus,
+            sink: Mutex::new(sink),
+            recording,
+            remote_board: false,
+        }
     }
 
     pub fn org(&self) -> std::sync::RwLockReadGuard<'_, Organisation> {
         self.org.read().unwrap_or_else(|p| p.into_inner())
     }
 
-    fn org_mut(&self) -> std::sync::RwLockWriteGuard<'_, Organisation> {
+    pub fn org_mut(&self) -> std::sync::RwLockWriteGuard<'_, Organisation> {
         self.org.write().unwrap_or_else(|p| p.into_inner())
     }
 
@@ -63,11 +73,11 @@ impl Shared {
     /// As [`receivers`](Self::receivers), into a buffer.
     pub fn receivers_into(&self, org: &Organisation, from: u32, out: &mut Vec<u32>) {
         out.clear();
-        if let Some(a) = org.action(from) {
+        if let Some(a) = org.action(from).filter(|_| org.mode(from) == Mode::Running) {
             out.extend_from_slice(&a.to);
         }
         for y in 0..self.content.agents.len() as u32 {
-            if y != from && org.action(y).is_some_and(|a| a.mode == Mode::Running && a.from.contains(&from)) {
+            if y != from && org.mode(y) == Mode::Running && org.action(y).is_some_and(|a| a.from.contains(&from)) {
                 out.push(y);
             }
         }
@@ -138,9 +148,9 @@ impl AgentRunner {
     pub fn cycle(&mut self, shared: &Shared, now: u64) -> Cycle {
         let mut out = Cycle::default();
         let content = &*shared.content;
-        let (state, mode, function) = {
+        let (state, mode, function, safe) = {
             let org = shared.org();
-            (org.state(), org.mode(self.id), org.action(self.id).and_then(|a| a.function))
+            (org.state(), org.mode(self.id), org.action(self.id).and_then(|a| a.function), org.safe())
         };
         if mode == Mode::Sleeping {
             self.counters.stale_inputs += shared.bus.discard_data(self.id) as u64;
@@ -167,6 +177,7 @@ impl AgentRunner {
                 now,
                 state,
                 mode,
+                safe,
                 function: function_name,
                 inputs: &self.inputs,
                 outputs: &mut self.outputs,
@@ -238,6 +249,9 @@ impl AgentRunner {
         for r in self.reports.drain(..) {
             self.counters.events += 1;
             out.reported = true;
+            if shared.remote_board {
+                shared.org_mut().on_event(self.id, r.event);
+            }
             shared.bus.send_event(EventMsg {
                 agent: self.id,
                 event: r.event,
@@ -318,6 +332,13 @@ impl BoardRunner {
     /// Broadcasts the initial status and records the initial modes.
     pub fn start(&mut self, shared: &Shared, now: u64) {
         self.broadcast(shared, now);
+    }
+
+    /// Repeats the current status, unchanged (same sequence number), with
+    /// the time of now: agents in other processes know the Bulletinboard
+    /// is alive.
+    pub fn reassure(&mut self, shared: &Shared, now: u64) {
+        shared.bus.send_status(StatusMsg { state: self.board.state(), time: now, seq: self.status_seq });
     }
 
     /// Takes every queued event, in order (urgent first); returns the

@@ -30,6 +30,8 @@ pub struct Summary {
     #[serde(skip)]
     since: u64,
     #[serde(skip)]
+    origin: u64,
+    #[serde(skip)]
     current: usize,
 }
 
@@ -59,8 +61,16 @@ impl Summary {
             names: c.states.iter().map(|s| s.name.clone()).collect(),
             agent_names: c.agents.iter().map(|a| a.name.clone()).collect(),
             since: 0,
+            origin: 0,
             current: c.initial as usize,
         }
+    }
+
+    /// Times are counted from `origin` (ns), e.g. a wall clock's start.
+    pub fn starting_at(mut self, origin: u64) -> Summary {
+        self.origin = origin;
+        self.since = origin;
+        self
     }
 
     /// A change of the state at rest.
@@ -95,7 +105,7 @@ impl Summary {
         let dt = now.saturating_sub(self.since);
         self.states[self.current].seconds += dt as f64 * 1e-9;
         self.since = now;
-        self.duration_s = now as f64 * 1e-9;
+        self.duration_s = now.saturating_sub(self.origin) as f64 * 1e-9;
         self.final_state = self.names[state as usize].clone();
         self.rules_fired = board.fired.clone();
         self.board = board.clone();

@@ -284,6 +284,8 @@ impl Bus for InProc {
             events_overflow: get(&c.events_overflow),
             status_sent: get(&c.status_sent),
             urgent: get(&c.urgent),
+            rejected: 0,
+            unsendable: 0,
         }
     }
 }

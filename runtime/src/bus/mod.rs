@@ -118,6 +118,11 @@ pub struct BusCounters {
     pub events_overflow: u64,
     pub status_sent: u64,
     pub urgent: u64,
+    /// Messages from other processes refused before they reached a queue
+    /// (not a message of this protocol, a newer version, too big, …).
+    pub rejected: u64,
+    /// Data that cannot cross to another process (a local Rust value).
+    pub unsendable: u64,
 }
 
 /// A transport of the three streams.

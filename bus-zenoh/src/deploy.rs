@@ -1,0 +1,266 @@
+//! The deployment file: the paper's process table (which agents run in
+//! which process) and host table (how the processes find each other), in
+//! TOML, and the Zenoh configuration of each process made from it.
+//!
+//! ```toml
+//! robot = "amr"                      # the key prefix: situ/amr/…
+//!
+//! [tls]                              # optional: TLS with client certificates
+//! ca = "certs/ca.pem"                # (mTLS) and access control by name
+//!
+//! [[process]]
+//! name = "board"                     # with TLS, its certificate's common name
+//! board = true                       # hosts the Bulletinboard
+//! listen = ["tcp/127.0.0.1:7447"]
+//! cert = "certs/board.pem"           # with TLS
+//! key = "certs/board.key"
+//!
+//! [[process]]
+//! name = "sensors"
+//! agents = ["RFCCD", "LADAR"]
+//! connect = ["tcp/127.0.0.1:7447"]
+//! ```
+//!
+//! Peers, multicast scouting off, explicit endpoints only. With `[tls]`
+//! every process presents its certificate and checks the others' against
+//! the CA; Zenoh's access control then lets only the process marked `board`
+//! put on `situ/<robot>/status`, and only the processes of the table put
+//! events and data.
+
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Deployment {
+    pub robot: String,
+    #[serde(default)]
+    pub tls: Option<Tls>,
+    #[serde(rename = "process")]
+    pub processes: Vec<Process>,
+    /// The directory of the file (relative paths are relative to it).
+    #[serde(skip)]
+    pub dir: PathBuf,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Tls {
+    pub ca: PathBuf,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Process {
+    pub name: String,
+    #[serde(default)]
+    pub board: bool,
+    #[serde(default)]
+    pub agents: Vec<String>,
+    #[serde(default)]
+    pub listen: Vec<String>,
+    #[serde(default)]
+    pub connect: Vec<String>,
+    #[serde(default)]
+    pub cert: Option<PathBuf>,
+    #[serde(default)]
+    pub key: Option<PathBuf>,
+}
+
+/// Why a deployment file is refused.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DeployError(pub String);
+
+impl std::fmt::Display for DeployError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for DeployError {}
+
+impl Deployment {
+    /// Reads and checks a deployment file against the agents of a bundle.
+    pub fn load(path: &Path, agents: &[String]) -> Result<Deployment, DeployError> {
+        let text =
+            std::fs::read_to_string(path).map_err(|e| DeployError(format!("cannot read `{}`: {e}", path.display())))?;
+        let mut d =
+            Deployment::parse(&text, agents).map_err(|e| DeployError(format!("{}: {}", path.display(), e.0)))?;
+        d.dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Ok(d)
+    }
+
+    pub fn parse(text: &str, agents: &[String]) -> Result<Deployment, DeployError> {
+        let d: Deployment = toml::from_str(text).map_err(|e| DeployError(e.to_string()))?;
+        if d.robot.is_empty() || !d.robot.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
+            return Err(DeployError(format!("`robot = \"{}\"`: letters, digits, `_` and `-` only", d.robot)));
+        }
+        let boards: Vec<&str> = d.processes.iter().filter(|p| p.board).map(|p| p.name.as_str()).collect();
+        if boards.len() != 1 {
+            return Err(DeployError(format!(
+                "exactly one process hosts the Bulletinboard (`board = true`); found {}",
+                if boards.is_empty() { "none".to_string() } else { boards.join(", ") }
+            )));
+        }
+        let mut seen: Vec<(&str, &str)> = Vec::new();
+        for p in &d.processes {
+            if d.processes.iter().filter(|q| q.name == p.name).count() > 1 {
+                return Err(DeployError(format!("process `{}` is declared twice", p.name)));
+            }
+            for a in &p.agents {
+                if !agents.contains(a) {
+                    return Err(DeployError(format!(
+                        "process `{}` runs `{a}`, which the rules do not declare",
+                        p.name
+                    )));
+                }
+                if let Some((_, other)) = seen.iter().find(|(x, _)| x == a) {
+                    return Err(DeployError(format!("agent `{a}` runs in both `{other}` and `{}`", p.name)));
+                }
+                seen.push((a, &p.name));
+            }
+            for e in p.listen.iter().chain(&p.connect) {
+                let tls_link = e.starts_with("tls/");
+                if !(e.starts_with("tcp/") || tls_link) {
+                    return Err(DeployError(format!(
+                        "process `{}`: endpoint `{e}` is not `tcp/HOST:PORT` or `tls/HOST:PORT`",
+                        p.name
+                    )));
+                }
+                if tls_link != d.tls.is_some() {
+                    return Err(DeployError(format!(
+                        "process `{}`: endpoint `{e}`: use `tls/` endpoints exactly when the file has a `[tls]` section",
+                        p.name
+                    )));
+                }
+            }
+            if d.tls.is_some() && (p.cert.is_none() || p.key.is_none()) {
+                return Err(DeployError(format!("process `{}` needs `cert` and `key` with `[tls]`", p.name)));
+            }
+        }
+        Ok(d)
+    }
+
+    pub fn process(&self, name: &str) -> Option<&Process> {
+        self.processes.iter().find(|p| p.name == name)
+    }
+
+    /// The process that runs all of `agents` (for `--only`).
+    pub fn process_of(&self, agents: &[String]) -> Option<&Process> {
+        self.processes.iter().find(|p| agents.iter().all(|a| p.agents.contains(a)))
+    }
+
+    pub fn board(&self) -> &Process {
+        self.processes.iter().find(|p| p.board).expect("checked: one board")
+    }
+
+    fn path(&self, p: &Path) -> String {
+        let full = if p.is_absolute() { p.to_path_buf() } else { self.dir.join(p) };
+        full.display().to_string()
+    }
+
+    /// The Zenoh configuration (JSON5 text) of one process.
+    pub fn zenoh_config(&self, process: &Process) -> String {
+        let q = |v: &[String]| serde_json::to_string(v).expect("strings serialize");
+        let mut cfg = serde_json::json!({
+            "mode": "peer",
+            "listen": { "endpoints": serde_json::from_str::<serde_json::Value>(&q(&process.listen)).unwrap_or_default() },
+            "connect": { "endpoints": serde_json::from_str::<serde_json::Value>(&q(&process.connect)).unwrap_or_default() },
+            "scouting": { "multicast": { "enabled": false }, "gossip": { "enabled": true } },
+        });
+        if let (Some(tls), Some(cert), Some(key)) = (&self.tls, &process.cert, &process.key) {
+            cfg["transport"] = serde_json::json!({ "link": { "tls": {
+                "root_ca_certificate": self.path(&tls.ca),
+                "listen_private_key": self.path(key),
+                "listen_certificate": self.path(cert),
+                "connect_private_key": self.path(key),
+                "connect_certificate": self.path(cert),
+                "enable_mtls": true,
+                "verify_name_on_connect": false,
+            }}});
+            cfg["access_control"] = self.access_control();
+        }
+        cfg.to_string()
+    }
+
+    /// Who may put what, by certificate name: the board's status, the
+    /// processes' events and data; subscribing is free.
+    fn access_control(&self) -> serde_json::Value {
+        let robot = &self.robot;
+        let all: Vec<&str> = self.processes.iter().map(|p| p.name.as_str()).collect();
+        serde_json::json!({
+            "enabled": true,
+            "default_permission": "deny",
+            "rules": [
+                { "id": "status", "messages": ["put"], "flows": ["ingress", "egress"], "permission": "allow",
+                  "key_exprs": [format!("situ/{robot}/status")] },
+                { "id": "streams", "messages": ["put"], "flows": ["ingress", "egress"], "permission": "allow",
+                  "key_exprs": [format!("situ/{robot}/event/**"), format!("situ/{robot}/data/**")] },
+                { "id": "subscribe", "messages": ["declare_subscriber", "declare_liveliness_subscriber", "liveliness_token"],
+                  "flows": ["ingress", "egress"], "permission": "allow", "key_exprs": ["**"] },
+            ],
+            "subjects": [
+                { "id": "board", "cert_common_names": [self.board().name] },
+                { "id": "members", "cert_common_names": all },
+            ],
+            "policies": [
+                { "id": "board_status", "rules": ["status"], "subjects": ["board"] },
+                { "id": "members_streams", "rules": ["streams", "subscribe"], "subjects": ["members"] },
+            ],
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn agents() -> Vec<String> {
+        ["RFCCD", "LADAR", "Fusion"].iter().map(|s| s.to_string()).collect()
+    }
+
+    const GOOD: &str = r#"
+robot = "amr"
+[[process]]
+name = "board"
+board = true
+listen = ["tcp/127.0.0.1:7447"]
+[[process]]
+name = "sensors"
+agents = ["RFCCD", "LADAR"]
+connect = ["tcp/127.0.0.1:7447"]
+"#;
+
+    #[test]
+    fn a_good_file_gives_each_process_its_config() {
+        let d = Deployment::parse(GOOD, &agents()).unwrap();
+        assert_eq!(d.board().name, "board");
+        assert_eq!(d.process_of(&["LADAR".into()]).unwrap().name, "sensors");
+        let cfg: serde_json::Value = serde_json::from_str(&d.zenoh_config(d.process("sensors").unwrap())).unwrap();
+        assert_eq!(cfg["scouting"]["multicast"]["enabled"], false);
+        assert_eq!(cfg["connect"]["endpoints"][0], "tcp/127.0.0.1:7447");
+        assert!(cfg.get("access_control").is_none());
+    }
+
+    #[test]
+    fn bad_files_say_what_is_wrong() {
+        let cases = [
+            (GOOD.replace("board = true", ""), "exactly one process hosts the Bulletinboard"),
+            (GOOD.replace("\"LADAR\"]", "\"LADAR\", \"Ghost\"]"), "`Ghost`, which the rules do not declare"),
+            (
+                GOOD.replace(
+                    "tcp/127.0.0.1:7447\"]\n[[process]]\nname = \"sensors\"",
+                    "udp/1.2.3.4:1\"]\n[[process]]\nname = \"sensors\"",
+                ),
+                "is not `tcp/HOST:PORT`",
+            ),
+            (GOOD.replace("robot = \"amr\"", "robot = \"a/b\""), "letters, digits"),
+            (GOOD.replace("agents = [", "agent = ["), "unknown field `agent`"),
+            (format!("{GOOD}\n[tls]\nca = \"ca.pem\"\n"), "use `tls/` endpoints"),
+        ];
+        for (text, want) in cases {
+            let e = Deployment::parse(&text, &agents()).unwrap_err().to_string();
+            assert!(e.contains(want), "{want}: {e}");
+        }
+    }
+}

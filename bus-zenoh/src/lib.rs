@@ -1,0 +1,271 @@
+//! The three streams of a situ stack over Zenoh (peer to peer, optional
+//! routers): the same agents and the same bundle as in one process, spread
+//! over processes, hosts and languages.
+//!
+//! [`ZenohBus`] implements the runtime's [`Bus`]: the agents of this
+//! process keep in-process mailboxes ([`InProc`]); what goes to an agent of
+//! another process, or to a Bulletinboard in another process, is published
+//! on the keys of [`wire`], and what arrives on them is checked and put in
+//! the local mailboxes. Quality of service: events and status are sent with
+//! `CongestionControl::Block` (never dropped by Zenoh), data with `Drop`
+//! (keep-latest, as in process); urgent messages at `Priority::RealTime`,
+//! status at `InteractiveHigh`, events and data at `Data`.
+
+pub mod deploy;
+pub mod wire;
+
+use situ_compiler::bundle::Content;
+use situ_runtime::agent::Body;
+use situ_runtime::bus::inproc::{Capacity, InProc};
+use situ_runtime::bus::{Attention, Bus, BusCounters, DataMsg, Doorbell, EventMsg, StatusMsg, Wake};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+use wire::{DataWire, EventWire, StatusWire, VERSION};
+use zenoh::qos::{CongestionControl, Priority};
+use zenoh::Wait;
+
+/// What runs where, for one process.
+#[derive(Debug, Clone)]
+pub struct Placement {
+    pub robot: String,
+    /// Per agent of the bundle: whether it runs in this process.
+    pub local: Vec<bool>,
+    /// Whether this process hosts the Bulletinboard.
+    pub board: bool,
+}
+
+#[derive(Default)]
+struct Counters {
+    rejected: AtomicU64,
+    unsendable: AtomicU64,
+    published: AtomicU64,
+}
+
+pub struct ZenohBus {
+    local: Arc<InProc>,
+    session: zenoh::Session,
+    content: Arc<Content>,
+    placement: Placement,
+    counters: Arc<Counters>,
+    /// The latest refusals, for whoever reports them.
+    refusals: Arc<Mutex<Vec<String>>>,
+    _subscribers: Vec<zenoh::pubsub::Subscriber<()>>,
+}
+
+/// Why the bus could not start.
+#[derive(Debug)]
+pub struct BusError(pub String);
+
+impl std::fmt::Display for BusError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for BusError {}
+
+impl ZenohBus {
+    /// Opens a Zenoh session with `config` (JSON5) and subscribes to what
+    /// this process must receive.
+    pub fn open(
+        content: Arc<Content>,
+        placement: Placement,
+        config: &str,
+        capacity: Capacity,
+    ) -> Result<ZenohBus, BusError> {
+        let config = zenoh::Config::from_json5(config).map_err(|e| BusError(format!("Zenoh configuration: {e}")))?;
+        let session =
+            zenoh::open(config).wait().map_err(|e| BusError(format!("cannot open the Zenoh session: {e}")))?;
+        let local = Arc::new(InProc::new(content.agents.len(), capacity));
+        let counters = Arc::new(Counters::default());
+        let refusals = Arc::new(Mutex::new(Vec::new()));
+        let robot = placement.robot.clone();
+        let mut subscribers = Vec::new();
+        let refuse = {
+            let (counters, refusals) = (counters.clone(), refusals.clone());
+            move |why: String| {
+                counters.rejected.fetch_add(1, Ordering::Relaxed);
+                let mut r = refusals.lock().unwrap_or_else(|p| p.into_inner());
+                if r.len() < 1000 {
+                    r.push(why);
+                }
+            }
+        };
+        if placement.board {
+            let (local, content, refuse) = (local.clone(), content.clone(), refuse.clone());
+            let prefix = format!("situ/{robot}/event/");
+            let sub = session
+                .declare_subscriber(format!("situ/{robot}/event/*"))
+                .callback(move |sample| {
+                    let key = sample.key_expr().as_str();
+                    let key_agent = key.strip_prefix(&prefix).unwrap_or("");
+                    let bytes = sample.payload().to_bytes();
+                    match wire::parse::<EventWire>(&bytes) {
+                        Ok(w) => match wire::event_of(&content, key_agent, &w) {
+                            Ok((agent, event, payload)) => {
+                                local.send_event(EventMsg { agent, event, time: w.time_ns, payload, urgent: w.urgent })
+                            }
+                            Err(e) => refuse(format!("{key}: {e}")),
+                        },
+                        Err(e) => refuse(format!("{key}: {e}")),
+                    }
+                })
+                .wait()
+                .map_err(|e| BusError(format!("cannot subscribe to events: {e}")))?;
+            subscribers.push(sub);
+        } else {
+            let (local, content, refuse) = (local.clone(), content.clone(), refuse.clone());
+            let sub = session
+                .declare_subscriber(wire::status_key(&robot))
+                .callback(move |sample| {
+                    let bytes = sample.payload().to_bytes();
+                    match wire::parse::<StatusWire>(&bytes) {
+                        Ok(w) => match content.state_id(&w.state) {
+                            Some(state) => local.send_status(StatusMsg { state, time: w.time_ns, seq: w.seq }),
+                            None => refuse(format!("status: unknown state `{}`", w.state)),
+                        },
+                        Err(e) => refuse(format!("status: {e}")),
+                    }
+                })
+                .wait()
+                .map_err(|e| BusError(format!("cannot subscribe to the status: {e}")))?;
+            subscribers.push(sub);
+        }
+        for (i, a) in content.agents.iter().enumerate() {
+            if !placement.local[i] {
+                continue;
+            }
+            let (local, content, refuse) = (local.clone(), content.clone(), refuse.clone());
+            let to = i as u32;
+            let sub = session
+                .declare_subscriber(format!("situ/{robot}/data/*/{}", a.name))
+                .callback(move |sample| {
+                    let bytes = sample.payload().to_bytes();
+                    match wire::parse::<DataWire>(&bytes) {
+                        Ok(w) => match content.agent_id(&w.from) {
+                            Some(from) => local.send_data(DataMsg {
+                                from,
+                                to,
+                                time: w.time_ns,
+                                urgent: w.urgent,
+                                body: Body::json(w.body),
+                            }),
+                            None => refuse(format!("data from unknown agent `{}`", w.from)),
+                        },
+                        Err(e) => refuse(format!("data: {e}")),
+                    }
+                })
+                .wait()
+                .map_err(|e| BusError(format!("cannot subscribe to data: {e}")))?;
+            subscribers.push(sub);
+        }
+        Ok(ZenohBus { local, session, content, placement, counters, refusals, _subscribers: subscribers })
+    }
+
+    /// The latest refused messages (at most 1,000 kept), emptied.
+    pub fn take_refusals(&self) -> Vec<String> {
+        std::mem::take(&mut *self.refusals.lock().unwrap_or_else(|p| p.into_inner()))
+    }
+
+    fn put(&self, key: String, bytes: Vec<u8>, congestion: CongestionControl, priority: Priority) {
+        self.counters.published.fetch_add(1, Ordering::Relaxed);
+        let _ = self.session.put(key, bytes).congestion_control(congestion).priority(priority).wait();
+    }
+}
+
+impl Bus for ZenohBus {
+    fn send_data(&self, msg: DataMsg) {
+        if self.placement.local.get(msg.to as usize).copied().unwrap_or(false) {
+            return self.local.send_data(msg);
+        }
+        let Body::Json(body) = &msg.body else {
+            self.counters.unsendable.fetch_add(1, Ordering::Relaxed);
+            return;
+        };
+        let c = &self.content;
+        let (from, to) = (&c.agents[msg.from as usize].name, &c.agents[msg.to as usize].name);
+        let w = DataWire {
+            v: VERSION,
+            from: from.clone(),
+            to: to.clone(),
+            time_ns: msg.time,
+            urgent: msg.urgent,
+            body: (**body).clone(),
+        };
+        let priority = if msg.urgent { Priority::RealTime } else { Priority::Data };
+        self.put(
+            wire::data_key(&self.placement.robot, from, to),
+            serde_json::to_vec(&w).expect("JSON"),
+            CongestionControl::Drop,
+            priority,
+        );
+    }
+
+    fn send_event(&self, msg: EventMsg) {
+        if self.placement.board {
+            return self.local.send_event(msg);
+        }
+        let w = wire::event_wire(&self.content, msg.agent, msg.event, msg.time, &msg.payload, msg.urgent);
+        let key = wire::event_key(&self.placement.robot, &w.agent);
+        let priority = if msg.urgent { Priority::RealTime } else { Priority::Data };
+        self.put(key, serde_json::to_vec(&w).expect("JSON"), CongestionControl::Block, priority);
+    }
+
+    fn send_status(&self, msg: StatusMsg) {
+        self.local.send_status(msg);
+        if self.placement.board {
+            let w = StatusWire {
+                v: VERSION,
+                state: self.content.states[msg.state as usize].name.clone(),
+                time_ns: msg.time,
+                seq: msg.seq,
+            };
+            let key = wire::status_key(&self.placement.robot);
+            self.put(key, serde_json::to_vec(&w).expect("JSON"), CongestionControl::Block, Priority::InteractiveHigh);
+        }
+    }
+
+    fn recv_data(&self, agent: u32, out: &mut Vec<DataMsg>) {
+        self.local.recv_data(agent, out)
+    }
+    fn discard_data(&self, agent: u32) -> usize {
+        self.local.discard_data(agent)
+    }
+    fn recv_events(&self, out: &mut Vec<EventMsg>) -> u64 {
+        self.local.recv_events(out)
+    }
+    fn status(&self, agent: u32) -> Option<StatusMsg> {
+        self.local.status(agent)
+    }
+    fn wait(&self, agent: u32, deadline: Instant) -> Wake {
+        self.local.wait(agent, deadline)
+    }
+    fn wait_input(&self, agent: u32, deadline: Instant) -> Wake {
+        self.local.wait_input(agent, deadline)
+    }
+    fn wait_events(&self, deadline: Instant) -> Wake {
+        self.local.wait_events(deadline)
+    }
+    fn set_doorbell(&self, agent: u32, bell: Arc<Doorbell>) {
+        self.local.set_doorbell(agent, bell)
+    }
+    fn attention(&self, agent: u32) -> Attention {
+        self.local.attention(agent)
+    }
+    fn close(&self) {
+        self.local.close();
+    }
+    fn counters(&self) -> BusCounters {
+        let mut c = self.local.counters();
+        c.rejected = self.counters.rejected.load(Ordering::Relaxed);
+        c.unsendable = self.counters.unsendable.load(Ordering::Relaxed);
+        c
+    }
+}
+
+impl Drop for ZenohBus {
+    fn drop(&mut self) {
+        let _ = self.session.close().wait();
+    }
+}
