@@ -74,10 +74,8 @@ impl Agent for Scripted {
                 }
                 cx.send(json(serde_json::json!({ "path": [] })));
             }
-            "Drive" => {
-                if cx.safe_mode() || !cx.inputs().is_empty() {
-                    let _ = cx.report("DRSTOP", &[]);
-                }
+            "Drive" if cx.safe_mode() || !cx.inputs().is_empty() => {
+                let _ = cx.report("DRSTOP", &[]);
             }
             _ => {}
         }
