@@ -165,7 +165,12 @@ impl Deployment {
         let mut cfg = serde_json::json!({
             "mode": "peer",
             "listen": { "endpoints": serde_json::from_str::<serde_json::Value>(&q(&process.listen)).unwrap_or_default() },
-            "connect": { "endpoints": serde_json::from_str::<serde_json::Value>(&q(&process.connect)).unwrap_or_default() },
+            // A process that comes back (a restarted Bulletinboard) is met again
+            // within half a second.
+            "connect": {
+                "endpoints": serde_json::from_str::<serde_json::Value>(&q(&process.connect)).unwrap_or_default(),
+                "retry": { "period_init_ms": 100, "period_max_ms": 500, "period_increase_factor": 2 },
+            },
             "scouting": { "multicast": { "enabled": false }, "gossip": { "enabled": true } },
         });
         if let (Some(tls), Some(cert), Some(key)) = (&self.tls, &process.cert, &process.key) {

@@ -234,7 +234,10 @@ fn follow(
                 });
             }
         }
-        if status.seq != seq {
+        // A change is a state other than the one followed: sequence numbers
+        // start again with a restarted Bulletinboard, and a status missed
+        // while reconnecting must not hide the next one.
+        if status.seq != seq || status.state != shared.org().state() {
             seq = status.seq;
             let from = shared.org().state();
             if from != status.state {
