@@ -196,8 +196,12 @@ impl Deployment {
         serde_json::json!({
             "enabled": true,
             "default_permission": "deny",
+            // A rule's subject is the other end of a link: a status comes in
+            // only from the board, and goes out to any member.
             "rules": [
-                { "id": "status", "messages": ["put"], "flows": ["ingress", "egress"], "permission": "allow",
+                { "id": "status_in", "messages": ["put"], "flows": ["ingress"], "permission": "allow",
+                  "key_exprs": [format!("situ/{robot}/status")] },
+                { "id": "status_out", "messages": ["put"], "flows": ["egress"], "permission": "allow",
                   "key_exprs": [format!("situ/{robot}/status")] },
                 { "id": "streams", "messages": ["put"], "flows": ["ingress", "egress"], "permission": "allow",
                   "key_exprs": [format!("situ/{robot}/event/**"), format!("situ/{robot}/data/**")] },
@@ -209,8 +213,8 @@ impl Deployment {
                 { "id": "members", "cert_common_names": all },
             ],
             "policies": [
-                { "id": "board_status", "rules": ["status"], "subjects": ["board"] },
-                { "id": "members_streams", "rules": ["streams", "subscribe"], "subjects": ["members"] },
+                { "id": "board_status", "rules": ["status_in"], "subjects": ["board"] },
+                { "id": "members_streams", "rules": ["status_out", "streams", "subscribe"], "subjects": ["members"] },
             ],
         })
     }

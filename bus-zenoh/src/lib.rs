@@ -163,11 +163,6 @@ impl ZenohBus {
         Ok(ZenohBus { local, session, content, placement, counters, refusals, _subscribers: subscribers })
     }
 
-    /// The latest refused messages (at most 1,000 kept), emptied.
-    pub fn take_refusals(&self) -> Vec<String> {
-        std::mem::take(&mut *self.refusals.lock().unwrap_or_else(|p| p.into_inner()))
-    }
-
     fn put(&self, key: String, bytes: Vec<u8>, congestion: CongestionControl, priority: Priority) {
         self.counters.published.fetch_add(1, Ordering::Relaxed);
         let _ = self.session.put(key, bytes).congestion_control(congestion).priority(priority).wait();
@@ -255,6 +250,10 @@ impl Bus for ZenohBus {
     }
     fn close(&self) {
         self.local.close();
+    }
+    /// The latest refused messages (at most 1,000 kept between calls).
+    fn take_refusals(&self) -> Vec<String> {
+        std::mem::take(&mut *self.refusals.lock().unwrap_or_else(|p| p.into_inner()))
     }
     fn counters(&self) -> BusCounters {
         let mut c = self.local.counters();

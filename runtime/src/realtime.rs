@@ -172,6 +172,11 @@ pub fn run_on(
                 }
                 let _ = shared.bus.wait_events(next_beat.min(end));
                 let mut changes = board.pump(&shared, clock());
+                for why in shared.bus.take_refusals() {
+                    shared.record(|s| {
+                        s.diagnostic(clock(), crate::record::Level::Warning, &format!("message refused: {why}"))
+                    });
+                }
                 let now = Instant::now();
                 if now >= next_beat {
                     next_beat += config.heartbeat;

@@ -155,6 +155,11 @@ pub trait Bus: Send + Sync {
     fn set_doorbell(&self, agent: u32, bell: std::sync::Arc<Doorbell>);
     /// What arrived for the agent since it last looked; clears it.
     fn attention(&self, agent: u32) -> Attention;
+    /// Messages from other processes refused since the last call, in words
+    /// (in process: none).
+    fn take_refusals(&self) -> Vec<String> {
+        Vec::new()
+    }
     /// Wakes every waiter with [`Wake::Closed`].
     fn close(&self);
     fn counters(&self) -> BusCounters;
