@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Every test of situ, from a fresh machine: installs what the tests need
+# (Python packages from PyPI, CLIPS and spin from Debian's packages), then
+# runs the Rust tests with every feature (the Zenoh bus included) and the
+# checks against the external references. A tool that cannot be installed
+# fails the run: nothing is skipped.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+echo "== installing the Python packages the tests use (examples/python/requirements.txt)"
+python3 -m pip install --quiet --disable-pip-version-check -r examples/python/requirements.txt
+
+echo "== cargo test --workspace --all-features"
+cargo test --workspace --all-features
+
+echo "== CLIPS: the outdoor rules in CLIPS pass their own tests"
+bash bench/clips/install.sh
+bash bench/clips/selftest.sh
+
+echo "== situ, CLIPS and the hand-written matcher reach the same states"
+EVENTS=200000 bash bench/vs-clips.sh
+
+echo "== spin and situ agree on the properties (Promela export)"
+bash verify/spin-check.sh
