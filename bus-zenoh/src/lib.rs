@@ -9,7 +9,9 @@
 //! the local mailboxes. Quality of service: events and status are sent with
 //! `CongestionControl::Block` (never dropped by Zenoh), data with `Drop`
 //! (keep-latest, as in process); urgent messages at `Priority::RealTime`,
-//! status at `InteractiveHigh`, events and data at `Data`.
+//! status at `InteractiveHigh`, events and data at `Data`. Status, events
+//! and urgent data are sent `express` (no batching: latency first); data
+//! is batched (throughput first).
 
 pub mod deploy;
 pub mod wire;
@@ -163,9 +165,11 @@ impl ZenohBus {
         Ok(ZenohBus { local, session, content, placement, counters, refusals, _subscribers: subscribers })
     }
 
-    fn put(&self, key: String, bytes: Vec<u8>, congestion: CongestionControl, priority: Priority) {
+    /// Publishes; `express` messages skip Zenoh's batching (status,
+    /// events, urgent data: latency first), the rest is batched (throughput).
+    fn put(&self, key: String, bytes: Vec<u8>, congestion: CongestionControl, priority: Priority, express: bool) {
         self.counters.published.fetch_add(1, Ordering::Relaxed);
-        let _ = self.session.put(key, bytes).congestion_control(congestion).priority(priority).wait();
+        let _ = self.session.put(key, bytes).congestion_control(congestion).priority(priority).express(express).wait();
     }
 }
 
@@ -194,6 +198,7 @@ impl Bus for ZenohBus {
             serde_json::to_vec(&w).expect("JSON"),
             CongestionControl::Drop,
             priority,
+            msg.urgent,
         );
     }
 
@@ -204,7 +209,7 @@ impl Bus for ZenohBus {
         let w = wire::event_wire(&self.content, msg.agent, msg.event, msg.time, &msg.payload, msg.urgent);
         let key = wire::event_key(&self.placement.robot, &w.agent);
         let priority = if msg.urgent { Priority::RealTime } else { Priority::Data };
-        self.put(key, serde_json::to_vec(&w).expect("JSON"), CongestionControl::Block, priority);
+        self.put(key, serde_json::to_vec(&w).expect("JSON"), CongestionControl::Block, priority, true);
     }
 
     fn send_status(&self, msg: StatusMsg) {
@@ -217,7 +222,13 @@ impl Bus for ZenohBus {
                 seq: msg.seq,
             };
             let key = wire::status_key(&self.placement.robot);
-            self.put(key, serde_json::to_vec(&w).expect("JSON"), CongestionControl::Block, Priority::InteractiveHigh);
+            self.put(
+                key,
+                serde_json::to_vec(&w).expect("JSON"),
+                CongestionControl::Block,
+                Priority::InteractiveHigh,
+                true,
+            );
         }
     }
 

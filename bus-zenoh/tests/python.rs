@@ -20,7 +20,8 @@ use std::time::Duration;
 #[test]
 fn a_python_agent_joins_the_rust_bulletinboard() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let checked = situ_compiler::check(&root.join("examples/fig5/fig5.situ"), &situ_compiler::loader::FsLoader).unwrap();
+    let checked =
+        situ_compiler::check(&root.join("examples/fig5/fig5.situ"), &situ_compiler::loader::FsLoader).unwrap();
     let c = Arc::new(situ_compiler::bundle::build(&checked));
     let port = std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
     let agents: Vec<String> = c.agents.iter().map(|a| a.name.clone()).collect();
@@ -31,7 +32,8 @@ fn a_python_agent_joins_the_rust_bulletinboard() {
     let p = d.board();
     let local: Vec<bool> = c.agents.iter().map(|a| p.agents.contains(&a.name)).collect();
     let placement = Placement { robot: "py".into(), local, board: true };
-    let bus: Arc<dyn Bus> = Arc::new(ZenohBus::open(c.clone(), placement, &d.zenoh_config(p), Capacity::default()).unwrap());
+    let bus: Arc<dyn Bus> =
+        Arc::new(ZenohBus::open(c.clone(), placement, &d.zenoh_config(p), Capacity::default()).unwrap());
     let log: demo::Log = Arc::new(Mutex::new(Vec::new()));
     let mine = demo::fig5(Duration::from_secs(3600), log.clone()).into_iter().filter(|a| a.name() != "LADAR").collect();
     let bound = agent::bind(&c, mine, false).unwrap();
