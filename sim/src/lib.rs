@@ -17,6 +17,9 @@
 //!   the hard switch and the multi-agent merge (eqs. 16–19);
 //! - [`outdoor`]: a closed loop of the outdoor stack with a simple built-in
 //!   situation logic (a stand-in for the Bulletinboard);
+//! - [`stack`]: the same parts as runtime agents of `rules/outdoor.situ`
+//!   and `rules/ugv.situ`, run on the **real** rules by the runtime's
+//!   simulated-time scheduler (what `situ run` drives);
 //! - [`metrics`] and [`plot`]: what a run measured (`metrics.json`,
 //!   deterministic to the byte), and its pictures (`trajectory.svg`,
 //!   `timeline.svg`).
@@ -44,6 +47,7 @@ pub mod outdoor;
 pub mod plot;
 pub mod scenario;
 pub mod sensors;
+pub mod stack;
 pub mod ugv;
 pub mod vehicle;
 pub mod world;
