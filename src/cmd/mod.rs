@@ -7,6 +7,7 @@ pub mod explain;
 pub mod fmt;
 pub mod graph;
 pub mod program;
+pub mod run;
 
 use std::io::IsTerminal;
 use std::path::Path;
