@@ -660,14 +660,14 @@ impl StackRun {
         let physics = self.physics.clone();
         let mut guard = lock(&physics);
         let ph = &mut *guard;
-        if self.k % self.cfg.sample_every == 0 {
+        if self.k.is_multiple_of(self.cfg.sample_every) {
             self.sample(ts, &def.name, ph);
         }
         if let Some(scene) = &self.scene {
-            if self.k % (50_000_000 / h).max(1) == 0 {
+            if self.k.is_multiple_of((50_000_000 / h).max(1)) {
                 scene.pose(t0, ph);
             }
-            if self.k % (NS / h).max(1) == 0 {
+            if self.k.is_multiple_of((NS / h).max(1)) {
                 scene.obstacles(t0, ph);
             }
         }
@@ -747,7 +747,7 @@ impl StackRun {
     pub fn run(&mut self, progress: &mut dyn FnMut(&StackRun)) {
         let per_second = (NS / self.cfg.physics_step).max(1);
         while self.step() {
-            if self.k % per_second == 0 {
+            if self.k.is_multiple_of(per_second) {
                 progress(self);
             }
         }
