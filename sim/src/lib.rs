@@ -1,6 +1,6 @@
 //! `situ-sim`: the reference agent stack of situ, simulated.
 //!
-//! Plain, deterministic parts with no dependency on the runtime, each with an
+//! Plain, deterministic parts (only [`stack`] uses the runtime), each with an
 //! API a wrapper calls once per tick:
 //! - [`world`]: roads (a petgraph graph with geometry), cross-country areas,
 //!   static and moving obstacles, and the queries sensors need;

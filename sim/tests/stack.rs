@@ -144,3 +144,25 @@ fn the_same_scenario_and_seed_give_the_same_metrics_to_the_byte() {
     let b = run("outdoor.situ", 1, None).to_json();
     assert!(a.as_bytes() == b.as_bytes(), "metrics.json differs between two runs");
 }
+
+#[test]
+fn a_lost_position_is_an_emergency_that_ends_in_a_stop_once_the_vehicle_stands() {
+    let content = rules("outdoor.situ");
+    let mut world = scenario::outdoor_default().world;
+    world.gps_outages.push(situ_sim::geom::rect_polygon(situ_sim::geom::v2(150.0, 0.0), 20.0, 20.0, 0.0));
+    let memory = SharedMemory::default();
+    let cfg = StackConfig { seed: 1, until: 120.0, ..StackConfig::default() };
+    let recording = Recording { mcap: None, sinks: vec![Box::new(memory.clone())] };
+    let mut run = StackRun::new(content.clone(), StackKind::Outdoor, &world, cfg, recording).unwrap();
+    run.run(&mut |_| {});
+    let report = run.finish().unwrap();
+    assert!(matches!(&report.outcome, Outcome::Stopped { state, .. } if state == "SP"), "{:?}", report.outcome);
+    assert_eq!(report.runtime.path, ["IT", "RD", "RS", "EM", "SP"]);
+    let rec = memory.snapshot();
+    let at = |s: &str| rec.changes.iter().find(|c| c.changed() && c.to == content.state_id(s).unwrap()).unwrap().time;
+    // From 10 m/s at 4 m/s²: 2.5 s of braking. The DRSTOP Drive reported
+    // standing at the start does not end the emergency (`within 100ms`).
+    let braking = (at("SP") - at("EM")) as f64 * 1e-9;
+    assert!((2.3..3.0).contains(&braking), "EM for {braking:.2} s");
+    assert!(report.metrics.summary.collisions.is_empty());
+}

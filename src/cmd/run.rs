@@ -113,7 +113,7 @@ pub fn run(args: Args) -> u8 {
             }
         };
     let live = std::io::stderr().is_terminal();
-    let mut last = Instant::now();
+    let mut last = Instant::now().checked_sub(REDRAW).unwrap_or_else(Instant::now);
     let mut drawn = false;
     run.run(&mut |r| {
         if live && last.elapsed() >= REDRAW {
