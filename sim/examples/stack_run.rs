@@ -1,8 +1,13 @@
-//! Runs a rules file's stack on a scenario and prints the tables.
+//! Runs a rules file's stack on a scenario and prints the tables: a tool
+//! for tuning the stack without the CLI.
 //!
 //! ```sh
 //! cargo run --release -p situ-sim --example stack_run -- rules/outdoor.situ [SCENARIO] [SEED]
 //! ```
+//!
+//! Environment: `RATES=Gps:20,LPL:20` sets agents' rates over the rules;
+//! `PROGRESS=1` prints the live line every simulated second; `STEER=1` the
+//! largest steering-rate steps, and `WINDOW=T` the samples around T seconds.
 use situ_compiler::loader::FsLoader;
 use situ_sim::scenario;
 use situ_sim::stack::{Recording, StackConfig, StackKind, StackRun};
@@ -58,6 +63,3 @@ fn main() {
         }
     }
 }
-
-#[allow(dead_code)]
-fn unused() {}
