@@ -81,6 +81,29 @@ enum Command {
         #[arg(long)]
         no_reset: bool,
     },
+    /// Run the rules' reference stack on a simulated mission; exit 0 mission done, 1 failed, 2 usage or I/O.
+    Run {
+        /// A `.situ` source or a bundle (rules/outdoor.situ, rules/ugv.situ: the stack is told by the agents).
+        file: PathBuf,
+        /// A built-in scenario (outdoor-default, dafflon-4) or a TOML file; default: the stack's own.
+        #[arg(long)]
+        scenario: Option<String>,
+        /// Record the run to this MCAP file (Foxglove reads it).
+        #[arg(long)]
+        record: Option<PathBuf>,
+        /// Write trajectory.svg, timeline.svg, metrics.json and recording.mcap into this directory.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// The noise seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Stop after this many seconds of simulated time (default 600, the UGV 120).
+        #[arg(long)]
+        until: Option<f64>,
+        /// Dafflon et al.'s comparison of the controllers (rules/ugv.situ): hard-switch,merge.
+        #[arg(long, value_delimiter = ',')]
+        compare: Option<Vec<String>>,
+    },
     /// Pictures: the wiring of a state, the Rete network, the state transitions.
     Graph {
         /// A `.situ` source or a bundle (the states view needs the source).
@@ -173,6 +196,9 @@ fn main() -> ExitCode {
         }
         Command::Export { promela: _, file, output, depth, max_states } => {
             cmd::export::run(&file, output.as_ref(), depth, max_states)
+        }
+        Command::Run { file, scenario, record, out, seed, until, compare } => {
+            cmd::run::run(cmd::run::Args { file, scenario, record, out, seed, until, compare })
         }
         Command::Graph { file, view, state, format, output } => {
             cmd::graph::run(&file, view, state.as_deref(), format, output.as_ref())

@@ -1,6 +1,6 @@
 //! `situ-sim`: the reference agent stack of situ, simulated.
 //!
-//! Plain, deterministic parts with no dependency on the runtime, each with an
+//! Plain, deterministic parts (only [`stack`] uses the runtime), each with an
 //! API a wrapper calls once per tick:
 //! - [`world`]: roads (a petgraph graph with geometry), cross-country areas,
 //!   static and moving obstacles, and the queries sensors need;
@@ -17,6 +17,9 @@
 //!   the hard switch and the multi-agent merge (eqs. 16–19);
 //! - [`outdoor`]: a closed loop of the outdoor stack with a simple built-in
 //!   situation logic (a stand-in for the Bulletinboard);
+//! - [`stack`]: the same parts as runtime agents of `rules/outdoor.situ`
+//!   and `rules/ugv.situ`, run on the **real** rules by the runtime's
+//!   simulated-time scheduler (what `situ run` drives);
 //! - [`metrics`] and [`plot`]: what a run measured (`metrics.json`,
 //!   deterministic to the byte), and its pictures (`trajectory.svg`,
 //!   `timeline.svg`).
@@ -44,6 +47,7 @@ pub mod outdoor;
 pub mod plot;
 pub mod scenario;
 pub mod sensors;
+pub mod stack;
 pub mod ugv;
 pub mod vehicle;
 pub mod world;

@@ -458,6 +458,37 @@ impl Lpl {
     }
 }
 
+/// The road edge an obstacle blocks, if it blocks one: an obstacle on a
+/// road (taller than the vehicle's clearance) beside which there is room
+/// for the vehicle with `margin` on neither side (the test of the passes of
+/// [`Lpl`]). What the Mapper writes into the map, for GPL to re-plan.
+pub fn blocked_road(world: &World, polygon: &[crate::geom::Vec2], height: f64, margin: f64) -> Option<EdgeIndex> {
+    let veh = &world.vehicle;
+    if height <= veh.clearance || polygon.is_empty() {
+        return None;
+    }
+    let centre = crate::geom::vertex_centroid(polygon);
+    let (edge, pr) = world.roads.nearest_edge(centre, Some(EdgeKind::Road))?;
+    let piece = world.roads.graph[edge].piece;
+    let road_half = world.roads.half_width();
+    let radius = polygon.iter().map(|p| (p - centre).norm()).fold(0.0, f64::max);
+    if pr.distance > road_half + radius {
+        return None; // not on that road (beyond its end, or off it)
+    }
+    let (mut lmin, mut lmax) = (f64::INFINITY, f64::NEG_INFINITY);
+    for p in polygon {
+        let l = piece.project(*p).lateral;
+        lmin = lmin.min(l);
+        lmax = lmax.max(l);
+    }
+    if lmin > road_half || lmax < -road_half {
+        return None;
+    }
+    let hw = veh.width / 2.0;
+    let fits = |l: f64| l.abs() <= road_half - hw + 0.25;
+    (!fits(lmax + hw + margin) && !fits(lmin - hw - margin)).then_some(edge)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -527,6 +558,19 @@ mod tests {
         let later = PlanInput { pose: Pose::new(260.0, -1.75, 0.0), s: 255.0, obstacles: &[], ..input };
         assert_eq!(lpl.plro(&later).event, PlanEvent::Straight);
         assert!(lpl.windows.is_empty());
+    }
+
+    #[test]
+    fn the_mapper_sees_which_road_an_obstacle_blocks() {
+        let w = scenario::outdoor_default().world;
+        let wide = rect_polygon(v2(200.0, 0.0), 4.5, 6.5, 0.0);
+        let edge = blocked_road(&w, &wide, 1.5, 0.8).map(|e| w.roads.graph[e].id.as_str());
+        assert_eq!(edge, Some("r1"));
+        let car = rect_polygon(v2(200.0, -1.75), 4.5, 1.8, 0.0);
+        assert_eq!(blocked_road(&w, &car, 1.5, 0.8), None, "the left lane is free");
+        assert_eq!(blocked_road(&w, &wide, 0.1, 0.8), None, "driven over");
+        let thicket = crate::geom::circle_polygon(v2(600.0, 220.5), 2.0, 16);
+        assert_eq!(blocked_road(&w, &thicket, 1.2, 0.8), None, "on the track, beyond the road's end");
     }
 
     #[test]

@@ -133,6 +133,7 @@ pub struct Recorder {
     steer_rate_sq: f64,
     rate_count: u64,
     speed_sum: f64,
+    count: u64,
 }
 
 impl Recorder {
@@ -152,6 +153,7 @@ impl Recorder {
             steer_rate_sq: 0.0,
             rate_count: 0,
             speed_sum: 0.0,
+            count: 0,
         }
     }
 
@@ -185,6 +187,7 @@ impl Recorder {
         sum.max_abs_steer = sum.max_abs_steer.max(s.steer_cmd.abs());
         sum.duration = s.t;
         self.speed_sum += s.v;
+        self.count += 1;
         self.metrics.samples.push(s.clone());
         self.prev = Some(s);
     }
@@ -212,6 +215,12 @@ impl Recorder {
         *self.metrics.architecture.messages_per_stream.entry(stream.into()).or_insert(0) += n;
     }
 
+    /// Drops the samples kept so far (long runs that want the summary
+    /// only; the summary keeps counting).
+    pub fn forget_samples(&mut self) {
+        self.metrics.samples.clear();
+    }
+
     /// The samples so far.
     pub fn samples(&self) -> &[Sample] {
         &self.metrics.samples
@@ -224,7 +233,7 @@ impl Recorder {
 
     /// Ends the run.
     pub fn finish(mut self) -> Metrics {
-        let n = self.metrics.samples.len();
+        let n = self.count;
         if self.rate_count > 0 {
             self.metrics.summary.rms_steer_rate = (self.steer_rate_sq / self.rate_count as f64).sqrt();
         }

@@ -376,6 +376,11 @@ pub struct Localization {
     pub position_sigma: f64,
     /// Heading noise (σ, rad).
     pub heading_sigma: f64,
+    /// Correlation of the error from one solution to the next, in [0, 1):
+    /// 0 is white noise; a GPS/INS filter's error wanders slowly (a
+    /// first-order Gauss–Markov process keeping σ), see [`Localization::correlated`].
+    pub correlation: f64,
+    error: (f64, f64, f64),
     noise: Noise,
 }
 
@@ -393,7 +398,20 @@ pub struct Fix {
 impl Localization {
     /// GPS/INS with 0.1 m and 0.005 rad noise, and a seed.
     pub fn new(seed: u64) -> Self {
-        Localization { position_sigma: 0.1, heading_sigma: 0.005, noise: Noise::new(seed, 14) }
+        Localization {
+            position_sigma: 0.1,
+            heading_sigma: 0.005,
+            correlation: 0.0,
+            error: (0.0, 0.0, 0.0),
+            noise: Noise::new(seed, 14),
+        }
+    }
+
+    /// The same with an error that wanders with correlation time `tau` (s)
+    /// for solutions every `period` (s): what a GPS/INS filter gives, rather
+    /// than a fresh error at every solution.
+    pub fn correlated(seed: u64, period: f64, tau: f64) -> Self {
+        Localization { correlation: (-period / tau.max(1e-9)).exp(), ..Localization::new(seed) }
     }
 
     /// One solution (`gpsins()`): LOLOST inside the scenario's GPS outages,
@@ -403,10 +421,18 @@ impl Localization {
             return Fix { event: LocalizationEvent::Lost, pose: None, speed: state.v };
         }
         let s = self.position_sigma;
+        let a = self.correlation;
+        let k = (1.0 - a * a).sqrt();
+        let (ex, ey, eh) = self.error;
+        self.error = (
+            a * ex + k * self.noise.normal(s),
+            a * ey + k * self.noise.normal(s),
+            a * eh + k * self.noise.normal(self.heading_sigma),
+        );
         let pose = Pose::new(
-            state.pose.x + self.noise.normal(s),
-            state.pose.y + self.noise.normal(s),
-            crate::geom::wrap_angle(state.pose.theta + self.noise.normal(self.heading_sigma)),
+            state.pose.x + self.error.0,
+            state.pose.y + self.error.1,
+            crate::geom::wrap_angle(state.pose.theta + self.error.2),
         );
         let error = 2.0 * s * (1.0 + self.noise.normal(0.1)).max(0.5);
         Fix { event: LocalizationEvent::Fix { error }, pose: Some(pose), speed: state.v }

@@ -573,6 +573,30 @@ pub struct ComparisonRow {
     pub time_to_goal: Option<f64>,
 }
 
+impl ComparisonRow {
+    /// The row of a run's metrics (its samples give the top speed near obstacles).
+    pub fn from_metrics(strategy: &str, m: &Metrics) -> ComparisonRow {
+        let sum = &m.summary;
+        ComparisonRow {
+            strategy: strategy.into(),
+            max_steer_rate: sum.max_steer_rate,
+            rms_steer_rate: sum.rms_steer_rate,
+            max_speed: sum.max_speed,
+            max_speed_near: m
+                .samples
+                .iter()
+                .filter(|s| s.closest.is_some_and(|c| c < NEAR))
+                .map(|s| s.v_cmd)
+                .fold(0.0, f64::max),
+            mean_speed: sum.mean_speed,
+            closest_distance: sum.closest_distance.unwrap_or(f64::INFINITY),
+            min_ttc: sum.min_ttc,
+            collisions: sum.collisions.len(),
+            time_to_goal: sum.time_to_goal,
+        }
+    }
+}
+
 /// Dafflon et al.'s comparison: one row per strategy.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Comparison {
@@ -597,9 +621,10 @@ impl Comparison {
 impl fmt::Display for Comparison {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(f, "scenario {} (seed {})", self.scenario, self.seed)?;
+        let w = self.rows.iter().map(|r| r.strategy.chars().count()).max().unwrap_or(0).max(12);
         writeln!(
             f,
-            "{:<12} {:>12} {:>10} {:>7} {:>12} {:>7} {:>8} {:>8} {:>10} {:>8}",
+            "{:<w$} {:>12} {:>10} {:>7} {:>12} {:>7} {:>8} {:>8} {:>10} {:>8}",
             "strategy",
             "max |dγ/dt|",
             "rms dγ/dt",
@@ -613,14 +638,14 @@ impl fmt::Display for Comparison {
         )?;
         writeln!(
             f,
-            "{:<12} {:>12} {:>10} {:>7} {:>12} {:>7} {:>8} {:>8} {:>10} {:>8}",
+            "{:<w$} {:>12} {:>10} {:>7} {:>12} {:>7} {:>8} {:>8} {:>10} {:>8}",
             "", "(rad/s)", "(rad/s)", "(m/s)", "(m/s)", "(m/s)", "(m)", "(s)", "", "(s)"
         )?;
         for r in &self.rows {
             let opt = |o: Option<f64>| o.map_or("-".to_string(), |v| format!("{v:.2}"));
             writeln!(
                 f,
-                "{:<12} {:>12.3} {:>10.3} {:>7.2} {:>12.2} {:>7.2} {:>8.2} {:>8} {:>10} {:>8}",
+                "{:<w$} {:>12.3} {:>10.3} {:>7.2} {:>12.2} {:>7.2} {:>8.2} {:>8} {:>10} {:>8}",
                 r.strategy,
                 r.max_steer_rate,
                 r.rms_steer_rate,
@@ -644,24 +669,7 @@ pub fn compare(world: &World, strategies: &[Strategy], seed: u64, cfg: &UgvConfi
     let mut runs = Vec::new();
     for &s in strategies {
         let m = run(world, s, seed, cfg);
-        let sum = &m.summary;
-        rows.push(ComparisonRow {
-            strategy: s.name().into(),
-            max_steer_rate: sum.max_steer_rate,
-            rms_steer_rate: sum.rms_steer_rate,
-            max_speed: sum.max_speed,
-            max_speed_near: m
-                .samples
-                .iter()
-                .filter(|s| s.closest.is_some_and(|c| c < NEAR))
-                .map(|s| s.v_cmd)
-                .fold(0.0, f64::max),
-            mean_speed: sum.mean_speed,
-            closest_distance: sum.closest_distance.unwrap_or(f64::INFINITY),
-            min_ttc: sum.min_ttc,
-            collisions: sum.collisions.len(),
-            time_to_goal: sum.time_to_goal,
-        });
+        rows.push(ComparisonRow::from_metrics(s.name(), &m));
         runs.push(m);
     }
     Comparison { scenario: world.name.clone(), seed, rows, runs }

@@ -8,6 +8,7 @@ pub mod export;
 pub mod fmt;
 pub mod graph;
 pub mod program;
+pub mod run;
 pub mod test;
 
 use std::io::IsTerminal;

@@ -12,6 +12,10 @@
 //! | `/situ/data` | `situ.Data` | every data message's metadata: from, to, size, fate |
 //! | `/situ/modes` | `situ.Mode` | every change of an agent's mode or function |
 //!
+//! More channels can be added ([`McapRecorder::add_channel`]): `situ run`
+//! adds the vehicle's pose (`/pose`, `foxglove.PoseInFrame`) and the
+//! obstacles (`/obstacles`, `foxglove.SceneUpdate`).
+//!
 //! The bundle that ran is attached (`bundle.json`), so that a replay needs
 //! nothing else. Chunks are closed and the file flushed at least once a
 //! second (of wall time) while records come, so a process killed mid-run
@@ -62,13 +66,15 @@ struct Channels {
 }
 
 /// Counts of messages written per topic.
-pub type Counts = BTreeMap<&'static str, u64>;
+pub type Counts = BTreeMap<String, u64>;
 
 pub struct McapRecorder {
     writer: Option<mcap::Writer<BufWriter<File>>>,
     content: Arc<Content>,
     channels: Channels,
     counts: Counts,
+    /// Channels added with [`McapRecorder::add_channel`]: id → topic.
+    extra: BTreeMap<u16, String>,
     last_flush: Instant,
     error: Option<io::Error>,
 }
@@ -150,6 +156,7 @@ impl McapRecorder {
             content,
             channels,
             counts: Counts::new(),
+            extra: BTreeMap::new(),
             last_flush: Instant::now(),
             error: None,
         })
@@ -160,7 +167,28 @@ impl McapRecorder {
         &self.counts
     }
 
-    fn write(&mut self, channel: u16, topic: &'static str, time: u64, message: &Json) {
+    /// Adds a channel of JSON messages with a JSON-schema schema (a
+    /// Foxglove schema name such as `foxglove.PoseInFrame` makes Foxglove's
+    /// panels show it); returns its id for [`write_message`](Self::write_message).
+    pub fn add_channel(&mut self, topic: &str, schema_name: &str, schema_text: &str) -> io::Result<u16> {
+        let w = self.writer.as_mut().ok_or_else(|| io::Error::other("the recording is finished"))?;
+        let schema = w.add_schema(schema_name, "jsonschema", schema_text.as_bytes()).map_err(mcap_err)?;
+        let id = w.add_channel(schema, topic, "json", &BTreeMap::new()).map_err(mcap_err)?;
+        self.extra.insert(id, topic.to_string());
+        Ok(id)
+    }
+
+    /// Writes a message on a channel made by [`add_channel`](Self::add_channel),
+    /// at `time` (ns); flushed with the rest, at least once a second.
+    pub fn write_message(&mut self, channel: u16, time: u64, message: &Json) {
+        let Some(topic) = self.extra.get(&channel).cloned() else {
+            self.error.get_or_insert(io::Error::other(format!("no channel {channel} was added")));
+            return;
+        };
+        self.write(channel, &topic, time, message);
+    }
+
+    fn write(&mut self, channel: u16, topic: &str, time: u64, message: &Json) {
         let Some(w) = self.writer.as_mut() else { return };
         let header = MessageHeader { channel_id: channel, sequence: 0, log_time: time, publish_time: time };
         let bytes = serde_json::to_vec(message).expect("JSON serializes");
@@ -168,7 +196,12 @@ impl McapRecorder {
             self.error.get_or_insert(mcap_err(e));
             return;
         }
-        *self.counts.entry(topic).or_default() += 1;
+        match self.counts.get_mut(topic) {
+            Some(n) => *n += 1,
+            None => {
+                self.counts.insert(topic.to_string(), 1);
+            }
+        }
         if self.last_flush.elapsed() >= FLUSH_EVERY {
             let _ = self.flush();
         }

@@ -184,3 +184,32 @@ impl Sink for Tee {
         self.0.iter_mut().try_for_each(|s| s.finish())
     }
 }
+
+/// Any sink shared with whoever else writes to it or reads it during a run
+/// (a recording that the simulation adds its own channels to, say).
+impl<S: Sink> Sink for std::sync::Arc<std::sync::Mutex<S>> {
+    fn event(&mut self, rec: &EventRecord) {
+        self.lock().unwrap_or_else(|p| p.into_inner()).event(rec)
+    }
+    fn change(&mut self, change: &StateChange) {
+        self.lock().unwrap_or_else(|p| p.into_inner()).change(change)
+    }
+    fn data(&mut self, rec: &DataRecord) {
+        self.lock().unwrap_or_else(|p| p.into_inner()).data(rec)
+    }
+    fn mode(&mut self, rec: &ModeRecord) {
+        self.lock().unwrap_or_else(|p| p.into_inner()).mode(rec)
+    }
+    fn diagnostic(&mut self, time: u64, level: Level, text: &str) {
+        self.lock().unwrap_or_else(|p| p.into_inner()).diagnostic(time, level, text)
+    }
+    fn tick(&mut self, time: u64) {
+        self.lock().unwrap_or_else(|p| p.into_inner()).tick(time)
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.lock().unwrap_or_else(|p| p.into_inner()).flush()
+    }
+    fn finish(&mut self) -> std::io::Result<()> {
+        self.lock().unwrap_or_else(|p| p.into_inner()).finish()
+    }
+}

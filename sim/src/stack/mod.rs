@@ -1,0 +1,850 @@
+//! The reference stacks on the **real** rules: every agent of
+//! `rules/outdoor.situ` (Zhang & Zhu) and of `rules/ugv.situ` (Dafflon et
+//! al.) as a runtime [`Agent`](situ_runtime::agent::Agent) wrapping the sim's
+//! parts, run by the runtime's simulated-time scheduler with the compiled
+//! rules deciding the state. This is what `situ run` drives.
+//!
+//! - [`Physics`]: the ground truth the agents share (world, vehicle, time,
+//!   the last command). Sensors read it; the actuator (Drive, Vehicle)
+//!   writes its command into it; nothing else touches it. Every other input
+//!   of an agent comes through the data stream, along the links of the
+//!   moment (Fig. 5: LPL plans from RFCCD in RS, from Fusion in RO).
+//! - [`StackRun`]: the loop. The physics integrates at a fixed step `h`
+//!   (10 ms); between two steps the runtime runs every agent step and
+//!   heartbeat that falls in `[T, T + h)`, all of them seeing the world at
+//!   `T` (a zero-order hold, causal). The run ends at a collision, at a
+//!   final state once the vehicle stands still, or at `until`.
+//! - [`RunReport`]: what `metrics.json` holds: the outcome, the paper's
+//!   metrics (time to goal, closest distance, collisions, steering rate,
+//!   speed per state), the architecture's figures and the runtime's summary.
+//!   Nothing in it reads a clock: the same scenario and seed give the same
+//!   bytes.
+
+pub mod events;
+pub mod outdoor;
+pub mod ugv;
+
+use crate::metrics::{Metrics, Recorder, Sample};
+use crate::vehicle::{Command, Vehicle};
+use crate::world::{ObstacleView, World};
+use serde::Serialize;
+use serde_json::{json, Value as Json};
+use situ_compiler::bundle::{Content, Mode};
+use situ_runtime::agent;
+use situ_runtime::record::mcap::McapRecorder;
+use situ_runtime::record::{DataRecord, EventRecord, Fate, Level, ModeRecord, Sink, Tee};
+use situ_runtime::rete::StateChange;
+use situ_runtime::sched::{SimConfig, SimRuntime};
+use situ_runtime::summary::Summary;
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt::Write as _;
+use std::sync::{Arc, Mutex, MutexGuard};
+
+/// Nanoseconds per second.
+pub const NS: u64 = 1_000_000_000;
+
+/// The ground truth every agent of a simulated stack shares.
+#[derive(Debug)]
+pub struct Physics {
+    /// The world (roads, areas, obstacles).
+    pub world: World,
+    /// The vehicle (its true state).
+    pub vehicle: Vehicle,
+    /// Simulated time (s).
+    pub t: f64,
+    /// The command the actuator gave last, held until the next one.
+    pub command: Command,
+    /// The obstacles where they are at `t`.
+    pub views: Vec<ObstacleView>,
+}
+
+/// [`Physics`] behind a lock, for the agents.
+pub type SharedPhysics = Arc<Mutex<Physics>>;
+
+/// Locks the physics (a poisoned lock is still the truth).
+pub fn lock(p: &SharedPhysics) -> MutexGuard<'_, Physics> {
+    p.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Which reference stack a program is, told by its agents.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StackKind {
+    /// Zhang & Zhu's outdoor vehicle (`rules/outdoor.situ`).
+    Outdoor,
+    /// Dafflon et al.'s urban UGV (`rules/ugv.situ`).
+    Ugv,
+}
+
+impl StackKind {
+    /// The agents a program must declare to run on this stack.
+    pub fn agents(self) -> &'static [&'static str] {
+        match self {
+            StackKind::Outdoor => outdoor::AGENTS,
+            StackKind::Ugv => ugv::AGENTS,
+        }
+    }
+
+    /// The stack whose agents the program declares.
+    pub fn of(content: &Content) -> Result<StackKind, String> {
+        let names: BTreeSet<&str> = content.agents.iter().map(|a| a.name.as_str()).collect();
+        for kind in [StackKind::Outdoor, StackKind::Ugv] {
+            if kind.agents().iter().all(|a| names.contains(a)) {
+                return Ok(kind);
+            }
+        }
+        Err(format!(
+            "no simulated stack for these agents ({}): `situ run` knows the agents of rules/outdoor.situ ({}) and of rules/ugv.situ ({})",
+            names.into_iter().collect::<Vec<_>>().join(", "),
+            outdoor::AGENTS.join(", "),
+            ugv::AGENTS.join(", ")
+        ))
+    }
+
+    /// The built-in scenario run by default.
+    pub fn default_scenario(self) -> &'static str {
+        match self {
+            StackKind::Outdoor => "outdoor-default",
+            StackKind::Ugv => "dafflon-4",
+        }
+    }
+
+    /// The state that means "mission done".
+    pub fn goal_state(self) -> &'static str {
+        match self {
+            StackKind::Outdoor => "GL",
+            StackKind::Ugv => "Reached",
+        }
+    }
+
+    /// Rates the stack sets over the rules file, and why.
+    pub fn rates(self) -> BTreeMap<String, f64> {
+        match self {
+            // TeleControl has no `rate` in the rules (it runs in every state
+            // with no function): its heartbeat TCHB comes at 10 Hz, the
+            // rate the rules' `stale after 1s` ("10 heartbeats") assumes.
+            StackKind::Outdoor => [("TeleControl".to_string(), 10.0)].into(),
+            StackKind::Ugv => BTreeMap::new(),
+        }
+    }
+
+    /// Physics steps (of 10 ms) per metrics sample: the outdoor Drive's
+    /// period (50 Hz), so that the steering rate is the rate of its
+    /// commands; for the UGV 20 Hz, the control period of Dafflon et al.'s
+    /// closed loop ([`crate::ugv::run`]), so that its figures compare with
+    /// the merge's.
+    pub fn sample_every(self) -> u64 {
+        match self {
+            StackKind::Outdoor => 2,
+            StackKind::Ugv => 5,
+        }
+    }
+
+    /// The longest run by default (s of simulated time).
+    pub fn default_until(self) -> f64 {
+        match self {
+            StackKind::Outdoor => 600.0,
+            StackKind::Ugv => 120.0,
+        }
+    }
+}
+
+/// How a run is set up.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StackConfig {
+    /// The noise seed.
+    pub seed: u64,
+    /// The run stops after this long (s of simulated time).
+    pub until: f64,
+    /// The physics step (ns).
+    pub physics_step: u64,
+    /// A metrics sample every this many physics steps (0: the stack's own,
+    /// [`StackKind::sample_every`]).
+    pub sample_every: u64,
+    /// Keep every sample in the metrics (off: the summary only).
+    pub samples: bool,
+    /// Rates (Hz) over the rules file and the stack's own ([`StackKind::rates`]).
+    pub rates: BTreeMap<String, f64>,
+}
+
+impl Default for StackConfig {
+    fn default() -> Self {
+        StackConfig {
+            seed: 1,
+            until: 600.0,
+            physics_step: 10_000_000,
+            sample_every: 0,
+            samples: true,
+            rates: BTreeMap::new(),
+        }
+    }
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Outcome {
+    /// The goal state, no collision.
+    GoalReached {
+        /// When the goal state was entered (s).
+        time: f64,
+    },
+    /// The vehicle touched an obstacle (the run stops there, as in the paper).
+    Collision {
+        /// When (s).
+        time: f64,
+        /// Which obstacle.
+        obstacle: String,
+        /// The state then.
+        state: String,
+    },
+    /// A final state other than the goal (a stop), the vehicle at standstill.
+    Stopped {
+        /// When the vehicle came to rest (s).
+        time: f64,
+        /// The final state.
+        state: String,
+    },
+    /// The time ran out before a final state.
+    Timeout {
+        /// The limit (s).
+        time: f64,
+        /// The state then.
+        state: String,
+    },
+}
+
+impl Outcome {
+    /// Whether the mission is done: the goal, no collision.
+    pub fn success(&self) -> bool {
+        matches!(self, Outcome::GoalReached { .. })
+    }
+
+    /// One line for a person.
+    pub fn describe(&self) -> String {
+        match self {
+            Outcome::GoalReached { time } => format!("mission done: goal reached at {time:.1} s, no collision"),
+            Outcome::Collision { time, obstacle, state } => {
+                format!("mission failed: collision with `{obstacle}` at {time:.1} s (state {state})")
+            }
+            Outcome::Stopped { time, state } => format!("mission failed: stopped in {state} at {time:.1} s"),
+            Outcome::Timeout { time, state } => {
+                format!("mission failed: no final state after {time:.1} s (still in {state})")
+            }
+        }
+    }
+}
+
+/// The figures of one state.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct StateFigures {
+    /// Time spent in it (s, from the samples).
+    pub seconds: f64,
+    /// Mean actual speed (m/s).
+    pub mean_speed: f64,
+    /// Top actual speed (m/s).
+    pub max_speed: f64,
+    /// Top commanded speed (m/s).
+    pub max_speed_cmd: f64,
+}
+
+/// Everything a run measured: `metrics.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct RunReport {
+    /// The rules (the bundle's source name).
+    pub rules: String,
+    /// Which stack.
+    pub stack: StackKind,
+    /// The scenario's name.
+    pub scenario: String,
+    /// The noise seed.
+    pub seed: u64,
+    /// How it ended.
+    pub outcome: Outcome,
+    /// Speed and time per state (the paper: faster in simple states).
+    pub per_state: BTreeMap<String, StateFigures>,
+    /// The runtime's summary: time and steps per state, rules fired,
+    /// messages per stream and what was dropped.
+    pub runtime: Summary,
+    /// The sim's metrics: summary, architecture (time in each state,
+    /// agents running per state, data messages per link), every sample.
+    pub metrics: Metrics,
+}
+
+impl RunReport {
+    /// `metrics.json` (pretty, deterministic).
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
+    }
+
+    /// The paper's metrics as a table for a person.
+    pub fn table(&self) -> String {
+        let s = &self.metrics.summary;
+        let mut out = String::new();
+        let opt = |o: Option<f64>, unit: &str| o.map_or("-".to_string(), |v| format!("{v:.2} {unit}"));
+        let _ = writeln!(out, "  scenario          {} (seed {})", self.scenario, self.seed);
+        let _ = writeln!(out, "  time to goal      {}", opt(s.time_to_goal, "s"));
+        let _ = writeln!(out, "  distance driven   {:.1} m", s.distance);
+        let closest = match (&s.closest_distance, &s.closest_obstacle) {
+            (Some(d), Some(o)) => format!("{d:.2} m ({o})"),
+            (Some(d), None) => format!("{d:.2} m"),
+            _ => "-".into(),
+        };
+        let _ = writeln!(out, "  closest distance  {closest}");
+        let _ = writeln!(out, "  min time to coll. {}", opt(s.min_ttc, "s"));
+        let collisions: Vec<String> = s.collisions.iter().map(|c| format!("{} at {:.1} s", c.obstacle, c.t)).collect();
+        let _ = writeln!(
+            out,
+            "  collisions        {}",
+            if collisions.is_empty() { "none".into() } else { collisions.join(", ") }
+        );
+        let _ =
+            writeln!(out, "  steering rate     max {:.3} rad/s, RMS {:.3} rad/s", s.max_steer_rate, s.rms_steer_rate);
+        let _ = writeln!(out, "  speed             top {:.2} m/s, mean {:.2} m/s", s.max_speed, s.mean_speed);
+        let _ = writeln!(out, "\n  state   time (s)  mean v (m/s)  top v (m/s)  running");
+        for st in &self.runtime.states {
+            let Some(f) = self.per_state.get(&st.state) else { continue };
+            let running = self.metrics.architecture.agents_running.get(&st.state).map_or(0, Vec::len);
+            let _ = writeln!(
+                out,
+                "  {:<6} {:>9.1}  {:>12.2}  {:>11.2}  {:>7}",
+                st.state, f.seconds, f.mean_speed, f.max_speed, running
+            );
+        }
+        let _ = writeln!(out, "\n  {}", self.outcome.describe());
+        out
+    }
+}
+
+/// A live view of a run, for a progress line.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Progress {
+    /// Simulated time (s).
+    pub t: f64,
+    /// The state at rest.
+    pub state: String,
+    /// The vehicle's speed (m/s).
+    pub speed: f64,
+    /// Agents running now, and all agents.
+    pub running: (usize, usize),
+}
+
+impl Progress {
+    /// The line.
+    pub fn line(&self) -> String {
+        format!(
+            "t {:>7.1} s  state {:<8}  {:>5.2} m/s  agents running {}/{}",
+            self.t, self.state, self.speed, self.running.0, self.running.1
+        )
+    }
+}
+
+/// Counts the data messages per link and what was dropped, for the report.
+#[derive(Debug, Default)]
+struct StreamCounts {
+    delivered: BTreeMap<(u32, u32), u64>,
+    dropped: BTreeMap<(u32, &'static str), u64>,
+}
+
+impl Sink for StreamCounts {
+    fn event(&mut self, _rec: &EventRecord) {}
+    fn change(&mut self, _change: &StateChange) {}
+    fn data(&mut self, rec: &DataRecord) {
+        match rec.fate {
+            Fate::Delivered => *self.delivered.entry((rec.from, rec.to)).or_default() += 1,
+            Fate::Suppressed => *self.dropped.entry((rec.from, "suppressed (waiting sender)")).or_default() += 1,
+            Fate::ToSleeping => *self.dropped.entry((rec.from, "to a sleeping agent")).or_default() += 1,
+            Fate::Unrouted => *self.dropped.entry((rec.from, "no active link")).or_default() += 1,
+        }
+    }
+    fn mode(&mut self, _rec: &ModeRecord) {}
+    fn diagnostic(&mut self, _time: u64, _level: Level, _text: &str) {}
+    fn tick(&mut self, _time: u64) {}
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+    fn finish(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// Topics `situ run` adds to a recording.
+pub mod topics {
+    /// The vehicle's pose, `foxglove.PoseInFrame`.
+    pub const POSE: &str = "/pose";
+    /// The obstacles, `foxglove.SceneUpdate`.
+    pub const OBSTACLES: &str = "/obstacles";
+}
+
+fn time_json(t: u64) -> Json {
+    json!({ "sec": t / NS, "nsec": t % NS })
+}
+
+fn time_schema() -> Json {
+    json!({ "type": "object", "title": "time",
+            "properties": { "sec": {"type": "integer", "minimum": 0},
+                            "nsec": {"type": "integer", "minimum": 0, "maximum": 999_999_999} } })
+}
+
+fn vector3_schema(title: &str) -> Json {
+    json!({ "type": "object", "title": title,
+            "properties": { "x": {"type": "number"}, "y": {"type": "number"}, "z": {"type": "number"} } })
+}
+
+fn pose_schema() -> Json {
+    json!({ "type": "object", "title": "foxglove.Pose",
+            "properties": { "position": vector3_schema("foxglove.Vector3"),
+                            "orientation": { "type": "object", "title": "foxglove.Quaternion",
+                                "properties": { "x": {"type": "number"}, "y": {"type": "number"},
+                                                "z": {"type": "number"}, "w": {"type": "number"} } } } })
+}
+
+/// The JSON schema of `foxglove.PoseInFrame`.
+pub fn pose_in_frame_schema() -> String {
+    json!({ "title": "foxglove.PoseInFrame", "description": "A timestamped pose in a reference frame",
+            "type": "object",
+            "properties": { "timestamp": time_schema(), "frame_id": {"type": "string"}, "pose": pose_schema() } })
+    .to_string()
+}
+
+/// The JSON schema of `foxglove.SceneUpdate` (the parts `situ run` writes
+/// are given in full; the other primitive lists are arrays of objects).
+pub fn scene_update_schema() -> String {
+    let color = json!({ "type": "object", "title": "foxglove.Color",
+        "properties": { "r": {"type": "number"}, "g": {"type": "number"}, "b": {"type": "number"}, "a": {"type": "number"} } });
+    let line = json!({ "type": "object", "title": "foxglove.LinePrimitive",
+        "properties": {
+            "type": {"type": "integer", "description": "0 LINE_STRIP, 1 LINE_LOOP, 2 LINE_LIST"},
+            "pose": pose_schema(), "thickness": {"type": "number"}, "scale_invisible": {"type": "boolean"},
+            "points": {"type": "array", "items": vector3_schema("foxglove.Point3")},
+            "color": color, "colors": {"type": "array", "items": color},
+            "indices": {"type": "array", "items": {"type": "integer", "minimum": 0}} } });
+    let others = json!({"type": "array", "items": {"type": "object"}});
+    let entity = json!({ "type": "object", "title": "foxglove.SceneEntity",
+        "properties": {
+            "timestamp": time_schema(), "frame_id": {"type": "string"}, "id": {"type": "string"},
+            "lifetime": { "type": "object", "title": "duration",
+                "properties": { "sec": {"type": "integer"}, "nsec": {"type": "integer", "minimum": 0, "maximum": 999_999_999} } },
+            "frame_locked": {"type": "boolean"},
+            "metadata": {"type": "array", "items": { "type": "object", "title": "foxglove.KeyValuePair",
+                "properties": { "key": {"type": "string"}, "value": {"type": "string"} } } },
+            "arrows": others, "cubes": others, "spheres": others, "cylinders": others,
+            "lines": {"type": "array", "items": line},
+            "triangles": others, "texts": others, "models": others } });
+    json!({ "title": "foxglove.SceneUpdate", "description": "An update to the entities displayed in a 3D scene",
+            "type": "object",
+            "properties": {
+                "deletions": {"type": "array", "items": { "type": "object", "title": "foxglove.SceneEntityDeletion",
+                    "properties": { "timestamp": time_schema(),
+                                    "type": {"type": "integer", "description": "0 MATCHING_ID, 1 ALL"},
+                                    "id": {"type": "string"} } } },
+                "entities": {"type": "array", "items": entity} } })
+    .to_string()
+}
+
+/// The pose and obstacle channels of a recording.
+struct Scene {
+    mcap: Arc<Mutex<McapRecorder>>,
+    pose: u16,
+    obstacles: u16,
+}
+
+impl Scene {
+    fn new(mcap: Arc<Mutex<McapRecorder>>) -> std::io::Result<Scene> {
+        let (pose, obstacles) = {
+            let mut m = mcap.lock().unwrap_or_else(|e| e.into_inner());
+            let pose = m.add_channel(topics::POSE, "foxglove.PoseInFrame", &pose_in_frame_schema())?;
+            let obstacles = m.add_channel(topics::OBSTACLES, "foxglove.SceneUpdate", &scene_update_schema())?;
+            (pose, obstacles)
+        };
+        Ok(Scene { mcap, pose, obstacles })
+    }
+
+    fn pose(&self, t: u64, ph: &Physics) {
+        let p = ph.vehicle.state.pose;
+        let (s, c) = (p.theta / 2.0).sin_cos();
+        let msg = json!({
+            "timestamp": time_json(t), "frame_id": "map",
+            "pose": { "position": {"x": p.x, "y": p.y, "z": 0.0}, "orientation": {"x": 0.0, "y": 0.0, "z": s, "w": c} },
+        });
+        self.mcap.lock().unwrap_or_else(|e| e.into_inner()).write_message(self.pose, t, &msg);
+    }
+
+    fn obstacles(&self, t: u64, ph: &Physics) {
+        let entities: Vec<Json> = ph
+            .views
+            .iter()
+            .map(|o| {
+                let points: Vec<Json> = o.polygon.iter().map(|q| json!({"x": q.x, "y": q.y, "z": 0.0})).collect();
+                let tall = o.height > ph.world.vehicle.clearance;
+                let color = if tall { json!({"r": 0.85, "g": 0.15, "b": 0.15, "a": 1.0}) } else { json!({"r": 0.6, "g": 0.6, "b": 0.6, "a": 1.0}) };
+                json!({
+                    "timestamp": time_json(t), "frame_id": "map",
+                    "id": format!("obstacle/{}", o.index), "lifetime": {"sec": 0, "nsec": 0}, "frame_locked": false,
+                    "metadata": [ {"key": "name", "value": ph.world.obstacles[o.index].id},
+                                  {"key": "height", "value": format!("{:.2}", o.height)} ],
+                    "arrows": [], "cubes": [], "spheres": [], "cylinders": [],
+                    "lines": [{
+                        "type": 1,
+                        "pose": { "position": {"x": 0.0, "y": 0.0, "z": 0.0}, "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0} },
+                        "thickness": 0.15, "scale_invisible": false, "points": points,
+                        "color": color, "colors": [], "indices": [],
+                    }],
+                    "triangles": [], "texts": [], "models": [],
+                })
+            })
+            .collect();
+        let msg = json!({ "deletions": [], "entities": entities });
+        self.mcap.lock().unwrap_or_else(|e| e.into_inner()).write_message(self.obstacles, t, &msg);
+    }
+}
+
+/// Where a run's records go besides the report.
+#[derive(Default)]
+pub struct Recording {
+    /// An MCAP recording; the pose and obstacle channels are added to it.
+    pub mcap: Option<Arc<Mutex<McapRecorder>>>,
+    /// More sinks (a [`situ_runtime::record::SharedMemory`] for tests, say).
+    pub sinks: Vec<Box<dyn Sink>>,
+}
+
+/// One run of a stack: the runtime, the physics, the metrics.
+pub struct StackRun {
+    /// The stack.
+    pub kind: StackKind,
+    /// The runtime running the rules and the agents.
+    pub rt: SimRuntime,
+    /// The ground truth.
+    pub physics: SharedPhysics,
+    content: Arc<Content>,
+    cfg: StackConfig,
+    scenario: String,
+    recorder: Recorder,
+    counts: Arc<Mutex<StreamCounts>>,
+    scene: Option<Scene>,
+    moving: bool,
+    /// Physics steps done.
+    k: u64,
+    outcome: Option<Outcome>,
+    goal_state: Option<u32>,
+    last_state: Option<u32>,
+    running: BTreeMap<String, BTreeSet<String>>,
+    per_state: BTreeMap<String, (f64, f64, f64, f64, u64)>,
+    final_since: Option<u64>,
+}
+
+impl StackRun {
+    /// Sets up a run of `content` (the stack `kind`) on `world`, its
+    /// records going to `recording` too.
+    pub fn new(
+        content: Arc<Content>,
+        kind: StackKind,
+        world: &World,
+        cfg: StackConfig,
+        recording: Recording,
+    ) -> Result<StackRun, String> {
+        let mut views = Vec::new();
+        world.obstacles_at(0.0, &mut views);
+        let physics = Arc::new(Mutex::new(Physics {
+            world: world.clone(),
+            vehicle: Vehicle::new(world.vehicle, world.start),
+            t: 0.0,
+            command: Command::default(),
+            views,
+        }));
+        let agents = match kind {
+            StackKind::Outdoor => outdoor::agents(&content, &physics, world, cfg.seed),
+            StackKind::Ugv => ugv::agents(&content, &physics, world, cfg.seed),
+        };
+        let bound = agent::bind(&content, agents, true).map_err(|e| e.to_string())?;
+        let counts = Arc::new(Mutex::new(StreamCounts::default()));
+        let mut sinks: Vec<Box<dyn Sink>> = vec![Box::new(counts.clone())];
+        sinks.extend(recording.sinks);
+        let scene = match recording.mcap {
+            Some(m) => {
+                sinks.push(Box::new(m.clone()));
+                Some(Scene::new(m).map_err(|e| format!("recording: {e}"))?)
+            }
+            None => None,
+        };
+        let mut cfg = cfg;
+        if cfg.sample_every == 0 {
+            cfg.sample_every = kind.sample_every();
+        }
+        let mut rates = kind.rates();
+        rates.extend(cfg.rates.clone());
+        let config = SimConfig { rates, stop_on_final: false, ..SimConfig::default() };
+        let rt = SimRuntime::new(content.clone(), bound, Some(Box::new(Tee(sinks))), config);
+        let dt = cfg.physics_step as f64 * cfg.sample_every as f64 / NS as f64;
+        let controller = format!("situ run {} (the rules decide the state)", content.source);
+        let moving = world.obstacles.iter().any(|o| o.motion != crate::world::Motion::Static);
+        Ok(StackRun {
+            kind,
+            rt,
+            physics,
+            goal_state: content.state_id(kind.goal_state()),
+            content,
+            scenario: world.name.clone(),
+            recorder: Recorder::new(&world.name, &controller, cfg.seed, dt),
+            cfg,
+            counts,
+            scene,
+            moving,
+            k: 0,
+            outcome: None,
+            last_state: None,
+            running: BTreeMap::new(),
+            per_state: BTreeMap::new(),
+            final_since: None,
+        })
+    }
+
+    /// Simulated time (s).
+    pub fn t(&self) -> f64 {
+        (self.k * self.cfg.physics_step) as f64 / NS as f64
+    }
+
+    /// The state at rest, by name.
+    pub fn state(&self) -> &str {
+        &self.content.states[self.rt.state() as usize].name
+    }
+
+    /// How the run ended, once it has.
+    pub fn outcome(&self) -> Option<&Outcome> {
+        self.outcome.as_ref()
+    }
+
+    /// The live view.
+    pub fn progress(&self) -> Progress {
+        let org = self.rt.shared.org();
+        let n = self.content.agents.len();
+        let running = (0..n as u32).filter(|&a| org.mode(a) == Mode::Running).count();
+        Progress {
+            t: self.t(),
+            state: self.state().to_string(),
+            speed: lock(&self.physics).vehicle.state.v,
+            running: (running, n),
+        }
+    }
+
+    fn note_running(&mut self, state: u32) {
+        let org = self.rt.shared.org();
+        let set = self.running.entry(self.content.states[state as usize].name.clone()).or_default();
+        for (a, def) in self.content.agents.iter().enumerate() {
+            if org.mode(a as u32) == Mode::Running {
+                set.insert(def.name.clone());
+            }
+        }
+    }
+
+    /// One physics step: the agents' steps of `[T, T + h)`, then the world
+    /// moves to `T + h`. Returns whether the run goes on.
+    pub fn step(&mut self) -> bool {
+        if self.outcome.is_some() {
+            return false;
+        }
+        let h = self.cfg.physics_step;
+        let t0 = self.k * h;
+        let ts = t0 as f64 / NS as f64;
+        self.rt.run_until(t0 + h - 1, &mut |_| {});
+        let state = self.rt.state();
+        if self.last_state != Some(state) {
+            self.last_state = Some(state);
+            self.note_running(state);
+            if Some(state) == self.goal_state {
+                self.recorder.goal(ts);
+            }
+        }
+        let content = self.content.clone();
+        let def = &content.states[state as usize];
+        let physics = self.physics.clone();
+        let mut guard = lock(&physics);
+        let ph = &mut *guard;
+        if self.k.is_multiple_of(self.cfg.sample_every) {
+            self.sample(ts, &def.name, ph);
+        }
+        if let Some(scene) = &self.scene {
+            if self.k.is_multiple_of((50_000_000 / h).max(1)) {
+                scene.pose(t0, ph);
+            }
+            if self.k.is_multiple_of((NS / h).max(1)) {
+                scene.obstacles(t0, ph);
+            }
+        }
+        let name = def.name.clone();
+        if let Some(i) = ph.world.collision(&ph.vehicle.state.pose, &ph.views) {
+            let obstacle = ph.world.obstacles[i].id.clone();
+            self.recorder.collision(ts, &obstacle);
+            self.outcome = Some(Outcome::Collision { time: ts, obstacle, state: name });
+            return false;
+        }
+        if def.is_final {
+            let since = *self.final_since.get_or_insert(t0);
+            // Wait for the vehicle to stand still (10 s at most).
+            if ph.vehicle.state.v <= 1e-3 || t0 - since >= 10 * NS {
+                self.outcome = Some(if Some(state) == self.goal_state {
+                    Outcome::GoalReached { time: since as f64 / NS as f64 }
+                } else {
+                    Outcome::Stopped { time: ts, state: name }
+                });
+                return false;
+            }
+        }
+        if ts >= self.cfg.until {
+            self.outcome = Some(Outcome::Timeout { time: ts, state: name });
+            return false;
+        }
+        let dt = h as f64 / NS as f64;
+        let cmd = ph.command;
+        ph.vehicle.step(cmd, dt);
+        self.k += 1;
+        ph.t = (self.k * h) as f64 / NS as f64;
+        if self.moving {
+            ph.world.obstacles_at(ph.t, &mut ph.views);
+        }
+        true
+    }
+
+    fn sample(&mut self, t: f64, label: &str, ph: &Physics) {
+        let st = ph.vehicle.state;
+        let closest = ph.world.closest_obstacle(&st.pose, &ph.views);
+        let ttc = ph.world.time_to_collision(&st.pose, st.v, &ph.views, 60.0);
+        let s = Sample {
+            t,
+            x: st.pose.x,
+            y: st.pose.y,
+            theta: st.pose.theta,
+            v: st.v,
+            steer: st.steer,
+            v_cmd: ph.command.v,
+            steer_cmd: ph.command.steer,
+            closest: closest.map(|c| c.0),
+            ttc,
+            label: label.to_string(),
+        };
+        let dt = self.recorder_dt();
+        let e = self.per_state.entry(label.to_string()).or_default();
+        e.0 += dt;
+        e.1 += st.v;
+        e.2 = e.2.max(st.v);
+        e.3 = e.3.max(ph.command.v);
+        e.4 += 1;
+        let name = closest.map(|(_, i)| ph.world.obstacles[i].id.as_str());
+        if self.cfg.samples {
+            self.recorder.record(s, name);
+        } else {
+            // The summary without keeping the samples: record, then forget.
+            self.recorder.record(s.clone(), name);
+            self.recorder.forget_samples();
+        }
+    }
+
+    fn recorder_dt(&self) -> f64 {
+        self.cfg.physics_step as f64 * self.cfg.sample_every as f64 / NS as f64
+    }
+
+    /// Runs to the end; `progress` is called every simulated second.
+    pub fn run(&mut self, progress: &mut dyn FnMut(&StackRun)) {
+        let per_second = (NS / self.cfg.physics_step).max(1);
+        while self.step() {
+            if self.k.is_multiple_of(per_second) {
+                progress(self);
+            }
+        }
+    }
+
+    /// Ends the run (and the recording) and gathers the report.
+    pub fn finish(mut self) -> Result<RunReport, String> {
+        while self.outcome.is_none() {
+            self.step();
+        }
+        let recording = self.rt.finish_recording();
+        let runtime = self.rt.summary();
+        let c = self.content.clone();
+        let name = |a: u32| c.agents.get(a as usize).map_or("?", |x| x.name.as_str()).to_string();
+        for (state, agents) in std::mem::take(&mut self.running) {
+            self.recorder.agents_running(&state, agents.into_iter().collect());
+        }
+        {
+            let counts = self.counts.lock().unwrap_or_else(|e| e.into_inner());
+            for (&(from, to), &n) in &counts.delivered {
+                self.recorder.message(&format!("{}->{}", name(from), name(to)), n);
+            }
+            for (&(from, why), &n) in &counts.dropped {
+                self.recorder.message(&format!("{} dropped: {why}", name(from)), n);
+            }
+        }
+        self.recorder.message("events accepted", runtime.board.accepted);
+        self.recorder.message("status broadcasts", runtime.board.status_sent);
+        let per_state = self
+            .per_state
+            .iter()
+            .map(|(k, &(secs, vsum, vmax, vcmd, n))| {
+                (
+                    k.clone(),
+                    StateFigures {
+                        seconds: secs,
+                        mean_speed: vsum / n.max(1) as f64,
+                        max_speed: vmax,
+                        max_speed_cmd: vcmd,
+                    },
+                )
+            })
+            .collect();
+        let outcome = self.outcome.clone().unwrap_or(Outcome::Timeout { time: self.t(), state: self.state().into() });
+        let report = RunReport {
+            rules: c.source.clone(),
+            stack: self.kind,
+            scenario: self.scenario.clone(),
+            seed: self.cfg.seed,
+            outcome,
+            per_state,
+            runtime,
+            metrics: self.recorder.finish(),
+        };
+        recording.map_err(|e| format!("recording: {e}"))?;
+        Ok(report)
+    }
+}
+
+/// Dafflon et al.'s comparison with the hard switch of the **rules**: for
+/// `hard-switch`, the run of `content` (`rules/ugv.situ`) through the stack,
+/// and, for reference, the sim's own closed loop; for `merge`, the sim's
+/// closed loop ([`crate::ugv::run`]): the merge blends both controllers at
+/// once, which no table of `rules/ugv.situ` links to the Vehicle.
+pub fn compare(
+    content: Arc<Content>,
+    world: &World,
+    strategies: &[crate::ugv::Strategy],
+    seed: u64,
+) -> Result<(crate::ugv::Comparison, Option<RunReport>), String> {
+    use crate::ugv::{self, ComparisonRow, Strategy, UgvConfig};
+    let kind = StackKind::of(&content)?;
+    if kind != StackKind::Ugv {
+        return Err(
+            "--compare needs the UGV's rules (rules/ugv.situ): hard-switch and merge are its controllers".into()
+        );
+    }
+    let cfg = UgvConfig::default();
+    let mut rows = Vec::new();
+    let mut runs = Vec::new();
+    let mut stack_report = None;
+    for &s in strategies {
+        if s == Strategy::HardSwitch {
+            let stack_cfg = StackConfig { seed, until: cfg.max_time, ..StackConfig::default() };
+            let mut run = StackRun::new(content.clone(), kind, world, stack_cfg, Recording::default())?;
+            run.run(&mut |_| {});
+            let report = run.finish()?;
+            rows.push(ComparisonRow::from_metrics(
+                &format!("hard-switch ({}, stack)", content.source),
+                &report.metrics,
+            ));
+            runs.push(report.metrics.clone());
+            stack_report = Some(report);
+        }
+        let m = ugv::run(world, s, seed, &cfg);
+        rows.push(ComparisonRow::from_metrics(&format!("{} (sim loop)", s.name()), &m));
+        runs.push(m);
+    }
+    Ok((ugv::Comparison { scenario: world.name.clone(), seed, rows, runs }, stack_report))
+}

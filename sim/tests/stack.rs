@@ -1,0 +1,168 @@
+//! The reference stacks on the real rules (`rules/outdoor.situ`,
+//! `rules/ugv.situ`), through the runtime: the papers' results, asserted
+//! on what the runtime recorded, and determinism.
+
+use situ_compiler::bundle::{Content, Mode};
+use situ_compiler::loader::FsLoader;
+use situ_runtime::record::{Fate, Memory, SharedMemory};
+use situ_sim::scenario;
+use situ_sim::stack::{self, Outcome, Recording, RunReport, StackConfig, StackKind, StackRun};
+use situ_sim::ugv::Strategy;
+use std::path::Path;
+use std::sync::{Arc, OnceLock};
+
+fn rules(name: &str) -> Arc<Content> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../rules").join(name);
+    let checked = situ_compiler::check(&path, &FsLoader).expect("the rules file reads");
+    assert!(!checked.fails(false), "{name} checks clean");
+    Arc::new(situ_compiler::bundle::build(&checked))
+}
+
+fn run(rules_file: &str, seed: u64, memory: Option<SharedMemory>) -> RunReport {
+    let content = rules(rules_file);
+    let kind = StackKind::of(&content).expect("a reference stack");
+    let world = scenario::builtin(kind.default_scenario()).expect("built in").world;
+    let cfg = StackConfig { seed, until: kind.default_until(), ..StackConfig::default() };
+    let recording = Recording { mcap: None, sinks: memory.into_iter().map(|m| Box::new(m) as _).collect() };
+    let mut run = StackRun::new(content, kind, &world, cfg, recording).expect("every agent bound");
+    run.run(&mut |_| {});
+    run.finish().expect("finished")
+}
+
+/// The default mission once, with everything the runtime recorded.
+fn outdoor() -> &'static (RunReport, Memory, Arc<Content>) {
+    static RUN: OnceLock<(RunReport, Memory, Arc<Content>)> = OnceLock::new();
+    RUN.get_or_init(|| {
+        let memory = SharedMemory::default();
+        let report = run("outdoor.situ", 1, Some(memory.clone()));
+        (report, memory.snapshot(), rules("outdoor.situ"))
+    })
+}
+
+#[test]
+fn every_event_the_agents_report_is_one_of_the_rules_file() {
+    let c = rules("outdoor.situ");
+    for e in stack::outdoor::sample_events() {
+        assert!(stack::events::payload(&c, e.as_ref()).is_some(), "{} maps onto outdoor.situ", e.name());
+    }
+    assert_eq!(StackKind::of(&c), Ok(StackKind::Outdoor));
+    assert_eq!(StackKind::of(&rules("ugv.situ")), Ok(StackKind::Ugv));
+}
+
+#[test]
+fn zhang_zhu_the_default_mission_on_the_real_rules_reaches_the_goal_through_every_state() {
+    let (report, _, _) = outdoor();
+    println!("{}\n{}", report.runtime.table(), report.table());
+    assert!(matches!(report.outcome, Outcome::GoalReached { .. }), "{:?}", report.outcome);
+    let s = &report.metrics.summary;
+    assert!(s.collisions.is_empty(), "{:?}", s.collisions);
+    assert!(s.closest_distance.is_some_and(|d| d > 0.5), "kept clear: {:?}", s.closest_distance);
+    // Every state of outdoor.situ the mission is meant to visit (not EM, SP).
+    for st in ["IT", "RD", "RS", "RT", "RB", "RO", "CN", "CO", "GL"] {
+        assert!(report.runtime.path.iter().any(|p| p == st), "{st} visited: {:?}", report.runtime.path);
+    }
+    assert!(!report.runtime.path.iter().any(|p| p == "EM" || p == "SP"));
+    // Faster in the simple states than with an obstacle.
+    let mean = |st: &str| report.per_state[st].mean_speed;
+    assert!(mean("RS") > mean("RO") + 2.0, "RS {:.2} vs RO {:.2} m/s", mean("RS"), mean("RO"));
+    assert!(mean("CN") > mean("CO") + 1.0, "CN {:.2} vs CO {:.2} m/s", mean("CN"), mean("CO"));
+    assert!(mean("RS") > mean("CN"));
+}
+
+#[test]
+fn zhang_zhu_fig_5_fusion_sleeps_on_the_straight_road_and_wakes_at_the_obstacle() {
+    let (_, rec, c) = outdoor();
+    let id = |n: &str| c.agent_id(n).unwrap();
+    let (rfccd, ladar, fusion, lpl) = (id("RFCCD"), id("LADAR"), id("Fusion"), id("LPL"));
+    let ro = c.state_id("RO").unwrap();
+    let rs = c.state_id("RS").unwrap();
+    // The obstacle: RS -> RO, and back.
+    let into = rec.changes.iter().find(|ch| ch.changed() && ch.to == ro).expect("RS -> RO");
+    let back = rec.changes.iter().find(|ch| ch.changed() && ch.from == ro).expect("RO -> RS");
+    assert_eq!((into.from, back.to), (rs, rs));
+    let (t_ro, t_rs) = (into.time, back.time);
+    // Fusion's modes, as recorded: asleep from the start, awake exactly in RO.
+    let modes: Vec<(u64, Mode)> = rec.modes.iter().filter(|m| m.agent == fusion).map(|m| (m.time, m.mode)).collect();
+    assert_eq!(modes[0], (0, Mode::Sleeping));
+    assert!(modes.contains(&(t_ro, Mode::Running)), "{modes:?}");
+    assert!(modes.contains(&(t_rs, Mode::Sleeping)), "{modes:?}");
+    assert_eq!(modes.iter().filter(|m| m.1 == Mode::Running).count(), 2, "woken for RO and CO only: {modes:?}");
+    let delivered = |from: u32, to: u32, lo: u64, hi: u64| {
+        rec.data
+            .iter()
+            .filter(|d| d.from == from && d.to == to && d.fate == Fate::Delivered && d.time > lo && d.time < hi)
+            .count()
+    };
+    // Fig. 5a, in RS before the obstacle: RFCCD -> LPL; nothing to or from Fusion.
+    assert!(delivered(rfccd, lpl, 0, t_ro) > 100);
+    assert!(!rec.data.iter().any(|d| d.time < t_ro && (d.from == fusion || d.to == fusion)));
+    // LADAR waits in RS: its scans are suppressed, its events count.
+    assert!(rec.data.iter().any(|d| d.from == ladar && d.time < t_ro && d.fate == Fate::Suppressed));
+    // Fig. 5b, in RO: RFCCD, LADAR -> Fusion -> LPL; RFCCD no longer to LPL.
+    assert!(delivered(rfccd, fusion, t_ro, t_rs) > 10);
+    assert!(delivered(ladar, fusion, t_ro, t_rs) > 10);
+    assert!(delivered(fusion, lpl, t_ro, t_rs) > 10);
+    assert_eq!(delivered(rfccd, lpl, t_ro, t_rs), 0);
+    // And what Fusion reported came only while it was awake.
+    let fusion_events: Vec<u64> = rec.events.iter().filter(|e| e.agent == fusion).map(|e| e.time).collect();
+    assert!(!fusion_events.is_empty());
+    assert!(fusion_events.iter().all(|&t| t >= t_ro), "no Fusion event before the obstacle");
+}
+
+#[test]
+fn dafflon_the_merge_is_smoother_than_the_hard_switch_of_the_rules() {
+    let content = rules("ugv.situ");
+    let world = scenario::dafflon_4().world;
+    let (table, stack_run) =
+        stack::compare(content, &world, &[Strategy::HardSwitch, Strategy::Merge], 1).expect("compared");
+    println!("{table}");
+    let report = stack_run.expect("the hard switch ran through the stack");
+    assert!(matches!(report.outcome, Outcome::GoalReached { .. }), "{:?}", report.outcome);
+    assert!(report.runtime.path.iter().any(|s| s == "AvoidCW") && report.runtime.path.iter().any(|s| s == "AvoidCCW"));
+    let hard = &table.rows[0];
+    let merge = table.rows.iter().find(|r| r.strategy.starts_with("merge")).expect("merge row");
+    assert!(hard.strategy.contains("stack"));
+    for r in [hard, merge] {
+        assert_eq!(r.collisions, 0, "{}", r.strategy);
+        assert!(r.closest_distance > 0.3, "{}: a safe closest distance, {:.2} m", r.strategy, r.closest_distance);
+        // Both are capped by vmax = 2 m/s on the free stretch: the top
+        // speed does not tell them apart.
+        assert!((r.max_speed - 2.0).abs() < 0.05, "{}: top speed {:.2}", r.strategy, r.max_speed);
+    }
+    assert!(
+        merge.max_steer_rate * 5.0 < hard.max_steer_rate,
+        "peaks {} vs {}",
+        merge.max_steer_rate,
+        hard.max_steer_rate
+    );
+    assert!(merge.rms_steer_rate < hard.rms_steer_rate);
+}
+
+#[test]
+fn the_same_scenario_and_seed_give_the_same_metrics_to_the_byte() {
+    let a = outdoor().0.to_json();
+    let b = run("outdoor.situ", 1, None).to_json();
+    assert!(a.as_bytes() == b.as_bytes(), "metrics.json differs between two runs");
+}
+
+#[test]
+fn a_lost_position_is_an_emergency_that_ends_in_a_stop_once_the_vehicle_stands() {
+    let content = rules("outdoor.situ");
+    let mut world = scenario::outdoor_default().world;
+    world.gps_outages.push(situ_sim::geom::rect_polygon(situ_sim::geom::v2(150.0, 0.0), 20.0, 20.0, 0.0));
+    let memory = SharedMemory::default();
+    let cfg = StackConfig { seed: 1, until: 120.0, ..StackConfig::default() };
+    let recording = Recording { mcap: None, sinks: vec![Box::new(memory.clone())] };
+    let mut run = StackRun::new(content.clone(), StackKind::Outdoor, &world, cfg, recording).unwrap();
+    run.run(&mut |_| {});
+    let report = run.finish().unwrap();
+    assert!(matches!(&report.outcome, Outcome::Stopped { state, .. } if state == "SP"), "{:?}", report.outcome);
+    assert_eq!(report.runtime.path, ["IT", "RD", "RS", "EM", "SP"]);
+    let rec = memory.snapshot();
+    let at = |s: &str| rec.changes.iter().find(|c| c.changed() && c.to == content.state_id(s).unwrap()).unwrap().time;
+    // From 10 m/s at 4 m/s²: 2.5 s of braking. The DRSTOP Drive reported
+    // standing at the start does not end the emergency (`within 100ms`).
+    let braking = (at("SP") - at("EM")) as f64 * 1e-9;
+    assert!((2.3..3.0).contains(&braking), "EM for {braking:.2} s");
+    assert!(report.metrics.summary.collisions.is_empty());
+}

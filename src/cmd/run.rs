@@ -1,0 +1,223 @@
+//! `situ run FILE|BUNDLE [--scenario S] [--record F.mcap] [--out DIR]
+//! [--seed N] [--until SECONDS] [--compare hard-switch,merge]`: runs the
+//! rules' reference stack (`rules/outdoor.situ` or `rules/ugv.situ`, told by
+//! the agents) in simulated time, in process, the compiled rules deciding
+//! the state; shows what happened and how well. Exit 0 when the mission is
+//! done (the goal, no collision), 1 when it failed (a collision, a stop, the
+//! time ran out), 2 on usage, I/O, a bad scenario or a damaged bundle.
+//!
+//! (The transport is in process; `--transport zenoh` is for later.)
+
+use super::{FAILED, OK, USAGE};
+use situ_compiler::bundle::{self, Content, Encoding};
+use situ_runtime::record::mcap::McapRecorder;
+use situ_sim::scenario::{self, Scenario};
+use situ_sim::stack::{self, Recording, StackConfig, StackKind, StackRun};
+use situ_sim::ugv::Strategy;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+pub struct Args {
+    pub file: PathBuf,
+    pub scenario: Option<String>,
+    pub record: Option<PathBuf>,
+    pub out: Option<PathBuf>,
+    pub seed: u64,
+    pub until: Option<f64>,
+    pub compare: Option<Vec<String>>,
+}
+
+/// How often the progress line is redrawn (wall time).
+const REDRAW: Duration = Duration::from_millis(200);
+
+/// A built-in scenario by name, or a TOML file; the error names the field
+/// or the place.
+fn load_scenario(name: &str) -> Result<Scenario, String> {
+    if let Some(s) = scenario::builtin(name) {
+        return Ok(s);
+    }
+    let path = Path::new(name);
+    if !path.exists() && !name.ends_with(".toml") {
+        return Err(format!("no built-in scenario `{name}` (outdoor-default, dafflon-4) and no such file"));
+    }
+    scenario::load(path).map_err(|e| format!("scenario `{name}`: {e}"))
+}
+
+/// The bundle's bytes, to attach to the recording: the file itself, or the
+/// source compiled to JSON.
+fn bundle_bytes(file: &Path, content: &Content) -> Vec<u8> {
+    if super::program::is_source(file) {
+        bundle::encode(content, Encoding::Json)
+    } else {
+        std::fs::read(file).unwrap_or_else(|_| bundle::encode(content, Encoding::Json))
+    }
+}
+
+pub fn run(args: Args) -> u8 {
+    let program = match super::program::load(&args.file, false) {
+        Ok(p) => p,
+        Err(code) => return code,
+    };
+    let content = program.content;
+    let kind = match StackKind::of(&content) {
+        Ok(k) => k,
+        Err(e) => {
+            eprintln!("error: `{}`: {e}", args.file.display());
+            return USAGE;
+        }
+    };
+    let name = args.scenario.clone().unwrap_or_else(|| kind.default_scenario().to_string());
+    let scenario = match load_scenario(&name) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return USAGE;
+        }
+    };
+    let until = args.until.unwrap_or(kind.default_until());
+    if !(until.is_finite() && until > 0.0) {
+        eprintln!("error: --until must be a positive number of seconds, not {until}");
+        return USAGE;
+    }
+    if let Some(out) = &args.out {
+        if let Err(e) = std::fs::create_dir_all(out) {
+            eprintln!("error: cannot create `{}`: {e}", out.display());
+            return USAGE;
+        }
+    }
+    if let Some(list) = &args.compare {
+        return compare(&args, content, &scenario, list);
+    }
+
+    // The recording: at --record, else in --out.
+    let record_path = args.record.clone().or_else(|| args.out.as_ref().map(|d| d.join("recording.mcap")));
+    let mcap = match &record_path {
+        Some(path) => match McapRecorder::create(path, content.clone(), &bundle_bytes(&args.file, &content)) {
+            Ok(m) => Some(Arc::new(Mutex::new(m))),
+            Err(e) => {
+                eprintln!("error: cannot write `{}`: {e}", path.display());
+                return USAGE;
+            }
+        },
+        None => None,
+    };
+    let cfg = StackConfig { seed: args.seed, until, ..StackConfig::default() };
+    let mut run =
+        match StackRun::new(content.clone(), kind, &scenario.world, cfg, Recording { mcap, sinks: Vec::new() }) {
+            Ok(r) => r,
+            Err(e) => {
+                eprintln!("error: `{}` cannot run on the {kind:?} stack: {e}", args.file.display());
+                return USAGE;
+            }
+        };
+    let live = std::io::stderr().is_terminal();
+    let mut last = Instant::now().checked_sub(REDRAW).unwrap_or_else(Instant::now);
+    let mut drawn = false;
+    run.run(&mut |r| {
+        if live && last.elapsed() >= REDRAW {
+            last = Instant::now();
+            drawn = true;
+            eprint!("\r{}\x1b[K", r.progress().line());
+        }
+    });
+    if drawn {
+        eprint!("\r\x1b[K");
+    }
+    let report = match run.finish() {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return USAGE;
+        }
+    };
+    println!("{} on {} (seed {})\n", content.source, scenario.name, args.seed);
+    print!("{}", report.runtime.table());
+    println!("\n{}", report.table());
+    if let Some(out) = &args.out {
+        if let Err(e) = write_out(out, &scenario, &report, args.record.as_deref()) {
+            eprintln!("error: {e}");
+            return USAGE;
+        }
+        println!("wrote {}", out.display());
+    }
+    if let Some(path) = &args.record {
+        println!("recorded {}", path.display());
+    }
+    if report.outcome.success() {
+        OK
+    } else {
+        FAILED
+    }
+}
+
+/// `trajectory.svg`, `timeline.svg`, `metrics.json` (and `recording.mcap`,
+/// copied from `--record` when it was written there).
+fn write_out(
+    out: &Path,
+    scenario: &Scenario,
+    report: &stack::RunReport,
+    recorded: Option<&Path>,
+) -> Result<(), String> {
+    let title = format!("{} — {}", scenario.name, report.rules);
+    let samples = &report.metrics.samples;
+    let write = |name: &str, bytes: &[u8]| {
+        super::write_atomically(&out.join(name), bytes)
+            .map_err(|e| format!("cannot write `{}`: {e}", out.join(name).display()))
+    };
+    let trajectory = situ_sim::plot::trajectory_svg(&scenario.world, samples, &title).map_err(|e| e.to_string())?;
+    write("trajectory.svg", trajectory.as_bytes())?;
+    let timeline = situ_sim::plot::timeline_svg(samples, &title).map_err(|e| e.to_string())?;
+    write("timeline.svg", timeline.as_bytes())?;
+    write("metrics.json", report.to_json().as_bytes())?;
+    if let Some(from) = recorded {
+        let to = out.join("recording.mcap");
+        std::fs::copy(from, &to).map_err(|e| format!("cannot write `{}`: {e}", to.display()))?;
+    }
+    Ok(())
+}
+
+/// `--compare`: Dafflon et al.'s table.
+fn compare(args: &Args, content: Arc<Content>, scenario: &Scenario, list: &[String]) -> u8 {
+    let mut strategies = Vec::new();
+    for s in list {
+        match Strategy::parse(s.trim()) {
+            Some(x) => strategies.push(x),
+            None => {
+                eprintln!("error: --compare: unknown strategy `{s}` (hard-switch, merge)");
+                return USAGE;
+            }
+        }
+    }
+    if args.record.is_some() {
+        eprintln!("warning: --record is not used with --compare");
+    }
+    let (table, _) = match stack::compare(content, &scenario.world, &strategies, args.seed) {
+        Ok(t) => t,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return USAGE;
+        }
+    };
+    print!("{table}");
+    println!(
+        "\nThe hard switch runs on the rules through the stack (the Selector's events, the rules \
+         avoid_ccw/avoid_cw/way_free, the tables' links) and, for reference, in the sim's own closed \
+         loop; the merge blends both controllers at once, which no table of the rules links to the \
+         Vehicle: it runs in the sim's closed loop (situ_sim::ugv::run). Steering rates are taken at \
+         20 Hz in both."
+    );
+    if let Some(out) = &args.out {
+        let json = serde_json::to_string_pretty(&table).expect("the table serializes");
+        if let Err(e) = super::write_atomically(&out.join("comparison.json"), json.as_bytes()) {
+            eprintln!("error: cannot write `{}`: {e}", out.join("comparison.json").display());
+            return USAGE;
+        }
+    }
+    if table.rows.iter().all(|r| r.collisions == 0 && r.time_to_goal.is_some()) {
+        OK
+    } else {
+        FAILED
+    }
+}

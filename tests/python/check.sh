@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Checks that a recording made by `situ run` reads with the `mcap` package
+# from PyPI (and `zstandard`, for the zstd chunks), with the schemas
+# Foxglove's panels need. Fails loudly when the packages cannot be installed.
+#
+#   bash tests/python/check.sh [SITU_BINARY]     (default: target/release/situ, else target/debug/situ)
+set -euo pipefail
+here="$(cd "$(dirname "$0")" && pwd)"
+root="$(cd "$here/../.." && pwd)"
+situ="${1:-}"
+if [[ -z "$situ" ]]; then
+  if [[ -x "$root/target/release/situ" ]]; then situ="$root/target/release/situ"; else situ="$root/target/debug/situ"; fi
+fi
+if [[ ! -x "$situ" ]]; then
+  echo "check.sh: no situ binary at $situ (cargo build first)" >&2
+  exit 1
+fi
+python="${PYTHON:-python3}"
+venv="${TMPDIR:-/tmp}/situ-mcap-venv"
+if [[ ! -x "$venv/bin/python" ]]; then
+  "$python" -m venv "$venv" || { echo "check.sh: FAILED to create a Python venv" >&2; exit 1; }
+fi
+if ! "$venv/bin/python" -m pip install --quiet --disable-pip-version-check mcap zstandard; then
+  echo "check.sh: FAILED to install the mcap and zstandard packages from PyPI" >&2
+  exit 1
+fi
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+cd "$root"
+"$situ" run rules/outdoor.situ --record "$work/run.mcap" > "$work/run.txt"
+"$venv/bin/python" "$here/read_mcap.py" "$work/run.mcap"

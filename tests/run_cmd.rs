@@ -1,0 +1,130 @@
+//! Golden tests of `situ run`: the real binary on the papers' stacks, its
+//! exit codes, the files it writes, the recording read back, determinism,
+//! and its refusals (a bad scenario, a damaged bundle, rules with no stack).
+
+use situ_runtime::record::mcap::read_messages;
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn situ(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_situ")).args(args).env("NO_COLOR", "1").output().expect("the binary runs")
+}
+
+fn code(o: &Output) -> i32 {
+    o.status.code().expect("exited normally, not by a signal")
+}
+
+fn text(o: &Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("a UTF-8 temp path")
+}
+
+#[test]
+fn the_default_mission_is_done_and_leaves_its_four_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let o = situ(&["run", "rules/outdoor.situ", "--out", s(&out)]);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    for want in ["final state GL", "mission done: goal reached", "closest distance", "steering rate", "RO "] {
+        assert!(stdout.contains(want), "`{want}` in:\n{stdout}");
+    }
+    for f in ["trajectory.svg", "timeline.svg", "metrics.json", "recording.mcap"] {
+        assert!(out.join(f).is_file(), "{f} written");
+    }
+    let metrics: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(metrics["outcome"]["kind"], "goal_reached");
+    assert!(metrics["runtime"]["states"].as_array().is_some_and(|s| !s.is_empty()));
+    assert!(metrics["metrics"]["architecture"]["messages_per_stream"]["Fusion->LPL"].as_u64() > Some(0));
+    assert!(metrics["metrics"]["architecture"]["agents_running"]["RO"]
+        .as_array()
+        .is_some_and(|a| a.iter().any(|x| x == "Fusion")));
+    assert!(std::fs::read_to_string(out.join("trajectory.svg")).unwrap().starts_with("<svg"));
+
+    let (messages, cut) = read_messages(&std::fs::read(out.join("recording.mcap")).unwrap()).unwrap();
+    assert!(!cut, "a whole recording");
+    let mut counts: BTreeMap<&str, usize> = BTreeMap::new();
+    for (topic, _, _) in &messages {
+        *counts.entry(topic.as_str()).or_default() += 1;
+    }
+    for topic in ["/state", "/events", "/pose", "/obstacles", "/situ/events", "/situ/data", "/situ/modes"] {
+        assert!(counts.get(topic).is_some_and(|n| *n > 0), "{topic}: {counts:?}");
+    }
+    let states: Vec<&str> =
+        messages.iter().filter(|(t, _, _)| t == "/state").filter_map(|(_, _, m)| m["state"].as_str()).collect();
+    assert_eq!(states.first(), Some(&"RD"));
+    assert_eq!(states.last(), Some(&"GL"));
+    let pose = messages.iter().find(|(t, _, _)| t == "/pose").map(|(_, _, m)| m).unwrap();
+    assert_eq!(pose["frame_id"], "map");
+    assert!(pose["pose"]["position"]["x"].is_number());
+}
+
+#[test]
+fn the_same_seed_gives_the_same_metrics_json_to_the_byte() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |name: &str| {
+        let out = dir.path().join(name);
+        // 40 s: past the obstacle on the road, then the time runs out (exit 1).
+        let o = situ(&["run", "rules/outdoor.situ", "--seed", "3", "--until", "40", "--out", s(&out)]);
+        assert_eq!(code(&o), 1, "a timeout is a failed mission:\n{}", text(&o));
+        assert!(text(&o).contains("no final state after 40.0 s"), "{}", text(&o));
+        std::fs::read(out.join("metrics.json")).unwrap()
+    };
+    let (a, b) = (run("a"), run("b"));
+    assert!(a == b, "metrics.json differs between two runs of one seed");
+}
+
+#[test]
+fn the_ugv_compares_the_hard_switch_of_the_rules_with_the_merge() {
+    let o = situ(&["run", "rules/ugv.situ", "--compare", "hard-switch,merge"]);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("scenario dafflon-4"), "{out}");
+    assert!(out.contains("hard-switch (rules/ugv.situ, stack)") && out.contains("merge (sim loop)"), "{out}");
+    let o = situ(&["run", "rules/ugv.situ", "--compare", "hard-switch,teleport"]);
+    assert_eq!(code(&o), 2);
+    assert!(text(&o).contains("teleport"), "{}", text(&o));
+}
+
+#[test]
+fn a_bad_scenario_is_a_usage_error_that_names_the_problem() {
+    let o = situ(&["run", "rules/outdoor.situ", "--scenario", "sim/tests/scenarios-bad/missing-field.toml"]);
+    assert_eq!(code(&o), 2);
+    assert!(text(&o).contains("missing field `y`"), "{}", text(&o));
+    let o = situ(&["run", "rules/outdoor.situ", "--scenario", "sim/tests/scenarios-bad/goal-off-map.toml"]);
+    assert_eq!(code(&o), 2);
+    assert!(text(&o).contains("goal (95, 60) is off the map"), "{}", text(&o));
+    let o = situ(&["run", "rules/outdoor.situ", "--scenario", "no-such-place"]);
+    assert_eq!(code(&o), 2);
+    assert!(text(&o).contains("no-such-place"), "{}", text(&o));
+    let o = situ(&["run", "rules/outdoor.situ", "--until", "-3"]);
+    assert_eq!(code(&o), 2, "{}", text(&o));
+}
+
+#[test]
+fn a_damaged_bundle_is_refused_with_exit_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let bundle = dir.path().join("outdoor.bundle");
+    assert_eq!(code(&situ(&["build", "rules/outdoor.situ", "-o", s(&bundle)])), 0);
+    let mut bytes = std::fs::read(&bundle).unwrap();
+    let i = bytes.len() / 2;
+    bytes[i] ^= 0x20;
+    std::fs::write(&bundle, &bytes).unwrap();
+    let o = situ(&["run", s(&bundle), "--until", "1"]);
+    assert_eq!(code(&o), 2, "{}", text(&o));
+    assert!(text(&o).contains("outdoor.bundle"), "{}", text(&o));
+}
+
+#[test]
+fn rules_without_a_reference_stack_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = dir.path().join("tiny.situ");
+    std::fs::write(&f, "states { IT initial RD final }\nagent Ready sensor { event RDY }\nrule ready { when state == IT and RDY then RD }\n").unwrap();
+    let o = situ(&["run", s(&f)]);
+    assert_eq!(code(&o), 2);
+    assert!(text(&o).contains("no simulated stack"), "{}", text(&o));
+}
