@@ -103,6 +103,37 @@ enum Command {
         /// Dafflon et al.'s comparison of the controllers (rules/ugv.situ): hard-switch,merge.
         #[arg(long, value_delimiter = ',')]
         compare: Option<Vec<String>>,
+        /// The agents: the simulated vehicle (simulated time), the scripted
+        /// Fig. 5 demo, or none here (real time).
+        #[arg(long, value_enum, default_value_t = cmd::distributed::Stack::Sim)]
+        stack: cmd::distributed::Stack,
+        /// In this process, or one process of a deployment over Zenoh.
+        #[arg(long, value_enum, default_value_t = cmd::distributed::Transport::Inproc)]
+        transport: cmd::distributed::Transport,
+        /// The deployment: process and host tables (with --transport zenoh).
+        #[arg(long)]
+        deploy: Option<PathBuf>,
+        /// Which process of the deployment this is.
+        #[arg(long)]
+        process: Option<String>,
+        /// Run only these agents (the process of the deployment that has them).
+        #[arg(long, value_delimiter = ',')]
+        only: Option<Vec<String>>,
+        /// Real-time runs (demo, none): how long, in seconds.
+        #[arg(long, default_value_t = 10.0)]
+        duration: f64,
+    },
+    /// Start every local process of a deployment (Zenoh) and stop them cleanly on Ctrl-C.
+    Up {
+        /// The deployment file.
+        deploy: PathBuf,
+        /// The rules (a `.situ` source or a bundle).
+        file: PathBuf,
+        #[arg(long, value_enum, default_value_t = cmd::distributed::Stack::Demo)]
+        stack: cmd::distributed::Stack,
+        /// How long each process runs, in seconds.
+        #[arg(long, default_value_t = 10.0)]
+        duration: f64,
     },
     /// Pictures: the wiring of a state, the Rete network, the state transitions.
     Graph {
@@ -197,9 +228,37 @@ fn main() -> ExitCode {
         Command::Export { promela: _, file, output, depth, max_states } => {
             cmd::export::run(&file, output.as_ref(), depth, max_states)
         }
-        Command::Run { file, scenario, record, out, seed, until, compare } => {
-            cmd::run::run(cmd::run::Args { file, scenario, record, out, seed, until, compare })
+        Command::Run {
+            file,
+            scenario,
+            record,
+            out,
+            seed,
+            until,
+            compare,
+            stack,
+            transport,
+            deploy,
+            process,
+            only,
+            duration,
+        } => {
+            if stack == cmd::distributed::Stack::Sim && transport == cmd::distributed::Transport::Inproc {
+                cmd::run::run(cmd::run::Args { file, scenario, record, out, seed, until, compare })
+            } else {
+                cmd::distributed::run(cmd::distributed::Args {
+                    file,
+                    stack,
+                    transport,
+                    deploy,
+                    process,
+                    only,
+                    duration,
+                    record,
+                })
+            }
         }
+        Command::Up { deploy, file, stack, duration } => cmd::distributed::up(&deploy, &file, stack, duration),
         Command::Graph { file, view, state, format, output } => {
             cmd::graph::run(&file, view, state.as_deref(), format, output.as_ref())
         }

@@ -316,3 +316,11 @@ fn graph_draws_states_rete_and_svg() {
     assert_eq!(code(&o), 2);
     assert!(stderr(&o).contains("no state `XX`"), "{}", stderr(&o));
 }
+
+#[cfg(not(feature = "zenoh"))]
+#[test]
+fn zenoh_without_the_feature_says_how_to_get_it() {
+    let o = situ(&["run", "examples/fig5/fig5.situ", "--stack", "demo", "--transport", "zenoh"]);
+    assert_eq!(code(&o), 2);
+    assert!(stderr(&o).contains("--features zenoh"), "{}", stderr(&o));
+}

@@ -65,6 +65,21 @@ pub struct Process {
     pub cert: Option<PathBuf>,
     #[serde(default)]
     pub key: Option<PathBuf>,
+    /// The host it runs on (the host table); `situ up` starts the processes
+    /// of this host: those without `host`, or with `localhost`, `127.0.0.1`
+    /// or this host's name.
+    #[serde(default)]
+    pub host: Option<String>,
+}
+
+impl Process {
+    /// Whether `situ up` on this host starts it.
+    pub fn is_local(&self) -> bool {
+        match self.host.as_deref() {
+            None | Some("localhost") | Some("127.0.0.1") => true,
+            Some(h) => std::fs::read_to_string("/etc/hostname").is_ok_and(|n| n.trim() == h),
+        }
+    }
 }
 
 /// Why a deployment file is refused.

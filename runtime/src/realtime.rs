@@ -45,6 +45,8 @@ pub struct RealtimeConfig {
     /// A process without the Bulletinboard enters safe mode when no status
     /// came for this long, and leaves it when one comes.
     pub safe_after: Duration,
+    /// Raised from outside (Ctrl-C, SIGTERM): the run ends cleanly.
+    pub stop: Option<Arc<AtomicBool>>,
 }
 
 impl Default for RealtimeConfig {
@@ -58,6 +60,7 @@ impl Default for RealtimeConfig {
             board: true,
             status_every: Duration::from_millis(200),
             safe_after: Duration::from_millis(600),
+            stop: None,
         }
     }
 }
@@ -102,7 +105,7 @@ pub fn run_on(
     let start = Instant::now();
     let epoch = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_nanos() as u64);
     let clock = move || epoch + start.elapsed().as_nanos() as u64;
-    let stop = Arc::new(AtomicBool::new(false));
+    let stop = config.stop.clone().unwrap_or_else(|| Arc::new(AtomicBool::new(false)));
     let counters = Arc::new(Mutex::new(Vec::new()));
     let mut board = BoardRunner::new(content.clone());
     let mut summary = Summary::new(&content).starting_at(epoch);

@@ -116,7 +116,7 @@ impl Summary {
     /// The table a person reads at the end of a run.
     pub fn table(&self) -> String {
         let mut s = String::new();
-        let _ = writeln!(s, "{:.1} s simulated, final state {}", self.duration_s, self.final_state);
+        let _ = writeln!(s, "{:.1} s, final state {}", self.duration_s, self.final_state);
         let _ = writeln!(s, "path: {}", self.path.join(" → "));
         let _ = writeln!(s, "\n  state   time (s)  entered  agent steps");
         for f in self.states.iter().filter(|f| f.entered > 0) {

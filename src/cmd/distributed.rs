@@ -1,0 +1,326 @@
+//! `situ run FILE --stack demo [--transport zenoh --deploy D (--process P |
+//! --only A,B)] [--duration S] [--record F.mcap]`: a stack of agents in
+//! real time, in this process or as one process of a deployment over Zenoh;
+//! and `situ up D FILE …`: every local process of a deployment, started
+//! together and stopped cleanly (Ctrl-C or SIGTERM stops them all).
+//!
+//! The agents come from `--stack`: `demo` is the scripted stack of
+//! `examples/fig5` (runtime::demo); `none` runs no agent here, only the
+//! Bulletinboard (the agents are in other processes or other languages:
+//! `examples/python/ladar.py`). The simulated vehicle of `situ run`'s
+//! default stack needs all its agents and its physics in one process, in
+//! simulated time: it does not run over Zenoh.
+
+use super::{FAILED, OK, USAGE};
+use situ_compiler::bundle::{self, Content, Encoding};
+use situ_runtime::agent::{self, Agent};
+use situ_runtime::demo;
+use situ_runtime::realtime::{self, RealtimeConfig};
+use situ_runtime::record::mcap::McapRecorder;
+use situ_runtime::record::Sink;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Transport {
+    /// Every agent in this process.
+    Inproc,
+    /// One process of a deployment, over Zenoh (build with `--features zenoh`).
+    Zenoh,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Stack {
+    /// The simulated vehicle of the rules (outdoor.situ, ugv.situ), simulated time.
+    Sim,
+    /// The scripted agents of examples/fig5, real time.
+    Demo,
+    /// No agent in this process: the Bulletinboard only.
+    None,
+}
+
+pub struct Args {
+    pub file: PathBuf,
+    pub stack: Stack,
+    pub transport: Transport,
+    pub deploy: Option<PathBuf>,
+    pub process: Option<String>,
+    pub only: Option<Vec<String>>,
+    pub duration: f64,
+    pub record: Option<PathBuf>,
+}
+
+/// The flag Ctrl-C and SIGTERM raise.
+fn stop_flag() -> Arc<AtomicBool> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let s = stop.clone();
+    // A second handler cannot be installed (tests run one command per
+    // process): an error here only means no clean stop on signals.
+    let _ = ctrlc::set_handler(move || s.store(true, Ordering::Release));
+    stop
+}
+
+fn agents_of(stack: Stack, names: &[String]) -> Result<Vec<Box<dyn Agent>>, String> {
+    match stack {
+        Stack::None => Ok(Vec::new()),
+        Stack::Demo => {
+            let log: demo::Log = Arc::new(Mutex::new(Vec::new()));
+            let all = demo::fig5(Duration::from_millis(1500), log);
+            let known: Vec<&str> = all.iter().map(|a| a.name()).collect();
+            if let Some(missing) = names.iter().find(|n| !known.contains(&n.as_str())) {
+                return Err(format!("the demo stack has no agent `{missing}` (it has {})", known.join(", ")));
+            }
+            Ok(all.into_iter().filter(|a| names.iter().any(|n| n == a.name())).collect())
+        }
+        Stack::Sim => {
+            Err("the simulated vehicle runs in one process, in simulated time: use `--stack demo` or `--stack none`"
+                .into())
+        }
+    }
+}
+
+fn recorder(args: &Args, content: &Arc<Content>) -> Result<Option<Box<dyn Sink>>, u8> {
+    let Some(path) = &args.record else { return Ok(None) };
+    let bytes = if super::program::is_source(&args.file) {
+        bundle::encode(content, Encoding::Json)
+    } else {
+        std::fs::read(&args.file).unwrap_or_default()
+    };
+    match McapRecorder::create(path, content.clone(), &bytes) {
+        Ok(r) => Ok(Some(Box::new(r))),
+        Err(e) => {
+            eprintln!("error: cannot write `{}`: {e}", path.display());
+            Err(USAGE)
+        }
+    }
+}
+
+pub fn run(args: Args) -> u8 {
+    if !(args.duration.is_finite() && args.duration > 0.0) {
+        eprintln!("error: --duration must be a positive number of seconds");
+        return USAGE;
+    }
+    let program = match super::program::load(&args.file, false) {
+        Ok(p) => p,
+        Err(code) => return code,
+    };
+    let content = program.content;
+    match args.transport {
+        Transport::Inproc => inproc(&args, content),
+        Transport::Zenoh => zenoh(&args, content),
+    }
+}
+
+fn finish(summary: situ_runtime::summary::Summary) -> u8 {
+    print!("{}", summary.table());
+    if summary.board.cascade_errors > 0 {
+        FAILED
+    } else {
+        OK
+    }
+}
+
+fn inproc(args: &Args, content: Arc<Content>) -> u8 {
+    let names: Vec<String> = content.agents.iter().map(|a| a.name.clone()).collect();
+    let agents = match agents_of(args.stack, &names) {
+        Ok(a) => a,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return USAGE;
+        }
+    };
+    let bound = match agent::bind(&content, agents, false) {
+        Ok(b) => b,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return USAGE;
+        }
+    };
+    let sink = match recorder(args, &content) {
+        Ok(s) => s,
+        Err(code) => return code,
+    };
+    let config = RealtimeConfig { stop: Some(stop_flag()), ..RealtimeConfig::default() };
+    let summary = realtime::run(content, bound, sink, config, Duration::from_secs_f64(args.duration), &mut |c| {
+        eprintln!("state {}", c.to)
+    });
+    finish(summary)
+}
+
+#[cfg(not(feature = "zenoh"))]
+fn zenoh(args: &Args, _content: Arc<Content>) -> u8 {
+    let _ = (&args.deploy, &args.process, &args.only);
+    eprintln!("error: {NO_ZENOH}");
+    USAGE
+}
+
+#[cfg(feature = "zenoh")]
+fn zenoh(args: &Args, content: Arc<Content>) -> u8 {
+    use situ_bus_zenoh::deploy::Deployment;
+    use situ_bus_zenoh::{Placement, ZenohBus};
+    use situ_runtime::bus::Bus;
+    let Some(deploy) = &args.deploy else {
+        eprintln!("error: --transport zenoh needs --deploy DEPLOY.toml (the process and host tables)");
+        return USAGE;
+    };
+    let names: Vec<String> = content.agents.iter().map(|a| a.name.clone()).collect();
+    let d = match Deployment::load(deploy, &names) {
+        Ok(d) => d,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return USAGE;
+        }
+    };
+    let process = match (&args.process, &args.only) {
+        (Some(p), None) => d.process(p).ok_or_else(|| format!("no process `{p}` in `{}`", deploy.display())),
+        (None, Some(only)) => d
+            .process_of(only)
+            .ok_or_else(|| format!("no process of `{}` runs all of {}", deploy.display(), only.join(", "))),
+        _ => Err("say which process of the deployment this is: --process NAME or --only AGENT,…".into()),
+    };
+    let process = match process {
+        Ok(p) => p.clone(),
+        Err(e) => {
+            eprintln!("error: {e}");
+            return USAGE;
+        }
+    };
+    let here: Vec<String> = args.only.clone().unwrap_or_else(|| process.agents.clone());
+    let agents = match agents_of(args.stack, &here) {
+        Ok(a) => a,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return USAGE;
+        }
+    };
+    let bound = match agent::bind(&content, agents, false) {
+        Ok(b) => b,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return USAGE;
+        }
+    };
+    let local: Vec<bool> = content.agents.iter().map(|a| here.contains(&a.name)).collect();
+    let placement = Placement { robot: d.robot.clone(), local, board: process.board };
+    let bus = match ZenohBus::open(content.clone(), placement, &d.zenoh_config(&process), Default::default()) {
+        Ok(b) => b,
+        Err(e) => {
+            eprintln!("error: process `{}`: {e}", process.name);
+            return USAGE;
+        }
+    };
+    let sink = match recorder(args, &content) {
+        Ok(s) => s,
+        Err(code) => return code,
+    };
+    let bus: Arc<dyn Bus> = Arc::new(bus);
+    let config = RealtimeConfig {
+        board: process.board,
+        stop_on_final: true,
+        stop: Some(stop_flag()),
+        ..RealtimeConfig::default()
+    };
+    let name = process.name.clone();
+    let states: Vec<String> = content.states.iter().map(|s| s.name.clone()).collect();
+    eprintln!("{name}: {} agent(s) here{}", here.len(), if process.board { ", and the Bulletinboard" } else { "" });
+    let summary =
+        realtime::run_on(content, bound, sink, config, Duration::from_secs_f64(args.duration), bus, &mut |c| {
+            eprintln!("{name}: state {}", states[c.to as usize])
+        });
+    finish(summary)
+}
+
+#[cfg(not(feature = "zenoh"))]
+const NO_ZENOH: &str =
+    "this situ was built without the Zenoh transport; build it with `cargo build --release --features zenoh`";
+
+/// The processes of the deployment that run on this host.
+#[cfg(feature = "zenoh")]
+fn local_processes(deploy: &Path, agents: &[String]) -> Result<Vec<String>, String> {
+    let d = situ_bus_zenoh::deploy::Deployment::load(deploy, agents).map_err(|e| e.to_string())?;
+    Ok(d.processes.iter().filter(|p| p.is_local()).map(|p| p.name.clone()).collect())
+}
+
+#[cfg(not(feature = "zenoh"))]
+fn local_processes(_deploy: &Path, _agents: &[String]) -> Result<Vec<String>, String> {
+    Err(NO_ZENOH.into())
+}
+
+/// `situ up DEPLOY FILE [--stack …] [--duration S]`.
+pub fn up(deploy: &Path, file: &Path, stack: Stack, duration: f64) -> u8 {
+    let program = match super::program::load(file, false) {
+        Ok(p) => p,
+        Err(code) => return code,
+    };
+    let names: Vec<String> = program.content.agents.iter().map(|a| a.name.clone()).collect();
+    let processes = match local_processes(deploy, &names) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return USAGE;
+        }
+    };
+    let stop = stop_flag();
+    let exe = match std::env::current_exe() {
+        Ok(e) => e,
+        Err(e) => {
+            eprintln!("error: cannot find this program: {e}");
+            return USAGE;
+        }
+    };
+    let stack = match stack {
+        Stack::Sim => "sim",
+        Stack::Demo => "demo",
+        Stack::None => "none",
+    };
+    let mut children = Vec::new();
+    for p in &processes {
+        let child = std::process::Command::new(&exe)
+            .arg("run")
+            .arg(file)
+            .args(["--transport", "zenoh", "--deploy"])
+            .arg(deploy)
+            .args(["--process", p, "--stack", stack, "--duration", &duration.to_string()])
+            .spawn();
+        match child {
+            Ok(c) => children.push((p.clone(), c)),
+            Err(e) => {
+                eprintln!("error: cannot start process `{p}`: {e}");
+                stop.store(true, Ordering::Release);
+            }
+        }
+    }
+    eprintln!("up: {} process(es): {}", children.len(), processes.join(", "));
+    let mut status = OK;
+    let mut running: Vec<(String, std::process::Child)> = children;
+    while !running.is_empty() {
+        if stop.load(Ordering::Acquire) {
+            // Ask each to stop as it would on Ctrl-C (SIGTERM), then wait.
+            for (_, c) in &running {
+                let _ = std::process::Command::new("kill").args(["-TERM", &c.id().to_string()]).status();
+            }
+            stop.store(false, Ordering::Release);
+        }
+        let mut still = Vec::new();
+        for (name, mut c) in running {
+            match c.try_wait() {
+                Ok(Some(code)) => {
+                    eprintln!("up: `{name}` ended ({code})");
+                    if !code.success() {
+                        status = FAILED;
+                    }
+                }
+                Ok(None) => still.push((name, c)),
+                Err(e) => {
+                    eprintln!("up: `{name}`: {e}");
+                    status = FAILED;
+                }
+            }
+        }
+        running = still;
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    status
+}
