@@ -13,6 +13,9 @@ python3 -m pip install --quiet --disable-pip-version-check -r examples/python/re
 echo "== cargo test --workspace --all-features"
 cargo test --workspace --all-features
 
+echo "== a situ run recording reads with the mcap package from PyPI (Foxglove's schemas)"
+bash tests/python/check.sh target/debug/situ
+
 echo "== CLIPS: the outdoor rules in CLIPS pass their own tests"
 bash bench/clips/install.sh
 bash bench/clips/selftest.sh

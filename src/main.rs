@@ -123,6 +123,16 @@ enum Command {
         #[arg(long, default_value_t = 10.0)]
         duration: f64,
     },
+    /// Feed a recording's events to a bundle and say where the states differ from the recorded ones.
+    Replay {
+        /// An MCAP recording of `situ run --record`.
+        recording: PathBuf,
+        /// The rules to replay on (a bundle or a `.situ` source); default: the recording's own.
+        #[arg(long)]
+        bundle: Option<PathBuf>,
+        #[arg(long, value_enum, default_value_t = cmd::replay::Format::Human)]
+        format: cmd::replay::Format,
+    },
     /// Start every local process of a deployment (Zenoh) and stop them cleanly on Ctrl-C.
     Up {
         /// The deployment file.
@@ -258,6 +268,7 @@ fn main() -> ExitCode {
                 })
             }
         }
+        Command::Replay { recording, bundle, format } => cmd::replay::run(&recording, bundle.as_ref(), format),
         Command::Up { deploy, file, stack, duration } => cmd::distributed::up(&deploy, &file, stack, duration),
         Command::Graph { file, view, state, format, output } => {
             cmd::graph::run(&file, view, state.as_deref(), format, output.as_ref())

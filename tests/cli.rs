@@ -324,3 +324,23 @@ fn zenoh_without_the_feature_says_how_to_get_it() {
     assert_eq!(code(&o), 2);
     assert!(stderr(&o).contains("--features zenoh"), "{}", stderr(&o));
 }
+
+#[test]
+fn replay_checks_a_rule_change_against_a_recorded_drive() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("drive.mcap");
+    let o = situ(&["run", "rules/outdoor.situ", "--until", "40", "--record", rec.to_str().unwrap()]);
+    assert!(rec.exists(), "{}{}", stdout(&o), stderr(&o));
+    let same = situ(&["replay", rec.to_str().unwrap()]);
+    assert_eq!(code(&same), 0, "{}{}", stdout(&same), stderr(&same));
+    assert!(stdout(&same).contains("same states"), "{}", stdout(&same));
+    // Obstacles seen from 10 m instead of 30 m: the drive of yesterday goes otherwise.
+    let rules = std::fs::read_to_string("rules/outdoor.situ").unwrap();
+    let changed = write(dir.path(), "changed.situ", rules.replace("LAOBS(distance < 30.0", "LAOBS(distance < 10.0"));
+    let o = situ(&["replay", rec.to_str().unwrap(), "--bundle", &changed, "--format", "json"]);
+    assert_eq!(code(&o), 1, "{}{}", stdout(&o), stderr(&o));
+    let report: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
+    assert!(report["first_difference"].is_u64(), "{report}");
+    let junk = write(dir.path(), "junk.mcap", "not a recording");
+    assert_eq!(code(&situ(&["replay", &junk])), 2);
+}

@@ -88,13 +88,17 @@ fn data() {
 fn fan_out() {
     const AGENTS: usize = 12;
     const ROUNDS: usize = 10_000;
-    let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let workers: usize = std::env::var("WORKERS")
+        .ok()
+        .and_then(|w| w.parse().ok())
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     let bus = Arc::new(InProc::new(AGENTS, Capacity::default()));
     let start = Instant::now();
     let seen: Arc<Vec<AtomicU64>> = Arc::new((0..AGENTS).map(|_| AtomicU64::new(0)).collect());
     let acks = Arc::new(AtomicU64::new(0));
     let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
     let mut lat = Vec::with_capacity(ROUNDS);
+    let main = std::thread::current();
     std::thread::scope(|scope| {
         for w in 0..workers {
             let mine: Vec<u32> = (0..AGENTS as u32).filter(|a| *a as usize % workers == w).collect();
@@ -102,7 +106,7 @@ fn fan_out() {
             for &a in &mine {
                 bus.set_doorbell(a, bell.clone());
             }
-            let (bus, seen, acks, stop) = (bus.clone(), seen.clone(), acks.clone(), stop.clone());
+            let (bus, seen, acks, stop, main) = (bus.clone(), seen.clone(), acks.clone(), stop.clone(), main.clone());
             scope.spawn(move || {
                 let mut last = [0u64; AGENTS];
                 while !stop.load(Ordering::Acquire) {
@@ -114,7 +118,9 @@ fn fan_out() {
                             if st.seq != last[a as usize] {
                                 last[a as usize] = st.seq;
                                 seen[a as usize].store(start.elapsed().as_nanos() as u64, Ordering::Release);
-                                acks.fetch_add(1, Ordering::AcqRel);
+                                if acks.fetch_add(1, Ordering::AcqRel) + 1 == AGENTS as u64 {
+                                    main.unpark();
+                                }
                             }
                         }
                     }
@@ -126,8 +132,9 @@ fn fan_out() {
             acks.store(0, Ordering::Release);
             let t0 = start.elapsed().as_nanos() as u64;
             bus.send_status(StatusMsg { state: (round % 2) as u32, time: t0, seq: round });
+            // Out of the way of the workers until the last agent has seen it.
             while acks.load(Ordering::Acquire) < AGENTS as u64 {
-                std::thread::yield_now();
+                std::thread::park_timeout(Duration::from_millis(10));
             }
             let last = seen.iter().map(|s| s.load(Ordering::Acquire)).max().unwrap_or(t0);
             lat.push(last.saturating_sub(t0));

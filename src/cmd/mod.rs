@@ -9,6 +9,7 @@ pub mod export;
 pub mod fmt;
 pub mod graph;
 pub mod program;
+pub mod replay;
 pub mod run;
 pub mod test;
 
