@@ -210,11 +210,13 @@
    =>
    (goto ?sys SP supervisor_stop))
 
-;; rule emergency_halted salience 90 { when state == EM and DRSTOP then SP }
+;; rule emergency_halted salience 90 { when state == EM and DRSTOP within 100ms then SP }
 (defrule emergency_halted (declare (salience 90))
    ?sys <- (system (state ?s&EM))
    (test (neq ?s SP))
-   (DRSTOP)
+   (DRSTOP (t ?t1))
+   (clock (now ?now))
+   (test (<= (- ?now ?t1) 100000000))
    =>
    (goto ?sys SP emergency_halted))
 

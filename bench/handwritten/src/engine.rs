@@ -6,7 +6,7 @@
 //! fire with a `match` on the current state that offers only the rules whose
 //! state test admits that state.
 
-use crate::model::{Agent, Ev, Event, State, Value, AGENTS, STALE_AFTER, WITHIN_500MS};
+use crate::model::{Agent, Ev, Event, State, Value, AGENTS, STALE_AFTER, WITHIN_100MS, WITHIN_500MS};
 
 /// At most this many firings per rest (§10.4); one more is a runtime error.
 pub const MAX_FIRINGS: usize = 64;
@@ -542,6 +542,12 @@ impl Engine {
         self.fact(ev).filter(|f| self.now - f.t <= WITHIN_500MS).map(|f| f.seq)
     }
 
+    /// `E within 100ms`.
+    #[inline(always)]
+    fn within_100ms(&self, ev: Ev) -> Option<u64> {
+        self.fact(ev).filter(|f| self.now - f.t <= WITHIN_100MS).map(|f| f.seq)
+    }
+
     /// `stale A`: a rule condition that matches no fact (recency 0).
     #[inline(always)]
     fn stale(&self, agent: Agent) -> Option<u64> {
@@ -615,9 +621,9 @@ impl Engine {
         self.is(Ev::SVSTOP)
     }
 
-    /// emergency_halted: state == EM and DRSTOP → SP
+    /// emergency_halted: state == EM and DRSTOP within 100ms → SP
     fn emergency_halted(&self) -> Option<u64> {
-        self.is(Ev::DRSTOP)
+        self.within_100ms(Ev::DRSTOP)
     }
 
     // 80: goal

@@ -97,6 +97,8 @@ pub const STALE_AFTER: [(Agent, u64); 5] = [
 
 /// `within 500ms`, the only window of the rules.
 pub const WITHIN_500MS: u64 = 500 * MS;
+/// `within 100ms` (emergency_halted: a fresh DRSTOP).
+pub const WITHIN_100MS: u64 = 100 * MS;
 
 /// The events of `outdoor.situ`, grouped by agent, in declaration order.
 #[allow(clippy::upper_case_acronyms)]

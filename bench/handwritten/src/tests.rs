@@ -263,6 +263,27 @@ fn a_run_is_broken_by_expiry() {
 }
 
 #[test]
+fn only_a_fresh_drstop_ends_an_emergency() {
+    // The DRSTOP of the start is older than 100 ms: the emergency stays.
+    let mut s = Sim::new();
+    s.given_state(RO).given("DRSTOP", 1);
+    assert_eq!(s.at(200, "PLF no_path"), EM);
+    // A fresh one ends it.
+    assert_eq!(s.at(300, "DRSTOP"), SP);
+
+    // The window is inclusive: 100 ms old still says the vehicle stands.
+    let mut s = Sim::new();
+    s.given_state(RO);
+    s.at(10, "DRSTOP");
+    assert_eq!(s.at(110, "PLF no_path"), SP);
+    let mut s = Sim::new();
+    s.given_state(RO);
+    s.at(10, "DRSTOP");
+    s.engine.post(&Sim::event(110 * MS + 1, "PLF no_path")).unwrap();
+    assert_eq!(s.engine.state(), EM);
+}
+
+#[test]
 fn within_500ms_expires() {
     let mut s = Sim::new();
     s.given_state(RO);
