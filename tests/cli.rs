@@ -127,6 +127,16 @@ fn explain_prints_the_long_text() {
 }
 
 #[test]
+fn the_shipped_situ_files_are_formatted() {
+    // The .situ files a user reads and copies are in the formatter's layout.
+    // The test corpora (tests/ui, tests/checks, tests/verify) are not: they
+    // are compact on purpose, with expectations inline on given lines.
+    let files = ["rules/outdoor.situ", "rules/ugv.situ", "examples/fig5/fig5.situ"];
+    let o = situ(&[&["fmt", "--check"][..], &files[..]].concat());
+    assert_eq!(code(&o), 0, "run `situ fmt` on them:\n{}{}", stdout(&o), stderr(&o));
+}
+
+#[test]
 fn fmt_check_reports_and_fmt_rewrites() {
     let dir = tempfile::tempdir().unwrap();
     let messy = "states{IT initial RD}  // the states\nagent Ready sensor{event RDY}\nrule ready{when state==IT and RDY then RD}\n";

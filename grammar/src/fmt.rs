@@ -49,6 +49,16 @@
 //!
 //! One blank line of the source is kept between the elements of a block and
 //! between comments and elements; none after `{` or before `}`.
+//!
+//! # Alignment
+//!
+//! A run of like lines, at one indentation with no blank or comment line
+//! between them, is aligned in columns: the descriptions of states and of
+//! functions, the `=>` of a table's entries and of an FSM's states, the `->`
+//! and `on` of an FSM's transitions. Trailing comments are aligned when two
+//! or more lines of such a run, or of consecutive lines, have one (never on
+//! a line that opens or closes a block). Alignment only adds spaces
+//! between tokens, so the output still parses to the same tree.
 
 use crate::ast::*;
 use crate::diag::{Diagnostic, FileId};
@@ -88,6 +98,7 @@ pub fn format(src: &str) -> Result<String, Vec<Diagnostic>> {
     }
     let mut lines = layout.lines;
     let at_end = attach(src, &mut lines, &parsed.comments);
+    align(src, &mut lines);
     Ok(render(src, &lines, &at_end, &parsed.comments))
 }
 
@@ -128,7 +139,20 @@ struct Line {
     closes: bool,
     leading: Vec<Lead>,
     trailing: Option<usize>,
+    /// The line as columns, for lines that are aligned with their like
+    /// neighbours (states, functions, table and FSM lines); `text` is them
+    /// joined with one space until [`align`] pads them.
+    cells: Vec<String>,
+    /// What kind of line it is: only lines of one kind align (0: none).
+    kind: u8,
 }
+
+/// Kinds of aligned lines.
+const STATE: u8 = 1;
+const FUNCTION: u8 = 2;
+const ENTRY: u8 = 3;
+const FSM_STATE: u8 = 4;
+const TRANSITION: u8 = 5;
 
 /// Builds the lines of a file from its AST and its source.
 struct Layout<'a> {
@@ -139,9 +163,29 @@ struct Layout<'a> {
 
 impl Layout<'_> {
     fn push(&mut self, indent: usize, text: String, anchor: Span, blank: Blank) {
-        let line =
-            Line { indent, text, anchor, blank, opens: false, closes: false, leading: Vec::new(), trailing: None };
+        let line = Line {
+            indent,
+            text,
+            anchor,
+            blank,
+            opens: false,
+            closes: false,
+            leading: Vec::new(),
+            trailing: None,
+            cells: Vec::new(),
+            kind: 0,
+        };
         self.lines.push(line);
+    }
+
+    /// Pushes a line made of columns that align with the lines of the same
+    /// kind around it.
+    fn push_cells(&mut self, indent: usize, kind: u8, cells: Vec<String>, anchor: Span, blank: Blank) {
+        self.push(indent, cells.join(" "), anchor, blank);
+        if let Some(line) = self.lines.last_mut() {
+            line.cells = cells;
+            line.kind = kind;
+        }
     }
 
     /// Pushes the header of the block `block` (from its keyword to its `}`),
@@ -196,7 +240,7 @@ impl Layout<'_> {
                 let after = s.span.start + "states".len();
                 if let Some(inner) = self.open(0, header, s.span, after, blank, s.states.is_empty()) {
                     for decl in &s.states {
-                        self.push(inner, state_decl(decl), self.tight(decl.span), Blank::Keep);
+                        self.push_cells(inner, STATE, state_decl(decl), self.tight(decl.span), Blank::Keep);
                     }
                     self.close(0, s.span);
                 }
@@ -261,19 +305,18 @@ impl Layout<'_> {
                 }
                 AgentMember::Rate(r) => self.push(inner, format!("rate {}Hz", r.hertz), anchor, Blank::Keep),
                 AgentMember::Event(e) => self.push(inner, event_decl(e), anchor, Blank::Keep),
-                AgentMember::Function(f) => self.push(
-                    inner,
-                    with_description(format!("function {}", f.name.name), &f.description),
-                    anchor,
-                    Blank::Keep,
-                ),
+                AgentMember::Function(f) => {
+                    let mut cells = vec![format!("function {}", f.name.name)];
+                    cells.extend(f.description.as_ref().map(|d| string(&d.value)));
+                    self.push_cells(inner, FUNCTION, cells, anchor, Blank::Keep)
+                }
                 AgentMember::Table(t) => {
                     let after = t.span.start + "table".len();
                     if let Some(deeper) =
                         self.open(inner, "table".into(), t.span, after, Blank::Keep, t.entries.is_empty())
                     {
                         for entry in &t.entries {
-                            self.push(deeper, table_entry(entry), self.tight(entry.span), Blank::Keep);
+                            self.push_cells(deeper, ENTRY, table_entry(entry), self.tight(entry.span), Blank::Keep);
                         }
                         self.close(inner, t.span);
                     }
@@ -283,7 +326,8 @@ impl Layout<'_> {
                     if let Some(deeper) = self.open(inner, "fsm".into(), f.span, after, Blank::Keep, f.lines.is_empty())
                     {
                         for line in &f.lines {
-                            self.push(deeper, fsm_line(line), self.tight(line.span()), Blank::Keep);
+                            let (kind, cells) = fsm_line(line);
+                            self.push_cells(deeper, kind, cells, self.tight(line.span()), Blank::Keep);
                         }
                         self.close(inner, f.span);
                     }
@@ -553,7 +597,7 @@ fn names(idents: &[Ident]) -> String {
     idents.iter().map(|i| i.name.as_str()).collect::<Vec<_>>().join(", ")
 }
 
-fn state_decl(d: &StateDecl) -> String {
+fn state_decl(d: &StateDecl) -> Vec<String> {
     let mut text = d.name.name.clone();
     if d.initial.is_some() {
         text.push_str(" initial");
@@ -561,7 +605,9 @@ fn state_decl(d: &StateDecl) -> String {
     if d.is_final.is_some() {
         text.push_str(" final");
     }
-    with_description(text, &d.description)
+    let mut cells = vec![text];
+    cells.extend(d.description.as_ref().map(|d| string(&d.value)));
+    cells
 }
 
 fn event_decl(e: &EventDecl) -> String {
@@ -599,27 +645,99 @@ fn action(a: &Action) -> String {
     text
 }
 
-fn table_entry(e: &TableEntry) -> String {
+fn table_entry(e: &TableEntry) -> Vec<String> {
     let selector = match &e.selector {
         Selector::States(s) => names(s),
         Selector::Wildcard(_) => "_".into(),
     };
-    format!("{selector} => {}", action(&e.action))
+    vec![selector, format!("=> {}", action(&e.action))]
 }
 
-fn fsm_line(line: &FsmLine) -> String {
+fn fsm_line(line: &FsmLine) -> (u8, Vec<String>) {
     match line {
         FsmLine::State(s) => {
             let initial = if s.initial.is_some() { " initial" } else { "" };
-            format!("{}{initial} => {}", s.name.name, action(&s.action))
+            (FSM_STATE, vec![format!("{}{initial}", s.name.name), format!("=> {}", action(&s.action))])
         }
         FsmLine::Transition(t) => {
             let trigger = match &t.trigger {
                 Trigger::State(s) => state_test(s),
                 Trigger::Event(e) => e.name.clone(),
             };
-            format!("{} -> {} on {trigger}", t.from.name, t.to.name)
+            (TRANSITION, vec![t.from.name.clone(), format!("-> {}", t.to.name), format!("on {trigger}")])
         }
+    }
+}
+
+/// Whether `next` continues the run of `prev`: at the same indentation,
+/// with no comment line and no blank line between them.
+fn continues(src: &str, prev: &Line, next: &Line) -> bool {
+    next.indent == prev.indent
+        && !prev.opens
+        && !next.closes
+        && next.leading.is_empty()
+        && !(next.blank == Blank::Keep && has_blank_line(src, prev.anchor.end, next.anchor.start))
+}
+
+/// Aligns columns of consecutive lines of one kind (a table's `=>`, the
+/// descriptions of states and functions), then their trailing comments,
+/// and those of consecutive commented lines.
+fn align(src: &str, lines: &mut [Line]) {
+    let mut i = 0;
+    while i < lines.len() {
+        let mut j = i + 1;
+        while j < lines.len()
+            && lines[i].kind != 0
+            && lines[j].kind == lines[i].kind
+            && continues(src, &lines[j - 1], &lines[j])
+        {
+            j += 1;
+        }
+        if j - i > 1 {
+            let columns = lines[i..j].iter().map(|l| l.cells.len()).max().unwrap_or(0);
+            for c in 0..columns.saturating_sub(1) {
+                let width =
+                    lines[i..j].iter().filter(|l| l.cells.len() > c + 1).map(|l| l.cells[c].chars().count()).max();
+                let Some(width) = width else { continue };
+                for l in &mut lines[i..j] {
+                    if l.cells.len() > c + 1 {
+                        let pad = width - l.cells[c].chars().count();
+                        l.cells[c].push_str(&" ".repeat(pad));
+                    }
+                }
+            }
+            for l in &mut lines[i..j] {
+                l.text = l.cells.join(" ");
+            }
+        }
+        i = j;
+    }
+    // Trailing comments: in a run of like lines (a table, the states), or of
+    // consecutive commented lines; never on a line that opens or closes a
+    // block.
+    let plain = |l: &Line| !l.opens && !l.closes && !l.text.contains('\n');
+    let commented = |l: &Line| l.trailing.is_some() && plain(l);
+    let mut i = 0;
+    while i < lines.len() {
+        let mut j = i + 1;
+        while j < lines.len()
+            && plain(&lines[j - 1])
+            && plain(&lines[j])
+            && continues(src, &lines[j - 1], &lines[j])
+            && ((commented(&lines[j - 1]) && commented(&lines[j]))
+                || (lines[j].kind != 0 && lines[j].kind == lines[j - 1].kind))
+        {
+            j += 1;
+        }
+        let width = lines[i..j].iter().filter(|l| commented(l)).map(|l| l.text.chars().count()).max();
+        if lines[i..j].iter().filter(|l| commented(l)).count() > 1 {
+            let width = width.unwrap_or(0);
+            for l in lines[i..j].iter_mut().filter(|l| l.trailing.is_some()) {
+                let pad = width - l.text.chars().count();
+                l.text.push_str(&" ".repeat(pad));
+            }
+        }
+        i = j;
     }
 }
 
