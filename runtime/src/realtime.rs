@@ -24,7 +24,7 @@ use crate::stack::{AgentRunner, BoardRunner, Shared};
 use crate::summary::Summary;
 use situ_compiler::bundle::Content;
 use std::collections::BTreeMap;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -107,6 +107,8 @@ pub fn run_on(
     let clock = move || epoch + start.elapsed().as_nanos() as u64;
     let stop = config.stop.clone().unwrap_or_else(|| Arc::new(AtomicBool::new(false)));
     let counters = Arc::new(Mutex::new(Vec::new()));
+    // Steps of agents that were not sleeping, since the summary last took them.
+    let steps = &AtomicU64::new(0);
     let mut board = BoardRunner::new(content.clone());
     let mut summary = Summary::new(&content).starting_at(epoch);
     if config.board {
@@ -150,8 +152,9 @@ pub fn run_on(
                             }
                         }
                         let on_input = slot.period.is_none() && attention.input;
-                        if due || attention.urgent || on_input {
-                            slot.runner.cycle(&shared, clock());
+                        let turn = due || attention.urgent || on_input;
+                        if turn && slot.runner.cycle(&shared, clock()).stepped {
+                            steps.fetch_add(1, Ordering::Relaxed);
                         }
                     }
                     let next = group.iter().filter(|s| s.period.is_some()).map(|s| s.next).min();
@@ -162,7 +165,7 @@ pub fn run_on(
             });
         }
         if !config.board {
-            follow(&shared, &local, &config, start + duration, &stop, &mut summary, on_change, &clock);
+            follow(&shared, &local, &config, start + duration, &stop, &mut summary, steps, on_change, &clock);
         } else {
             // The Bulletinboard, on this thread.
             let end = start + duration;
@@ -190,6 +193,7 @@ pub fn run_on(
                     board.reassure(&shared, clock());
                 }
                 for c in &changes {
+                    summary.add_steps(steps.swap(0, Ordering::Relaxed));
                     summary.change(c);
                     on_change(c);
                     if config.stop_on_final && content.states[c.to as usize].is_final {
@@ -203,6 +207,7 @@ pub fn run_on(
     });
     let agents = std::mem::take(&mut *counters.lock().unwrap_or_else(|p| p.into_inner()));
     let state = if config.board { board.board.state() } else { shared.org().state() };
+    summary.add_steps(steps.swap(0, Ordering::Relaxed));
     summary.finish(clock(), state, &board.counters, agents, shared.bus.counters());
     shared.record(|s| {
         let _ = s.finish();
@@ -220,6 +225,7 @@ fn follow(
     end: Instant,
     stop: &AtomicBool,
     summary: &mut Summary,
+    steps: &AtomicU64,
     on_change: &mut (dyn FnMut(&StateChange) + Send),
     clock: &dyn Fn() -> u64,
 ) {
@@ -251,6 +257,7 @@ fn follow(
             if from != status.state {
                 shared.org_mut().on_state(status.state);
                 let change = StateChange { from, to: status.state, time: status.time, firings: Vec::new() };
+                summary.add_steps(steps.swap(0, Ordering::Relaxed));
                 summary.change(&change);
                 on_change(&change);
                 if config.stop_on_final && shared.content.states[status.state as usize].is_final {

@@ -93,6 +93,13 @@ impl Summary {
         }
     }
 
+    /// `n` agent steps taken since the last call, all in the current state
+    /// (the real-time scheduler counts them on its workers and hands them
+    /// over at each state change and at the end).
+    pub fn add_steps(&mut self, n: u64) {
+        self.states[self.current].agent_steps += n;
+    }
+
     /// Closes the figures at `now`.
     pub fn finish(
         &mut self,

@@ -290,4 +290,10 @@ fn in_real_time_an_urgent_datum_interrupts_a_sleeping_receiver() {
     assert_eq!(summary.final_state, "B");
     assert_eq!(summary.agents["Slow"].steps, 2, "its first periodic step, then the urgent one");
     assert!(summary.duration_s < 30.0);
+    // The workers' steps are in the per-state figures too: no agent sleeps,
+    // so every step of every agent is counted in some state, most in A.
+    let per_state: u64 = summary.states.iter().map(|f| f.agent_steps).sum();
+    let per_agent: u64 = summary.agents.values().map(|a| a.steps).sum();
+    assert_eq!(per_state, per_agent, "{:?}", summary.states);
+    assert!(summary.states[0].agent_steps >= 5, "Fast stepped 5 times in A: {:?}", summary.states);
 }
