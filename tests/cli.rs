@@ -1,30 +1,9 @@
 //! Golden tests of the command line: they run the real `situ` binary and
 //! check its exit codes and outputs, as scripts and users rely on them.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
-fn situ(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_situ")).args(args).env("NO_COLOR", "1").output().expect("the binary runs")
-}
-
-fn code(o: &Output) -> i32 {
-    o.status.code().expect("exited normally, not by a signal")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8(o.stdout.clone()).expect("UTF-8 output")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8(o.stderr.clone()).expect("UTF-8 output")
-}
-
-fn write(dir: &Path, name: &str, content: impl AsRef<[u8]>) -> String {
-    let path = dir.join(name);
-    std::fs::write(&path, content).expect("temp file written");
-    path.display().to_string()
-}
+use common::{code, situ, stderr, stdout, write};
 
 const VALID: &str = "states { IT initial RD final }\nagent Ready sensor { event RDY }\nrule ready { when state == IT and RDY then RD }\n";
 

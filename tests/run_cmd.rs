@@ -2,22 +2,12 @@
 //! exit codes, the files it writes, the recording read back, determinism,
 //! and its refusals (a bad scenario, a damaged bundle, rules with no stack).
 
+mod common;
+
+use common::{code, situ, text};
 use situ_runtime::record::mcap::read_messages;
 use std::collections::BTreeMap;
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn situ(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_situ")).args(args).env("NO_COLOR", "1").output().expect("the binary runs")
-}
-
-fn code(o: &Output) -> i32 {
-    o.status.code().expect("exited normally, not by a signal")
-}
-
-fn text(o: &Output) -> String {
-    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
-}
 
 fn s(p: &Path) -> &str {
     p.to_str().expect("a UTF-8 temp path")

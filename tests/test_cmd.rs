@@ -3,26 +3,9 @@
 //! the summary line, failure reports with places, counterexamples that
 //! replay as tests, and the JSON form.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
-fn situ(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_situ")).args(args).env("NO_COLOR", "1").output().expect("the binary runs")
-}
-
-fn code(o: &Output) -> i32 {
-    o.status.code().expect("exited normally, not by a signal")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8(o.stdout.clone()).expect("UTF-8 output")
-}
-
-fn write(dir: &Path, name: &str, content: &str) -> String {
-    let path = dir.join(name);
-    std::fs::write(&path, content).expect("temp file written");
-    path.display().to_string()
-}
+use common::{code, situ, stdout, write};
 
 /// A small stack with one failing test and one failing property.
 const BUGGY: &str = r#"states { Ready initial Armed Fired final }
@@ -85,7 +68,7 @@ fn a_counterexample_replays_as_a_test() {
     let block: String =
         out[start..].lines().take_while(|l| l.starts_with("    ")).map(|l| format!("{}\n", &l[4..])).collect();
     assert!(block.trim_end().ends_with('}'), "{block}");
-    let replay = write(dir.path(), "replay.situ", &format!("{BUGGY}\n{block}"));
+    let replay = write(dir.path(), "replay.situ", format!("{BUGGY}\n{block}"));
     let o = situ(&["test", &replay, "--filter", "counterexample"]);
     assert_eq!(code(&o), 0, "{}\n{block}", stdout(&o));
     assert_eq!(stdout(&o).lines().last(), Some("1 passed, 0 failed"));

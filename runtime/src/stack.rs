@@ -434,14 +434,7 @@ impl BoardRunner {
         if let Some(reason) = self.check(&c, msg) {
             let key = reason_key(&reason);
             *self.counters.refused.entry(key).or_default() += 1;
-            let rec = EventRecord {
-                time: msg.time,
-                agent: msg.agent,
-                event: msg.event,
-                payload: msg.payload.clone(),
-                urgent: msg.urgent,
-                verdict: Verdict::Refused(reason.clone()),
-            };
+            let rec = record_of(msg, Verdict::Refused(reason.clone()));
             shared.record(|s| {
                 s.event(&rec);
                 s.diagnostic(msg.time, Level::Warning, &format!("event refused: {reason}"));
@@ -450,14 +443,7 @@ impl BoardRunner {
         }
         self.last_time[msg.agent as usize] = msg.time;
         self.counters.accepted += 1;
-        let rec = EventRecord {
-            time: msg.time,
-            agent: msg.agent,
-            event: msg.event,
-            payload: msg.payload.clone(),
-            urgent: msg.urgent,
-            verdict: Verdict::Accepted,
-        };
+        let rec = record_of(msg, Verdict::Accepted);
         shared.record(|s| s.event(&rec));
         // The agent's FSM sees its own event before the Bulletinboard's rest.
         let moved = shared.org_mut().on_event(msg.agent, msg.event);
@@ -534,6 +520,18 @@ impl BoardRunner {
         }
         drop(org);
         shared.record(|s| recs.iter().for_each(|r| s.mode(r)));
+    }
+}
+
+/// The record of an event the Bulletinboard received, with what became of it.
+fn record_of(msg: &EventMsg, verdict: Verdict) -> EventRecord {
+    EventRecord {
+        time: msg.time,
+        agent: msg.agent,
+        event: msg.event,
+        payload: msg.payload.clone(),
+        urgent: msg.urgent,
+        verdict,
     }
 }
 

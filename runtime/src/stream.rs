@@ -28,10 +28,10 @@
 //!
 //! The same seed gives the same stream, on every machine.
 
-use crate::rete::{compare, in_range, Engine};
+use crate::rete::{passes, Engine};
 use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
-use situ_compiler::bundle::{AlphaNode, BetaKind, Check, Content, FieldType, Operand, Test, Value};
+use situ_compiler::bundle::{AlphaNode, BetaKind, Check, Content, FieldType, Operand, Value};
 use std::fmt::Write as _;
 use std::sync::Arc;
 
@@ -302,23 +302,6 @@ impl Generator {
             FieldType::Bool => Value::Bool(self.rng.random_bool(0.5)),
             FieldType::Symbols(s) => Value::Symbol(self.rng.random_range(0..s.len().max(1)) as u32),
         }
-    }
-}
-
-/// Whether a payload passes a test on its own fields.
-fn passes(t: &Test, payload: &[Value]) -> bool {
-    let get = |o: &Operand| match o {
-        Operand::Value(v) => Some(*v),
-        Operand::Own { field } => payload.get(*field as usize).copied(),
-        Operand::Fact { .. } => None,
-    };
-    let Some(&x) = payload.get(t.field as usize) else { return false };
-    match &t.check {
-        Check::Compare { op, rhs } => get(rhs).is_some_and(|y| compare(*op, x, y)),
-        Check::Range { lo, hi, inclusive } => match (get(lo), get(hi)) {
-            (Some(lo), Some(hi)) => in_range(x, lo, hi, *inclusive),
-            _ => false,
-        },
     }
 }
 

@@ -113,6 +113,17 @@ pub fn run(args: Args) -> u8 {
     }
 }
 
+/// The agents of `stack` among `names`, bound to the functions `content`
+/// names; the error printed and a usage exit code otherwise.
+fn bound_agents(stack: Stack, content: &Content, names: &[String]) -> Result<agent::Bound, u8> {
+    let bound =
+        agents_of(stack, names).and_then(|agents| agent::bind(content, agents, false).map_err(|e| e.to_string()));
+    bound.map_err(|e| {
+        eprintln!("error: {e}");
+        USAGE
+    })
+}
+
 fn finish(summary: situ_runtime::summary::Summary) -> u8 {
     print!("{}", summary.table());
     if summary.board.cascade_errors > 0 {
@@ -124,19 +135,9 @@ fn finish(summary: situ_runtime::summary::Summary) -> u8 {
 
 fn inproc(args: &Args, content: Arc<Content>) -> u8 {
     let names: Vec<String> = content.agents.iter().map(|a| a.name.clone()).collect();
-    let agents = match agents_of(args.stack, &names) {
-        Ok(a) => a,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return USAGE;
-        }
-    };
-    let bound = match agent::bind(&content, agents, false) {
+    let bound = match bound_agents(args.stack, &content, &names) {
         Ok(b) => b,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return USAGE;
-        }
+        Err(code) => return code,
     };
     let sink = match recorder(args, &content) {
         Ok(s) => s,
@@ -188,19 +189,9 @@ fn zenoh(args: &Args, content: Arc<Content>) -> u8 {
         }
     };
     let here: Vec<String> = args.only.clone().unwrap_or_else(|| process.agents.clone());
-    let agents = match agents_of(args.stack, &here) {
-        Ok(a) => a,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return USAGE;
-        }
-    };
-    let bound = match agent::bind(&content, agents, false) {
+    let bound = match bound_agents(args.stack, &content, &here) {
         Ok(b) => b,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return USAGE;
-        }
+        Err(code) => return code,
     };
     let local: Vec<bool> = content.agents.iter().map(|a| here.contains(&a.name)).collect();
     let placement = Placement { robot: d.robot.clone(), local, board: process.board };

@@ -2,7 +2,7 @@
 //! integer compares with a float by exact numeric value, NaN satisfies no
 //! comparison (not even `!=`), symbols and booleans only (in)equality.
 
-use situ_compiler::bundle::{Cmp, Value};
+use situ_compiler::bundle::{Check, Cmp, Operand, Test, Value};
 use std::cmp::Ordering;
 
 /// `a op b`.
@@ -23,6 +23,24 @@ pub fn compare(op: Cmp, a: Value, b: Value) -> bool {
 #[inline]
 pub fn in_range(x: Value, lo: Value, hi: Value, inclusive: bool) -> bool {
     compare(Cmp::Ge, x, lo) && compare(if inclusive { Cmp::Le } else { Cmp::Lt }, x, hi)
+}
+
+/// Whether a payload passes a test on its own fields (a test on another
+/// fact's field passes nothing: it needs the other fact).
+pub fn passes(t: &Test, payload: &[Value]) -> bool {
+    let get = |o: &Operand| match o {
+        Operand::Value(v) => Some(*v),
+        Operand::Own { field } => payload.get(*field as usize).copied(),
+        Operand::Fact { .. } => None,
+    };
+    let Some(&x) = payload.get(t.field as usize) else { return false };
+    match &t.check {
+        Check::Compare { op, rhs } => get(rhs).is_some_and(|y| compare(*op, x, y)),
+        Check::Range { lo, hi, inclusive } => match (get(lo), get(hi)) {
+            (Some(lo), Some(hi)) => in_range(x, lo, hi, *inclusive),
+            _ => false,
+        },
+    }
 }
 
 #[inline]

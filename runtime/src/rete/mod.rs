@@ -26,7 +26,7 @@ use net::{AlphaKind, Kind, Net, OperandRt, TestKind, TestRt, NONE};
 use situ_compiler::bundle::{Content, FieldType, Value};
 use std::sync::Arc;
 
-pub use eval::{compare, in_range};
+pub use eval::{compare, in_range, passes};
 
 /// The default bound of a cascade (§10.4).
 pub const CASCADE_LIMIT: usize = 64;

@@ -402,7 +402,7 @@ fn constants(ch: &Check) -> Vec<f64> {
 }
 
 fn check_value(ch: &Check, v: Value) -> bool {
-    super::passes(&Test { field: 0, check: ch.clone() }, &[v])
+    crate::rete::passes(&Test { field: 0, check: ch.clone() }, &[v])
 }
 
 fn same(a: Value, b: Value) -> bool {

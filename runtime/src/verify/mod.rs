@@ -24,8 +24,8 @@ pub mod random;
 pub mod scenario;
 
 use crate::organise::Organisation;
-use crate::rete::{compare, format_time, in_range, show_value, Engine, PostError, Step};
-use situ_compiler::bundle::{Check, Content, Operand, Test, Value};
+use crate::rete::{format_time, passes, show_value, Engine, PostError, Step};
+use situ_compiler::bundle::{Content, Value};
 use situ_compiler::spec::{Pred, PropertySpec};
 use std::sync::Arc;
 
@@ -93,23 +93,6 @@ impl System {
         let premise = if p.premise.is_some() { preds.next().is_some_and(|q| self.holds(q)) } else { true };
         let q = preds.last().is_some_and(|q| self.holds(q));
         (premise, q)
-    }
-}
-
-/// Whether a payload passes a test on its own fields.
-pub fn passes(t: &Test, payload: &[Value]) -> bool {
-    let get = |o: &Operand| match o {
-        Operand::Value(v) => Some(*v),
-        Operand::Own { field } => payload.get(*field as usize).copied(),
-        Operand::Fact { .. } => None,
-    };
-    let Some(&x) = payload.get(t.field as usize) else { return false };
-    match &t.check {
-        Check::Compare { op, rhs } => get(rhs).is_some_and(|y| compare(*op, x, y)),
-        Check::Range { lo, hi, inclusive } => match (get(lo), get(hi)) {
-            (Some(lo), Some(hi)) => in_range(x, lo, hi, *inclusive),
-            _ => false,
-        },
     }
 }
 
