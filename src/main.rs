@@ -81,7 +81,7 @@ enum Command {
         #[arg(long)]
         no_reset: bool,
     },
-    /// Run the rules' reference stack on a simulated mission; exit 0 mission done, 1 failed, 2 usage or I/O.
+    /// Run rules: the reference stack on a mission, or any rules file on a script; exit 0 done, 1 failed, 2 usage.
     Run {
         /// A `.situ` source or a bundle (rules/outdoor.situ, rules/ugv.situ: the stack is told by the agents).
         file: PathBuf,
@@ -103,6 +103,13 @@ enum Command {
         /// Dafflon et al.'s comparison of the controllers (rules/ugv.situ): hard-switch,merge.
         #[arg(long, value_delimiter = ',')]
         compare: Option<Vec<String>>,
+        /// Any rules file: play this `script` block (its name) or the first script of this
+        /// `.situ` file, every agent a stand-in that follows its table or FSM.
+        #[arg(long, conflicts_with_all = ["compare", "scenario", "random"])]
+        script: Option<String>,
+        /// Any rules file: the guided random generator drives every agent, with this seed.
+        #[arg(long, conflicts_with_all = ["compare", "scenario"])]
+        random: Option<u64>,
         /// The agents: the simulated vehicle (simulated time), the scripted
         /// Fig. 5 demo, or none here (real time).
         #[arg(long, value_enum, default_value_t = cmd::distributed::Stack::Sim)]
@@ -246,6 +253,8 @@ fn main() -> ExitCode {
             seed,
             until,
             compare,
+            script,
+            random,
             stack,
             transport,
             deploy,
@@ -253,7 +262,10 @@ fn main() -> ExitCode {
             only,
             duration,
         } => {
-            if stack == cmd::distributed::Stack::Sim && transport == cmd::distributed::Transport::Inproc {
+            let local = stack == cmd::distributed::Stack::Sim && transport == cmd::distributed::Transport::Inproc;
+            if local && (script.is_some() || random.is_some()) {
+                cmd::scripted::run(cmd::scripted::Args { file, script, random, until, out, record })
+            } else if local {
                 cmd::run::run(cmd::run::Args { file, scenario, record, out, seed, until, compare })
             } else {
                 cmd::distributed::run(cmd::distributed::Args {

@@ -59,6 +59,11 @@ codes! {
     FSM_INITIAL = "E0115", Error, "not exactly one initial FSM state";
     SELF_LINK = "E0116", Error, "agent links to itself";
     TEST_TIME_ORDER = "E0117", Error, "test event earlier than the previous one";
+    FOREIGN_SCRIPT_EVENT = "E0118", Error, "script event named with another agent";
+    SCRIPT_TIME_ORDER = "E0119", Error, "script step that starts before the previous one";
+    OVERLAPPING_EVERY = "E0120", Error, "periodic script events that overlap";
+    BAD_INTERVAL = "E0121", Error, "script interval that is empty or too dense";
+    EVENT_IN_SILENCE = "E0122", Error, "script event of an agent told to be silent";
     TYPE_MISMATCH = "E0201", Error, "type mismatch";
     UNKNOWN_SYMBOL = "E0202", Error, "unknown symbol";
     BAD_OPERATOR = "E0203", Error, "operator does not apply to this type";

@@ -82,6 +82,13 @@ pub fn check(root: &Path, loader: &dyn Loader) -> Result<Checked, RootError> {
     Ok(check_loaded(loaded))
 }
 
+/// Checks `root` with more files read after it (`situ run --script FILE`):
+/// their items see the root's declarations.
+pub fn check_with(root: &Path, extra: &[&Path], loader: &dyn Loader) -> Result<Checked, RootError> {
+    let loaded = load::load_with(root, extra, loader)?;
+    Ok(check_loaded(loaded))
+}
+
 /// Checks a source given as text; includes are not available.
 pub fn check_source(name: &str, text: &str) -> Checked {
     check_loaded(load::load_text(name, text, &loader::MemLoader::new()))
@@ -100,7 +107,7 @@ const NAME_CODES: &[&str] = &[
 ];
 
 fn check_loaded(loaded: load::Loaded) -> Checked {
-    let load::Loaded { sources, files, mut diagnostics } = loaded;
+    let load::Loaded { sources, files, mut diagnostics, .. } = loaded;
     let syntax_failed = !diagnostics.is_empty();
     let (model, found) = resolve::resolve(&files);
     diagnostics.extend(found.into_iter().filter(|d| !(syntax_failed && NAME_CODES.contains(&d.code))));

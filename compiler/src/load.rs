@@ -16,6 +16,8 @@ pub struct Loaded {
     /// that items are in declaration order: an include stands for its items.
     pub files: Vec<(FileId, File)>,
     pub diagnostics: Vec<Diagnostic>,
+    /// The identities of the files read (canonical paths), in reading order.
+    pub sources_identities: Vec<PathBuf>,
 }
 
 /// The root file could not be read at all (a usage or I/O error, not a finding).
@@ -42,6 +44,26 @@ pub fn load(root: &Path, loader: &dyn Loader) -> Result<Loaded, RootError> {
     Ok(state.loaded)
 }
 
+/// Loads `root` and its includes, then each of `extra` (a file of scripts or
+/// tests written beside the rules, say) with its includes; a file is read
+/// once, whoever includes it. The extra files see the root's declarations as
+/// if the root included them at its end.
+pub fn load_with(root: &Path, extra: &[&Path], loader: &dyn Loader) -> Result<Loaded, RootError> {
+    let mut loaded = load(root, loader)?;
+    for path in extra {
+        let bytes = loader.read(path).map_err(|error| RootError { path: path.to_path_buf(), error })?;
+        let identity = loader.identity(path).unwrap_or_else(|_| path.to_path_buf());
+        let seen: Vec<PathBuf> = loaded.sources_identities.clone();
+        if seen.contains(&identity) {
+            continue;
+        }
+        let mut state = LoadState { loader, loaded, seen, stack: Vec::new() };
+        state.visit(path, identity, bytes);
+        loaded = state.loaded;
+    }
+    Ok(loaded)
+}
+
 /// Loads a source given as text (no includes are possible unless `loader` serves them).
 pub fn load_text(name: &str, text: &str, loader: &dyn Loader) -> Loaded {
     let mut state = LoadState { loader, loaded: Loaded::default(), seen: Vec::new(), stack: Vec::new() };
@@ -62,6 +84,7 @@ struct LoadState<'a> {
 impl LoadState<'_> {
     fn visit(&mut self, path: &Path, identity: PathBuf, bytes: Vec<u8>) -> FileId {
         self.seen.push(identity.clone());
+        self.loaded.sources_identities.push(identity.clone());
         let name = path.display().to_string();
         let text = match String::from_utf8(bytes) {
             Ok(text) => text,

@@ -51,6 +51,8 @@ pub struct Model {
     pub rules: Vec<Rule>,
     pub tests: Vec<Test>,
     pub properties: Vec<Property>,
+    /// `script` blocks, for `situ run --script`.
+    pub scripts: Vec<Script>,
 }
 
 impl Model {
@@ -473,4 +475,36 @@ pub enum Pred {
         pattern: Pattern,
         variables: Vec<Variable>,
     },
+}
+
+/// A `script` block: a timeline of events (`situ run --script`).
+#[derive(Debug, Clone, Serialize)]
+pub struct Script {
+    pub name: String,
+    /// In the order written, which is the order of their start times.
+    pub steps: Vec<ScriptStep>,
+    pub origin: Origin,
+    /// When the last step ends (nanoseconds).
+    pub end: u64,
+}
+
+/// One step of a script; times in nanoseconds from the start of the run.
+#[derive(Debug, Clone, Serialize)]
+pub enum ScriptStep {
+    /// One event at `time`.
+    At { time: u64, event: ScriptEvent, origin: Origin },
+    /// The event at `from`, `from + period`, … while before `to`.
+    Every { period: u64, from: u64, to: u64, event: ScriptEvent, origin: Origin },
+    /// The agent reports nothing in `[from, to)`.
+    Silent { agent: AgentId, from: u64, to: u64, origin: Origin },
+    /// The guided generator drives every agent in `[from, from + length)`.
+    Random { from: u64, length: u64, seed: u64, origin: Origin },
+}
+
+/// A concrete event of a script: every field given.
+#[derive(Debug, Clone, Serialize)]
+pub struct ScriptEvent {
+    pub event: EventId,
+    pub payload: Vec<Value>,
+    pub origin: Origin,
 }

@@ -299,3 +299,74 @@ fn pred(p: &model::Pred) -> Pred {
         }
     }
 }
+
+/// A `script` block in the runtime's terms (`situ run --script`).
+#[derive(Debug, Clone, Serialize)]
+pub struct ScriptSpec {
+    pub name: String,
+    pub place: Place,
+    pub steps: Vec<ScriptStep>,
+    /// When the last step ends (ns from the start of the run).
+    pub end: u64,
+}
+
+/// One step of a script; times in nanoseconds from the start of the run.
+#[derive(Debug, Clone, Serialize)]
+pub enum ScriptStep {
+    /// One event at `time`.
+    At { time: u64, event: ScriptEvent },
+    /// The event at `from`, `from + period`, … while before `to`.
+    Every { period: u64, from: u64, to: u64, event: ScriptEvent },
+    /// The agent reports nothing in `[from, to)`.
+    Silent { agent: u32, from: u64, to: u64, place: Place },
+    /// The guided generator drives every agent in `[from, from + length)`.
+    Random { from: u64, length: u64, seed: u64, place: Place },
+}
+
+/// A concrete event of a script.
+#[derive(Debug, Clone, Serialize)]
+pub struct ScriptEvent {
+    pub event: u32,
+    pub payload: Vec<Value>,
+    pub place: Place,
+}
+
+/// The scripts of a program without errors.
+pub fn scripts(checked: &Checked) -> Vec<ScriptSpec> {
+    let place = |o: model::Origin| {
+        let file = checked.sources.get(o.file);
+        let (line, column) = file.line_col(o.span.start);
+        Place { file: file.name.clone(), line: line as u32, column: column as u32 }
+    };
+    let event = |e: &model::ScriptEvent| ScriptEvent {
+        event: e.event.0,
+        payload: e.payload.iter().map(|v| rete::value(*v)).collect(),
+        place: place(e.origin),
+    };
+    checked
+        .model
+        .scripts
+        .iter()
+        .map(|s| ScriptSpec {
+            name: s.name.clone(),
+            place: place(s.origin),
+            end: s.end,
+            steps: s
+                .steps
+                .iter()
+                .map(|step| match step {
+                    model::ScriptStep::At { time, event: e, .. } => ScriptStep::At { time: *time, event: event(e) },
+                    model::ScriptStep::Every { period, from, to, event: e, .. } => {
+                        ScriptStep::Every { period: *period, from: *from, to: *to, event: event(e) }
+                    }
+                    model::ScriptStep::Silent { agent, from, to, origin } => {
+                        ScriptStep::Silent { agent: agent.0, from: *from, to: *to, place: place(*origin) }
+                    }
+                    model::ScriptStep::Random { from, length, seed, origin } => {
+                        ScriptStep::Random { from: *from, length: *length, seed: *seed, place: place(*origin) }
+                    }
+                })
+                .collect(),
+        })
+        .collect()
+}

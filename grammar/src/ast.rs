@@ -62,6 +62,7 @@ pub enum Item {
     Rule(Rule),
     Test(Test),
     Property(Property),
+    Script(Script),
 }
 
 impl Item {
@@ -73,6 +74,7 @@ impl Item {
             Item::Rule(i) => i.span,
             Item::Test(i) => i.span,
             Item::Property(i) => i.span,
+            Item::Script(i) => i.span,
         }
     }
 }
@@ -635,4 +637,46 @@ impl Predicate {
             Predicate::Event(p) => p.span,
         }
     }
+}
+
+/// `script "name" { ... }`: a timeline of events for `situ run --script`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Script {
+    pub name: StrLit,
+    pub steps: Vec<ScriptStep>,
+    pub span: Span,
+}
+
+/// One step of a script.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub enum ScriptStep {
+    /// `at 2.5s Bumper.BPHIT(side: left)`.
+    At { time: Duration, event: ScriptEvent, span: Span },
+    /// `every 100ms GPS.GPFIX(error: 0.3) from 0s to 60s`.
+    Every { period: Duration, event: ScriptEvent, from: Duration, to: Duration, span: Span },
+    /// `silent Rain from 10s to 12s`.
+    Silent { agent: Ident, from: Duration, to: Duration, span: Span },
+    /// `random 30s seed 7 [from 40s]`.
+    Random { length: Duration, seed: u64, seed_span: Span, from: Option<Duration>, span: Span },
+}
+
+impl ScriptStep {
+    pub fn span(&self) -> Span {
+        match self {
+            ScriptStep::At { span, .. }
+            | ScriptStep::Every { span, .. }
+            | ScriptStep::Silent { span, .. }
+            | ScriptStep::Random { span, .. } => *span,
+        }
+    }
+}
+
+/// `Bumper.BPHIT(side: left)`: an event of a script, every field given.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ScriptEvent {
+    /// The agent, when written (`Bumper.`).
+    pub agent: Option<Ident>,
+    pub event: Ident,
+    pub arguments: Vec<Argument>,
+    pub span: Span,
 }

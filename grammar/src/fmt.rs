@@ -257,6 +257,16 @@ impl Layout<'_> {
                     self.close(0, t.span);
                 }
             }
+            Item::Script(t) => {
+                let header = format!("script {}", string(&t.name.value));
+                if let Some(inner) = self.open(0, header, t.span, t.name.span.end, blank, t.steps.is_empty()) {
+                    for step in &t.steps {
+                        let text = crate::script::step_text(step, duration, literal);
+                        self.push(inner, text, self.tight(step.span()), Blank::Keep);
+                    }
+                    self.close(0, t.span);
+                }
+            }
             Item::Property(p) => {
                 let header = format!("property {}", string(&p.name.value));
                 self.open(0, header, p.span, p.name.span.end, blank, false);

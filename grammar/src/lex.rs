@@ -5,7 +5,7 @@
 use crate::ast::Span;
 
 /// The words that start a top-level item.
-const ITEM_KEYWORDS: [&str; 6] = ["states", "agent", "rule", "test", "property", "include"];
+const ITEM_KEYWORDS: [&str; 7] = ["states", "agent", "rule", "test", "property", "script", "include"];
 
 /// A `//` comment: its text without the slashes, and where it is.
 #[derive(Debug, Clone, PartialEq, Eq)]

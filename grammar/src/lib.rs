@@ -16,6 +16,7 @@ pub mod diag;
 pub mod fmt;
 pub mod lex;
 pub mod parse;
+mod script;
 
 pub use fmt::format;
 pub use parse::{parse, Parsed};

@@ -263,6 +263,11 @@ fn describe(r: Rule) -> Option<&'static str> {
         Rule::rule => "`rule`",
         Rule::test => "`test`",
         Rule::property => "`property`",
+        Rule::script => "`script`",
+        Rule::script_at | Rule::script_every | Rule::script_silent | Rule::script_random => {
+            "a script step (`at`, `every`, `silent`, `random`)"
+        }
+        Rule::script_event => "an event (`Agent.EVENT(field: value)`)",
         Rule::attribute => "an attribute (`#[allow(...)]`)",
         Rule::state_decl => "a state",
         Rule::state_flag => "`initial` or `final`",
@@ -302,25 +307,25 @@ fn describe(r: Rule) -> Option<&'static str> {
 }
 
 /// Builds AST nodes from pest pairs of one item, shifting spans by `offset`.
-struct Builder<'e> {
+pub(crate) struct Builder<'e> {
     offset: usize,
     file: FileId,
     errors: &'e mut Vec<Diagnostic>,
 }
 
-type P<'i> = Pair<'i, Rule>;
+pub(crate) type P<'i> = Pair<'i, Rule>;
 
 impl Builder<'_> {
-    fn span(&self, pair: &P) -> Span {
+    pub(crate) fn span(&self, pair: &P) -> Span {
         let s = pair.as_span();
         Span::new(self.offset + s.start(), self.offset + s.end())
     }
 
-    fn ident(&self, pair: P) -> Ident {
+    pub(crate) fn ident(&self, pair: P) -> Ident {
         Ident { name: pair.as_str().to_string(), span: self.span(&pair) }
     }
 
-    fn string(&self, pair: P) -> StrLit {
+    pub(crate) fn string(&self, pair: P) -> StrLit {
         let span = self.span(&pair);
         let inner = pair.into_inner().next().map(|p| p.as_str()).unwrap_or("");
         let mut value = String::with_capacity(inner.len());
@@ -361,7 +366,7 @@ impl Builder<'_> {
         }
     }
 
-    fn uint(&mut self, pair: P) -> Option<u64> {
+    pub(crate) fn uint(&mut self, pair: P) -> Option<u64> {
         let span = self.span(&pair);
         match pair.as_str().parse() {
             Ok(v) => Some(v),
@@ -383,7 +388,7 @@ impl Builder<'_> {
         }
     }
 
-    fn duration(&mut self, pair: P) -> Option<Duration> {
+    pub(crate) fn duration(&mut self, pair: P) -> Option<Duration> {
         let span = self.span(&pair);
         let mut inner = pair.into_inner();
         let value = inner.next()?.as_str();
@@ -417,6 +422,7 @@ impl Builder<'_> {
             Rule::rule => Item::Rule(self.rule(pair)?),
             Rule::test => Item::Test(self.test(pair)?),
             Rule::property => Item::Property(self.property(pair)?),
+            Rule::script => Item::Script(self.script(pair)?),
             _ => return None,
         })
     }
@@ -784,7 +790,7 @@ impl Builder<'_> {
         Some(Operand::Literal(self.literal(inner)?))
     }
 
-    fn literal(&mut self, pair: P) -> Option<Literal> {
+    pub(crate) fn literal(&mut self, pair: P) -> Option<Literal> {
         let span = self.span(&pair);
         let inner = pair.into_inner().next()?;
         let value = match inner.as_rule() {

@@ -123,6 +123,7 @@ pub struct Context<'a> {
     pub(crate) safe: bool,
     pub(crate) function: Option<&'a str>,
     pub(crate) inputs: &'a [Datum],
+    pub(crate) receivers: &'a [u32],
     pub(crate) outputs: &'a mut Vec<Outgoing>,
     pub(crate) reports: &'a mut Vec<Report>,
 }
@@ -158,6 +159,12 @@ impl<'a> Context<'a> {
     /// the order it arrived (urgent data first).
     pub fn inputs(&self) -> &'a [Datum] {
         self.inputs
+    }
+
+    /// The agents a datum sent now reaches: the links of the moment out of
+    /// this agent (empty when it waits: its outputs are dropped).
+    pub fn receivers(&self) -> &'a [u32] {
+        self.receivers
     }
 
     /// The name of an agent (of a datum's sender, say).

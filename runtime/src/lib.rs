@@ -23,6 +23,7 @@ pub mod record;
 pub mod replay;
 pub mod rete;
 pub mod sched;
+pub mod script;
 pub mod stack;
 pub mod stream;
 pub mod summary;

@@ -180,6 +180,16 @@ impl SimRuntime {
         }
     }
 
+    /// Queues a step of the agent at `time` (not before now), once, whatever
+    /// its rate: an agent with something to report steps when it happens
+    /// (a scripted event, say), not at its next period.
+    pub fn wake_at(&mut self, a: u32, time: u64) {
+        if (a as usize) < self.agents.len() && self.agents[a as usize].is_some() && !self.pending[a as usize] {
+            self.pending[a as usize] = true;
+            self.push(time.max(self.now), Task::Wake(a));
+        }
+    }
+
     /// Steps an agent without a rate at `time`, once.
     fn wake(&mut self, a: u32, time: u64) {
         if self.period[a as usize].is_none() {

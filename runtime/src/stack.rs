@@ -170,8 +170,14 @@ impl AgentRunner {
         self.reports.clear();
         let def = &content.agents[self.id as usize];
         let function_name = function.and_then(|f| def.functions.get(f as usize)).map(|f| f.name.as_str());
+        if mode == Mode::Running {
+            shared.receivers_into(&shared.org(), self.id, &mut self.receivers);
+        } else {
+            self.receivers.clear();
+        }
         {
             let mut cx = Context {
+                receivers: &self.receivers,
                 content,
                 agent: self.id,
                 now,

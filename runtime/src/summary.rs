@@ -125,14 +125,16 @@ impl Summary {
         let mut s = String::new();
         let _ = writeln!(s, "{:.1} s, final state {}", self.duration_s, self.final_state);
         let _ = writeln!(s, "path: {}", self.path.join(" → "));
-        let _ = writeln!(s, "\n  state   time (s)  entered  agent steps");
+        let w = self.states.iter().map(|f| f.state.chars().count()).max().unwrap_or(0).max(6);
+        let _ = writeln!(s, "\n  {:<w$} {:>9}  entered  agent steps", "state", "time (s)");
         for f in self.states.iter().filter(|f| f.entered > 0) {
-            let _ = writeln!(s, "  {:<6} {:>9.1}  {:>7}  {:>11}", f.state, f.seconds, f.entered, f.agent_steps);
+            let _ = writeln!(s, "  {:<w$} {:>9.1}  {:>7}  {:>11}", f.state, f.seconds, f.entered, f.agent_steps);
         }
         if !self.rules_fired.is_empty() {
-            let _ = writeln!(s, "\n  rule                           fired");
+            let w = self.rules_fired.keys().map(|r| r.chars().count()).max().unwrap_or(0).max(30);
+            let _ = writeln!(s, "\n  {:<w$} fired", "rule");
             for (r, n) in &self.rules_fired {
-                let _ = writeln!(s, "  {r:<30} {n:>5}");
+                let _ = writeln!(s, "  {r:<w$} {n:>5}");
             }
         }
         let (mut out, mut suppressed, mut undelivered, mut stale) = (0, 0, 0, 0);

@@ -11,6 +11,7 @@ pub mod graph;
 pub mod program;
 pub mod replay;
 pub mod run;
+pub mod scripted;
 pub mod test;
 
 use std::io::IsTerminal;

@@ -63,6 +63,11 @@ pub fn run(args: Args) -> u8 {
     let content = program.content;
     let kind = match StackKind::of(&content) {
         Ok(k) => k,
+        Err(_) if args.scenario.is_none() && args.compare.is_none() => {
+            // Any other robot: its first script, every agent a stand-in.
+            let Args { file, until, out, record, .. } = args;
+            return super::scripted::run(super::scripted::Args { file, script: None, random: None, until, out, record });
+        }
         Err(e) => {
             eprintln!("error: `{}`: {e}", args.file.display());
             return USAGE;

@@ -99,6 +99,12 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
     Sha256::digest(bytes).iter().map(|b| format!("{b:02x}")).collect()
 }
 
+/// The hash that names a program: the `sha256` of its JSON bundle (the same
+/// content encoded in binary has another hash of its own bytes).
+pub fn content_sha256(content: &Content) -> String {
+    sha256_hex(serde_json::to_string_pretty(content).expect("bundle content serializes").as_bytes())
+}
+
 /// The file bytes of a bundle.
 pub fn encode(content: &Content, encoding: Encoding) -> Vec<u8> {
     match encoding {

@@ -15,6 +15,7 @@ mod behaviour;
 mod declare;
 mod rules;
 mod scenarios;
+mod script;
 mod types;
 
 use crate::codes;
@@ -35,6 +36,7 @@ pub fn resolve(files: &[(FileId, ast::File)]) -> (Model, Vec<Diagnostic>) {
             ast::Item::Rule(rule) => rules::rule(&mut cx, file, rule),
             ast::Item::Test(test) => scenarios::test(&mut cx, file, test),
             ast::Item::Property(prop) => scenarios::property(&mut cx, file, prop),
+            ast::Item::Script(s) => script::script(&mut cx, file, s),
             ast::Item::Include(_) | ast::Item::States(_) => {}
         }
     }
@@ -57,6 +59,7 @@ struct Cx {
     rule_names: HashMap<String, Origin>,
     test_names: HashMap<String, Origin>,
     property_names: HashMap<String, Origin>,
+    script_names: HashMap<String, Origin>,
 }
 
 impl Cx {

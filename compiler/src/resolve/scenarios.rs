@@ -101,7 +101,7 @@ fn time_order(
 }
 
 /// A concrete event: every field given once, each of the right type.
-fn event_fact(cx: &mut Cx, file: FileId, e: &ast::EventInstance) -> Option<EventFact> {
+pub(super) fn event_fact(cx: &mut Cx, file: FileId, e: &ast::EventInstance) -> Option<EventFact> {
     let event = cx.event(file, &e.event)?;
     let fields = cx.model.event(event).fields.clone();
     let mut payload: Vec<Option<Value>> = vec![None; fields.len()];

@@ -76,6 +76,10 @@ pub struct McapRecorder {
     /// Channels added with [`McapRecorder::add_channel`]: id → topic.
     extra: BTreeMap<u16, String>,
     last_flush: Instant,
+    /// Flush by the messages' own time instead of the wall clock: the time
+    /// of the last flush (simulated runs whose files must be the same bytes
+    /// every time).
+    by_message_time: Option<u64>,
     error: Option<io::Error>,
 }
 
@@ -158,8 +162,16 @@ impl McapRecorder {
             counts: Counts::new(),
             extra: BTreeMap::new(),
             last_flush: Instant::now(),
+            by_message_time: None,
             error: None,
         })
+    }
+
+    /// Closes chunks every second of the messages' time rather than of the
+    /// wall clock, so that one simulated run always writes the same bytes.
+    pub fn flush_by_message_time(mut self) -> McapRecorder {
+        self.by_message_time = Some(0);
+        self
     }
 
     /// Messages written per topic so far.
@@ -202,8 +214,18 @@ impl McapRecorder {
                 self.counts.insert(topic.to_string(), 1);
             }
         }
-        if self.last_flush.elapsed() >= FLUSH_EVERY {
-            let _ = self.flush();
+        match self.by_message_time {
+            Some(last) => {
+                if time.saturating_sub(last) >= FLUSH_EVERY.as_nanos() as u64 {
+                    let _ = self.flush();
+                    self.by_message_time = Some(time);
+                }
+            }
+            None => {
+                if self.last_flush.elapsed() >= FLUSH_EVERY {
+                    let _ = self.flush();
+                }
+            }
         }
     }
 

@@ -301,13 +301,14 @@ impl RunReport {
         let _ =
             writeln!(out, "  steering rate     max {:.3} rad/s, RMS {:.3} rad/s", s.max_steer_rate, s.rms_steer_rate);
         let _ = writeln!(out, "  speed             top {:.2} m/s, mean {:.2} m/s", s.max_speed, s.mean_speed);
-        let _ = writeln!(out, "\n  state   time (s)  mean v (m/s)  top v (m/s)  running");
+        let w = self.runtime.states.iter().map(|st| st.state.chars().count()).max().unwrap_or(0).max(6);
+        let _ = writeln!(out, "\n  {:<w$} {:>9}  mean v (m/s)  top v (m/s)  running", "state", "time (s)");
         for st in &self.runtime.states {
             let Some(f) = self.per_state.get(&st.state) else { continue };
             let running = self.metrics.architecture.agents_running.get(&st.state).map_or(0, Vec::len);
             let _ = writeln!(
                 out,
-                "  {:<6} {:>9.1}  {:>12.2}  {:>11.2}  {:>7}",
+                "  {:<w$} {:>9.1}  {:>12.2}  {:>11.2}  {:>7}",
                 st.state, f.seconds, f.mean_speed, f.max_speed, running
             );
         }

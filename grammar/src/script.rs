@@ -1,0 +1,118 @@
+//! The AST of `script` items (`situ run --script`), built from pest pairs
+//! like the rest of an item (see `parse.rs`).
+
+use crate::ast::*;
+use crate::parse::{Builder, Rule, P};
+
+impl Builder<'_> {
+    /// `script "name" { step* }`.
+    pub(crate) fn script(&mut self, pair: P) -> Option<Script> {
+        let span = self.span(&pair);
+        let mut inner = pair.into_inner();
+        let name = self.string(inner.next()?);
+        let mut steps = Vec::new();
+        for step in inner {
+            steps.extend(self.script_step(step));
+        }
+        Some(Script { name, steps, span })
+    }
+
+    fn script_step(&mut self, pair: P) -> Option<ScriptStep> {
+        let span = self.span(&pair);
+        let kind = pair.as_rule();
+        let mut inner = pair.into_inner();
+        Some(match kind {
+            Rule::script_at => {
+                let time = self.duration(inner.next()?)?;
+                let event = self.script_event(inner.next()?)?;
+                ScriptStep::At { time, event, span }
+            }
+            Rule::script_every => {
+                let period = self.duration(inner.next()?)?;
+                let event = self.script_event(inner.next()?)?;
+                let from = self.duration(inner.next()?)?;
+                let to = self.duration(inner.next()?)?;
+                ScriptStep::Every { period, event, from, to, span }
+            }
+            Rule::script_silent => {
+                let agent = self.ident(inner.next()?);
+                let from = self.duration(inner.next()?)?;
+                let to = self.duration(inner.next()?)?;
+                ScriptStep::Silent { agent, from, to, span }
+            }
+            Rule::script_random => {
+                let length = self.duration(inner.next()?)?;
+                let seed_pair = inner.next()?;
+                let seed_span = self.span(&seed_pair);
+                let seed = self.uint(seed_pair)?;
+                let from = match inner.next() {
+                    Some(p) => Some(self.duration(p)?),
+                    None => None,
+                };
+                ScriptStep::Random { length, seed, seed_span, from, span }
+            }
+            _ => return None,
+        })
+    }
+
+    fn script_event(&mut self, pair: P) -> Option<ScriptEvent> {
+        let span = self.span(&pair);
+        let mut agent = None;
+        let mut event = None;
+        let mut arguments = Vec::new();
+        for p in pair.into_inner() {
+            match p.as_rule() {
+                Rule::script_agent => agent = Some(self.ident(p.into_inner().next()?)),
+                Rule::ident => event = Some(self.ident(p)),
+                Rule::arguments => {
+                    for a in p.into_inner() {
+                        let aspan = self.span(&a);
+                        let mut ai = a.into_inner();
+                        let field = self.ident(ai.next()?);
+                        let Some(value) = self.literal(ai.next()?) else { continue };
+                        arguments.push(Argument { field, value, span: aspan });
+                    }
+                }
+                _ => {}
+            }
+        }
+        Some(ScriptEvent { agent, event: event?, arguments, span })
+    }
+}
+
+/// A script step as the formatter writes it, on one line, given how the
+/// formatter writes durations and literals.
+pub(crate) fn step_text(step: &ScriptStep, duration: fn(u64) -> String, literal: fn(&Literal) -> String) -> String {
+    let event = |e: &ScriptEvent| {
+        let mut text = match &e.agent {
+            Some(a) => format!("{}.{}", a.name, e.event.name),
+            None => e.event.name.clone(),
+        };
+        if !e.arguments.is_empty() {
+            let args: Vec<String> =
+                e.arguments.iter().map(|a| format!("{}: {}", a.field.name, literal(&a.value))).collect();
+            text = format!("{text}({})", args.join(", "));
+        }
+        text
+    };
+    match step {
+        ScriptStep::At { time, event: e, .. } => format!("at {} {}", duration(time.nanos), event(e)),
+        ScriptStep::Every { period, event: e, from, to, .. } => format!(
+            "every {} {} from {} to {}",
+            duration(period.nanos),
+            event(e),
+            duration(from.nanos),
+            duration(to.nanos)
+        ),
+        ScriptStep::Silent { agent, from, to, .. } => {
+            format!("silent {} from {} to {}", agent.name, duration(from.nanos), duration(to.nanos))
+        }
+        ScriptStep::Random { length, seed, from, .. } => {
+            let mut text = format!("random {} seed {seed}", duration(length.nanos));
+            if let Some(f) = from {
+                text = format!("{text} from {}", duration(f.nanos));
+            }
+            text
+        }
+    }
+}

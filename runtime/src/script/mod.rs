@@ -1,0 +1,240 @@
+//! Scripted runs of any rules file (`situ run FILE --script S`, `--random N`):
+//! the compiled bundle on the real runtime (the Bulletinboard, the
+//! simulated-time scheduler at the rules' rates, the in-process bus, the
+//! wiring of the moment), every agent played by a [`StandIn`] that follows
+//! its table or FSM exactly and reports the events the script gives it, at
+//! the times the script says.
+//!
+//! - [`timeline`]: the script's events in time order, made lazily (one
+//!   event, periodic events, silences, seeded random sections that use the
+//!   guided generator of [`crate::stream`]);
+//! - [`standin`]: the agent that plays any agent of the rules;
+//! - [`report`]: each agent's modes over time, its time running, waiting
+//!   and sleeping and in each function; `metrics.json`;
+//! - [`chart`]: `timeline.svg`, a band for the state and one per agent.
+//!
+//! The driver posts an event by queueing it in its agent's inbox and
+//! stepping that agent at the event's time, so the event is reported by the
+//! agent's own running cycle (a sleeping agent reports nothing; a waiting
+//! one still does). Nothing reads a clock: one script and seed give the
+//! same report to the byte.
+
+pub mod chart;
+pub mod report;
+pub mod standin;
+pub mod timeline;
+
+use crate::agent::{self, Agent};
+use crate::record::{Sink, Tee};
+use crate::sched::{SimConfig, SimRuntime};
+use report::{agent_times, ScriptReport, Track};
+use situ_compiler::bundle::Content;
+use situ_compiler::spec::ScriptSpec;
+use standin::{Inbox, StandIn};
+use std::sync::Arc;
+use timeline::{Due, Timeline};
+
+/// How long a `--random` run lasts when not told (ns).
+pub const DEFAULT_RANDOM_NS: u64 = 60_000_000_000;
+
+/// What drives the agents.
+#[derive(Debug, Clone)]
+pub enum Driver {
+    /// A `script` block of the rules.
+    Script(ScriptSpec),
+    /// The guided generator, for the whole run.
+    Random { seed: u64 },
+}
+
+impl Driver {
+    /// How the report names it.
+    pub fn describe(&self) -> String {
+        match self {
+            Driver::Script(s) => format!("script \"{}\" ({})", s.name, s.place),
+            Driver::Random { seed } => format!("random seed {seed}"),
+        }
+    }
+}
+
+/// What the live line shows.
+#[derive(Debug, Clone)]
+pub struct Progress {
+    pub now: u64,
+    pub end: u64,
+    pub state: String,
+    pub changes: u64,
+    pub events: u64,
+}
+
+impl Progress {
+    pub fn line(&self) -> String {
+        let pct = if self.end > 0 { self.now as f64 / self.end as f64 * 100.0 } else { 100.0 };
+        format!(
+            "{:>8.1} s / {:.1} s ({pct:>3.0}%)  state {}  events {}  changes {}",
+            self.now as f64 * 1e-9,
+            self.end as f64 * 1e-9,
+            self.state,
+            self.events,
+            self.changes
+        )
+    }
+}
+
+/// A scripted run in progress.
+pub struct ScriptRun {
+    content: Arc<Content>,
+    rt: SimRuntime,
+    inboxes: Vec<Inbox>,
+    timeline: Timeline,
+    next: Option<Due>,
+    end: u64,
+    track: Track,
+    driver: String,
+    changes: u64,
+}
+
+/// Simulated time between two calls of the progress callback (ns).
+const PROGRESS_EVERY: u64 = 1_000_000_000;
+
+impl ScriptRun {
+    /// A run of `driver` on the rules, to `until` (ns; default: the script's
+    /// end, or a minute of random events), with a recorder if given.
+    pub fn new(content: Arc<Content>, driver: Driver, until: Option<u64>, sink: Option<Box<dyn Sink>>) -> ScriptRun {
+        let n = content.agents.len();
+        let inboxes: Vec<Inbox> = (0..n).map(|_| Inbox::default()).collect();
+        let agents: Vec<Box<dyn Agent>> = (0..n as u32)
+            .map(|a| Box::new(StandIn::new(&content, a, inboxes[a as usize].clone())) as Box<dyn Agent>)
+            .collect();
+        let bound = agent::bind(&content, agents, true).expect("a stand-in offers every function of its agent");
+        let (timeline, end) = match &driver {
+            Driver::Script(s) => (Timeline::of_script(content.clone(), s), until.unwrap_or(s.end)),
+            Driver::Random { seed } => {
+                let end = until.unwrap_or(DEFAULT_RANDOM_NS);
+                (Timeline::random(content.clone(), end, *seed), end)
+            }
+        };
+        let track = Track::new(n);
+        let mut sinks: Vec<Box<dyn Sink>> = vec![Box::new(track.clone())];
+        sinks.extend(sink);
+        let rt = SimRuntime::new(content.clone(), bound, Some(Box::new(Tee(sinks))), SimConfig::default());
+        ScriptRun {
+            content,
+            rt,
+            inboxes,
+            timeline,
+            next: None,
+            end,
+            track,
+            driver: driver.describe(),
+            changes: 0,
+        }
+    }
+
+    /// When the run ends (ns), unless a final state comes first.
+    pub fn end(&self) -> u64 {
+        self.end
+    }
+
+    /// The state at rest now.
+    pub fn state(&self) -> &str {
+        &self.content.states[self.rt.state() as usize].name
+    }
+
+    pub fn progress(&self) -> Progress {
+        Progress {
+            now: self.rt.now(),
+            end: self.end,
+            state: self.state().to_string(),
+            changes: self.changes,
+            events: self.rt.board.counters.accepted,
+        }
+    }
+
+    /// Runs to the end (or a final state), calling `progress` about once a
+    /// simulated second.
+    pub fn run(&mut self, progress: &mut dyn FnMut(&ScriptRun)) {
+        let mut mark = 0u64;
+        while !self.rt.finished() && self.rt.now() < self.end {
+            mark = mark.saturating_add(PROGRESS_EVERY).min(self.end);
+            self.run_until(mark);
+            progress(self);
+        }
+        if !self.rt.finished() {
+            self.run_until(self.end);
+        }
+    }
+
+    /// Runs every task and scripted event up to `until` (ns, included).
+    pub fn run_until(&mut self, until: u64) {
+        let until = until.min(self.end);
+        let mut changes = 0u64;
+        let mut count = |_: &crate::rete::StateChange| changes += 1;
+        loop {
+            if self.next.is_none() {
+                self.next = self.timeline.next();
+            }
+            let Some(due) = self.next.take_if(|d| d.time <= until) else { break };
+            self.rt.run_until(due.time, &mut count);
+            if self.rt.finished() {
+                break;
+            }
+            self.inboxes[due.agent as usize].push(due.time, due.event, due.payload);
+            self.rt.wake_at(due.agent, due.time);
+        }
+        if !self.rt.finished() {
+            self.rt.run_until(until, &mut count);
+        }
+        self.changes += changes;
+    }
+
+    /// Ends the run (and the recording): the report.
+    pub fn finish(self) -> std::io::Result<ScriptReport> {
+        let now = self.rt.now();
+        let ended = if self.rt.finished() {
+            format!("final state {} at {:.3} s", self.state(), now as f64 * 1e-9)
+        } else {
+            format!("end of the run at {:.3} s", now as f64 * 1e-9)
+        };
+        self.rt.finish_recording()?;
+        let summary = self.rt.summary();
+        let tracked = self.track.snapshot();
+        let times = agent_times(&tracked, now);
+        let agent_times = self
+            .content
+            .agents
+            .iter()
+            .enumerate()
+            .zip(times)
+            .map(|((a, def), mut t)| {
+                t.scripted_events = self.inboxes[a].reported();
+                t.asleep_events = self.inboxes[a].asleep(now.saturating_add(1));
+                t.silenced_events = self.timeline.silenced[a];
+                (def.name.clone(), t)
+            })
+            .collect();
+        let timeline = tracked
+            .states
+            .iter()
+            .map(|&(t, s)| (t as f64 * 1e-9, self.content.states[s as usize].name.clone()))
+            .collect();
+        Ok(ScriptReport {
+            rules: self.content.source.clone(),
+            bundle_sha256: situ_compiler::bundle::codec::content_sha256(&self.content),
+            driver: self.driver.clone(),
+            ended,
+            problems: tracked.problems.iter().map(|(t, p)| format!("{:.3} s: {p}", *t as f64 * 1e-9)).collect(),
+            runtime: summary,
+            agent_times,
+            timeline,
+        })
+    }
+
+    /// What the chart needs: the tracked modes and states so far.
+    pub fn tracked(&self) -> report::Tracked {
+        self.track.snapshot()
+    }
+
+    pub fn now(&self) -> u64 {
+        self.rt.now()
+    }
+}

@@ -1,0 +1,245 @@
+//! `situ run FILE --script S | --random SEED [--until SECONDS] [--out DIR]
+//! [--record F.mcap]`: any rules file on the real runtime, every agent a
+//! stand-in that follows its table or FSM and reports what the script (or
+//! the guided generator) gives it. `S` is the name of a `script` block of
+//! FILE or its includes, or a `.situ` file of scripts read after FILE.
+//!
+//! Exit 0 when the run played to its end (or to a final state) with every
+//! event taken; 1 when the Bulletinboard refused an event or a cascade did
+//! not settle, or the rules have errors; 2 on usage and I/O.
+
+use super::{FAILED, OK, USAGE};
+use situ_compiler::bundle::{self, Content, Encoding};
+use situ_compiler::loader::FsLoader;
+use situ_compiler::spec::{self, ScriptSpec};
+use situ_runtime::record::mcap::McapRecorder;
+use situ_runtime::record::Sink;
+use situ_runtime::script::{chart, Driver, ScriptRun};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+pub struct Args {
+    pub file: PathBuf,
+    pub script: Option<String>,
+    pub random: Option<u64>,
+    pub until: Option<f64>,
+    pub out: Option<PathBuf>,
+    pub record: Option<PathBuf>,
+}
+
+/// How often the live line is redrawn (wall time).
+const REDRAW: Duration = Duration::from_millis(200);
+
+/// The rules and the scripts they can be run with.
+struct Loaded {
+    content: Arc<Content>,
+    scripts: Vec<ScriptSpec>,
+    /// Whether the rules came as a bundle (no scripts then).
+    bundle: bool,
+}
+
+fn load(file: &Path, script_file: Option<&Path>) -> Result<Loaded, u8> {
+    if !super::program::is_source(file) {
+        if script_file.is_some() {
+            eprintln!("error: a script file is read with the rules' source: run the `.situ` file, not a bundle");
+            return Err(USAGE);
+        }
+        let p = super::program::load(file, false)?;
+        return Ok(Loaded { content: p.content, scripts: Vec::new(), bundle: true });
+    }
+    let extra: Vec<&Path> = script_file.into_iter().collect();
+    let checked = situ_compiler::check_with(file, &extra, &FsLoader).map_err(|e| {
+        eprintln!("error: {e}");
+        USAGE
+    })?;
+    if checked.fails(false) {
+        print!("{}", situ_compiler::render::human_all(&checked, super::style()));
+        eprintln!(
+            "error: `{}` has {} error(s); fix them first (`situ check` explains each)",
+            script_file.unwrap_or(file).display(),
+            checked.errors()
+        );
+        return Err(FAILED);
+    }
+    let content = Arc::new(bundle::build(&checked));
+    Ok(Loaded { content, scripts: spec::scripts(&checked), bundle: false })
+}
+
+/// The script named `name`, or why not.
+fn pick(loaded: &Loaded, file: &Path, name: Option<&str>) -> Result<ScriptSpec, String> {
+    let names: Vec<String> = loaded.scripts.iter().map(|s| format!("\"{}\"", s.name)).collect();
+    match name {
+        None => loaded.scripts.first().cloned().ok_or_else(|| {
+            format!("`{}` has no `script` block: give `--script FILE` or `--random SEED`", file.display())
+        }),
+        Some(n) => loaded.scripts.iter().find(|s| s.name == n).cloned().ok_or_else(|| {
+            if loaded.bundle {
+                format!("a bundle carries no scripts: run `{}`'s source to use script \"{n}\"", file.display())
+            } else if names.is_empty() {
+                format!("no script \"{n}\": `{}` has no `script` block, and no file `{n}` exists", file.display())
+            } else {
+                format!("no script \"{n}\" (and no such file); the scripts are: {}", names.join(", "))
+            }
+        }),
+    }
+}
+
+pub fn run(args: Args) -> u8 {
+    let script_file = args.script.as_deref().map(Path::new).filter(|p| p.is_file());
+    let loaded = match load(&args.file, script_file) {
+        Ok(l) => l,
+        Err(code) => return code,
+    };
+    let driver = match (args.random, &args.script) {
+        (Some(seed), None) => Driver::Random { seed },
+        (Some(_), Some(_)) => {
+            eprintln!("error: --script and --random exclude each other (a script has `random` steps of its own)");
+            return USAGE;
+        }
+        (None, script) => {
+            // A script file's own scripts come after the rules' ones: the
+            // first of the file is meant.
+            let name = if script_file.is_some() { None } else { script.as_deref() };
+            let mut pool = Loaded { content: loaded.content.clone(), scripts: loaded.scripts.clone(), bundle: loaded.bundle };
+            if let Some(f) = script_file {
+                let theirs: Vec<ScriptSpec> =
+                    pool.scripts.iter().filter(|s| Path::new(&s.place.file) == f).cloned().collect();
+                if theirs.is_empty() {
+                    eprintln!("error: `{}` has no `script` block", f.display());
+                    return USAGE;
+                }
+                pool.scripts = theirs;
+            }
+            match pick(&pool, &args.file, name) {
+                Ok(s) => Driver::Script(s),
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    return USAGE;
+                }
+            }
+        }
+    };
+    let until = match args.until {
+        None => None,
+        Some(s) if s.is_finite() && s > 0.0 && s < 1e9 => Some((s * 1e9).round() as u64),
+        Some(s) => {
+            eprintln!("error: --until must be a positive number of seconds (below 1e9), not {s}");
+            return USAGE;
+        }
+    };
+    let content = loaded.content;
+    if let Some(out) = &args.out {
+        if let Err(e) = std::fs::create_dir_all(out) {
+            eprintln!("error: cannot create `{}`: {e}", out.display());
+            return USAGE;
+        }
+    }
+    // The recording is written beside its place and renamed when whole.
+    let record_to = args.record.clone().or_else(|| args.out.as_ref().map(|d| d.join("recording.mcap")));
+    let partial = record_to.as_ref().map(|p| {
+        let name = p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        p.with_file_name(format!(".{name}.situ-tmp.{}", std::process::id()))
+    });
+    let sink: Option<Box<dyn Sink>> = match &partial {
+        Some(path) => {
+            let bytes = bundle::encode(&content, Encoding::Json);
+            match McapRecorder::create(path, content.clone(), &bytes) {
+                Ok(m) => Some(Box::new(m.flush_by_message_time())),
+                Err(e) => {
+                    eprintln!("error: cannot write `{}`: {e}", path.display());
+                    return USAGE;
+                }
+            }
+        }
+        None => None,
+    };
+    let mut run = ScriptRun::new(content.clone(), driver.clone(), until, sink);
+    let live = std::io::stderr().is_terminal();
+    let mut last = Instant::now().checked_sub(REDRAW).unwrap_or_else(Instant::now);
+    let mut drawn = false;
+    run.run(&mut |r| {
+        if live && last.elapsed() >= REDRAW {
+            last = Instant::now();
+            drawn = true;
+            eprint!("\r{}\x1b[K", r.progress().line());
+        }
+    });
+    if drawn {
+        eprint!("\r\x1b[K");
+    }
+    let tracked = run.tracked();
+    let end = run.now();
+    let report = match run.finish() {
+        Ok(r) => r,
+        Err(e) => {
+            if let Some(p) = &partial {
+                let _ = std::fs::remove_file(p);
+            }
+            eprintln!("error: the recording failed: {e}");
+            return USAGE;
+        }
+    };
+    if let (Some(from), Some(to)) = (&partial, &record_to) {
+        if let Err(e) = std::fs::rename(from, to) {
+            eprintln!("error: cannot write `{}`: {e}", to.display());
+            return USAGE;
+        }
+    }
+    println!("{} on {} ({})\n", content.source, report.driver, report.ended);
+    print!("{}", report.runtime.table());
+    println!("\n{}", report.agents_table(&content));
+    if !report.problems.is_empty() {
+        println!("problems the Bulletinboard reported:");
+        for p in report.problems.iter().take(10) {
+            println!("  {p}");
+        }
+        if report.problems.len() > 10 {
+            println!("  … {} more in metrics.json", report.problems.len() - 10);
+        }
+    }
+    if let Some(out) = &args.out {
+        let title = format!("{} — {}", content.source, report.driver);
+        if let Err(e) = write_out(out, &content, &tracked, end, &title, &report) {
+            eprintln!("error: {e}");
+            return USAGE;
+        }
+        println!("wrote {}", out.display());
+    }
+    if let Some(path) = &args.record {
+        println!("recorded {}", path.display());
+    }
+    if report.clean() {
+        OK
+    } else {
+        FAILED
+    }
+}
+
+/// `timeline.svg`, `wiring-STATE.svg` of every state visited, `metrics.json`.
+fn write_out(
+    out: &Path,
+    content: &Content,
+    tracked: &situ_runtime::script::report::Tracked,
+    end: u64,
+    title: &str,
+    report: &situ_runtime::script::report::ScriptReport,
+) -> Result<(), String> {
+    let write = |name: &str, bytes: &[u8]| {
+        super::write_atomically(&out.join(name), bytes)
+            .map_err(|e| format!("cannot write `{}`: {e}", out.join(name).display()))
+    };
+    write("timeline.svg", chart::timeline_svg(content, tracked, end, title).as_bytes())?;
+    let mut visited = vec![content.initial];
+    visited.extend(tracked.states.iter().map(|&(_, s)| s));
+    visited.sort_unstable();
+    visited.dedup();
+    for s in visited {
+        let dot = situ_compiler::graph::wiring(content, Some(s));
+        let svg = super::graph::svg(&dot).map_err(|e| format!("cannot lay out the wiring of a state: {e}"))?;
+        write(&format!("wiring-{}.svg", content.states[s as usize].name), svg.as_bytes())?;
+    }
+    write("metrics.json", report.to_json().as_bytes())?;
+    Ok(())
+}
