@@ -19,6 +19,8 @@ impl Builder<'_> {
 
     fn script_step(&mut self, pair: P) -> Option<ScriptStep> {
         let span = self.span(&pair);
+        // Without the spaces and comments pest leaves at the end.
+        let span = Span::new(span.start, span.start + code_len(pair.as_str()));
         let kind = pair.as_rule();
         let mut inner = pair.into_inner();
         Some(match kind {
@@ -57,6 +59,7 @@ impl Builder<'_> {
 
     fn script_event(&mut self, pair: P) -> Option<ScriptEvent> {
         let span = self.span(&pair);
+        let span = Span::new(span.start, span.start + code_len(pair.as_str()));
         let mut agent = None;
         let mut event = None;
         let mut arguments = Vec::new();
@@ -80,9 +83,53 @@ impl Builder<'_> {
     }
 }
 
+/// The length of `text` up to the end of its last token: trailing spaces and
+/// `//` comments left out (strings kept whole).
+fn code_len(text: &str) -> usize {
+    let bytes = text.as_bytes();
+    let (mut i, mut end) = (0, 0);
+    while i < bytes.len() {
+        match bytes[i] {
+            b'/' if bytes.get(i + 1) == Some(&b'/') => {
+                while i < bytes.len() && bytes[i] != b'\n' {
+                    i += 1;
+                }
+            }
+            b'"' => {
+                i += 1;
+                while i < bytes.len() && bytes[i] != b'"' && bytes[i] != b'\n' {
+                    i += if bytes[i] == b'\\' { 2 } else { 1 };
+                }
+                i = (i + 1).min(bytes.len());
+                end = i;
+            }
+            c if c.is_ascii_whitespace() => i += 1,
+            _ => {
+                i += 1;
+                end = i;
+            }
+        }
+    }
+    end
+}
+
 /// A script step as the formatter writes it, on one line, given how the
 /// formatter writes durations and literals.
-pub(crate) fn step_text(step: &ScriptStep, duration: fn(u64) -> String, literal: fn(&Literal) -> String) -> String {
+pub(crate) fn step_text(step: &ScriptStep, short: fn(u64) -> String, literal: fn(&Literal) -> String) -> String {
+    // Times of a timeline read best in seconds (`90.5s`, `300s`), short
+    // ones in their own unit (`100ms`).
+    let duration = |nanos: u64| {
+        if nanos >= 1_000_000_000 && nanos % 1_000_000 == 0 {
+            let (whole, ms) = (nanos / 1_000_000_000, nanos / 1_000_000 % 1000);
+            if ms == 0 {
+                format!("{whole}s")
+            } else {
+                format!("{whole}.{}s", format!("{ms:03}").trim_end_matches('0'))
+            }
+        } else {
+            short(nanos)
+        }
+    };
     let event = |e: &ScriptEvent| {
         let mut text = match &e.agent {
             Some(a) => format!("{}.{}", a.name, e.event.name),
@@ -114,5 +161,15 @@ pub(crate) fn step_text(step: &ScriptStep, duration: fn(u64) -> String, literal:
             }
             text
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn code_ends_before_trailing_comments() {
+        assert_eq!(super::code_len("at 1s X   // note\n  "), 7);
+        assert_eq!(super::code_len("at 1s X(a: \"//\") "), 16);
+        assert_eq!(super::code_len("  "), 0);
     }
 }

@@ -26,11 +26,13 @@ pub(super) fn script(cx: &mut Cx, file: FileId, script: &ast::Script) {
     let mut cursor: Option<(u64, ast::Span)> = None;
     let mut total: u64 = 0;
     for step in &script.steps {
-        let Some(resolved) = self::step(cx, file, step, cursor.map_or(0, |c| c.0)) else {
-            ok = false;
-            continue;
+        let here = cursor.map_or(0, |c| c.0);
+        // The start is known from the text, even when the step has errors.
+        let start = match step {
+            ast::ScriptStep::At { time, .. } => time.nanos,
+            ast::ScriptStep::Every { from, .. } | ast::ScriptStep::Silent { from, .. } => from.nanos,
+            ast::ScriptStep::Random { from, .. } => from.map_or(here, |f| f.nanos),
         };
-        let start = start_of(&resolved);
         if let Some((previous, span)) = cursor {
             if start < previous {
                 time_order(cx, file, step.span(), start, previous, span);
@@ -38,6 +40,10 @@ pub(super) fn script(cx: &mut Cx, file: FileId, script: &ast::Script) {
             }
         }
         cursor = Some((start, step.span()));
+        let Some(resolved) = self::step(cx, file, step, here) else {
+            ok = false;
+            continue;
+        };
         total = total.saturating_add(count(&resolved));
         steps.push(resolved);
     }
@@ -143,7 +149,6 @@ fn interval(cx: &mut Cx, file: FileId, from: &ast::Duration, to: &ast::Duration)
     if to.nanos > from.nanos {
         return true;
     }
-    let show = |ns: u64| format!("{}ms", ns as f64 / 1e6);
     cx.diags.push(
         Diagnostic::error(
             codes::BAD_INTERVAL,
@@ -159,7 +164,6 @@ fn interval(cx: &mut Cx, file: FileId, from: &ast::Duration, to: &ast::Duration)
 
 /// E0119: a step that starts before the one written before it.
 fn time_order(cx: &mut Cx, file: FileId, span: ast::Span, start: u64, previous: u64, previous_span: ast::Span) {
-    let show = |ns: u64| format!("{}ms", ns as f64 / 1e6);
     cx.diags.push(
         Diagnostic::error(
             codes::SCRIPT_TIME_ORDER,
@@ -228,13 +232,6 @@ fn silences(cx: &mut Cx, steps: &[ScriptStep]) -> bool {
     ok
 }
 
-fn start_of(step: &ScriptStep) -> u64 {
-    match step {
-        ScriptStep::At { time, .. } => *time,
-        ScriptStep::Every { from, .. } | ScriptStep::Silent { from, .. } | ScriptStep::Random { from, .. } => *from,
-    }
-}
-
 fn end_of(step: &ScriptStep) -> u64 {
     match step {
         ScriptStep::At { time, .. } => *time,
@@ -249,5 +246,14 @@ fn count(step: &ScriptStep) -> u64 {
         ScriptStep::At { .. } => 1,
         ScriptStep::Every { period, from, to, .. } => (to - from).div_ceil(*period),
         ScriptStep::Silent { .. } | ScriptStep::Random { .. } => 0,
+    }
+}
+
+/// A time as a person writes it in a script: `60s`, `2.5s`, `100ms`.
+fn show(ns: u64) -> String {
+    if ns >= 1_000_000_000 {
+        format!("{}s", ns as f64 / 1e9)
+    } else {
+        format!("{}ms", ns as f64 / 1e6)
     }
 }

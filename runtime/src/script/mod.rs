@@ -174,12 +174,17 @@ impl ScriptRun {
                 self.next = self.timeline.next();
             }
             let Some(due) = self.next.take_if(|d| d.time <= until) else { break };
-            self.rt.run_until(due.time, &mut count);
+            // Queued first: a periodic step of the agent at that very time
+            // reports it; otherwise the agent is stepped for it.
+            let (agent, time) = (due.agent, due.time);
+            self.inboxes[agent as usize].push(time, due.event, due.payload);
+            self.rt.run_until(time, &mut count);
             if self.rt.finished() {
                 break;
             }
-            self.inboxes[due.agent as usize].push(due.time, due.event, due.payload);
-            self.rt.wake_at(due.agent, due.time);
+            if self.inboxes[agent as usize].due_by(time) {
+                self.rt.wake_at(agent, time);
+            }
         }
         if !self.rt.finished() {
             self.rt.run_until(until, &mut count);

@@ -30,6 +30,11 @@ impl Inbox {
         self.lock().due.push_back((time, event, payload));
     }
 
+    /// Whether an event due at or before `time` is still to be reported.
+    pub fn due_by(&self, time: u64) -> bool {
+        self.lock().due.front().is_some_and(|d| d.0 <= time)
+    }
+
     /// Events dropped because the agent slept when they were due; counts
     /// what is still queued before `now` too.
     pub fn asleep(&self, now: u64) -> u64 {
@@ -53,6 +58,10 @@ pub struct StandIn {
     functions: Vec<String>,
     inbox: Inbox,
     sent: u64,
+    /// When it last sent: at most one datum per instant, so that agents
+    /// without a rate that feed each other (a data cycle) do not wake each
+    /// other for ever at one time.
+    last_sent: Option<u64>,
 }
 
 impl StandIn {
@@ -63,6 +72,7 @@ impl StandIn {
             functions: def.functions.iter().map(|f| f.name.clone()).collect(),
             inbox,
             sent: 0,
+            last_sent: None,
         }
     }
 }
@@ -79,8 +89,9 @@ impl Agent for StandIn {
     fn step(&mut self, cx: &mut Context<'_>) {
         let now = cx.now();
         // One datum per step along the links of the moment, when there
-        // are any.
-        if cx.mode() == Mode::Running && !cx.receivers().is_empty() {
+        // are any (and at most one per instant).
+        if cx.mode() == Mode::Running && !cx.receivers().is_empty() && self.last_sent != Some(now) {
+            self.last_sent = Some(now);
             self.sent += 1;
             let body = serde_json::json!({
                 "from": self.name,
