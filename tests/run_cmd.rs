@@ -70,8 +70,15 @@ fn the_same_seed_gives_the_same_metrics_json_to_the_byte() {
 
 #[test]
 fn the_ugv_compares_the_hard_switch_of_the_rules_with_the_merge() {
-    let o = situ(&["run", "rules/ugv.situ", "--compare", "hard-switch,merge"]);
+    let dir = tempfile::tempdir().unwrap();
+    let o = situ(&["run", "rules/ugv.situ", "--compare", "hard-switch,merge", "--out", s(dir.path())]);
     assert_eq!(code(&o), 0, "{}", text(&o));
+    // --out writes the pictures its help promises, one pair per row.
+    for name in ["comparison.json", "trajectory-merge-sim-loop.svg", "timeline-merge-sim-loop.svg"] {
+        assert!(dir.path().join(name).is_file(), "{name}");
+    }
+    let stack = std::fs::read_to_string(dir.path().join("trajectory-hard-switch-rules-ugv-situ-stack.svg")).unwrap();
+    assert!(stack.starts_with("<svg") && stack.contains("<polyline"), "a drawn trajectory");
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(out.contains("scenario dafflon-4"), "{out}");
     assert!(out.contains("hard-switch (rules/ugv.situ, stack)") && out.contains("merge (sim loop)"), "{out}");

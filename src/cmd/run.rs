@@ -219,10 +219,39 @@ fn compare(args: &Args, content: Arc<Content>, scenario: &Scenario, list: &[Stri
             eprintln!("error: cannot write `{}`: {e}", out.join("comparison.json").display());
             return USAGE;
         }
+        if let Err(e) = write_comparison(out, scenario, &table) {
+            eprintln!("error: {e}");
+            return USAGE;
+        }
+        println!("wrote {}", out.display());
     }
     if table.rows.iter().all(|r| r.collisions == 0 && r.time_to_goal.is_some()) {
         OK
     } else {
         FAILED
     }
+}
+
+/// `--compare --out DIR`: each row's path and time line, as `trajectory-ROW.svg`
+/// and `timeline-ROW.svg` (ROW: the row's name in lower case, words joined by `-`).
+fn write_comparison(out: &Path, scenario: &Scenario, table: &situ_sim::ugv::Comparison) -> Result<(), String> {
+    for (row, metrics) in table.rows.iter().zip(&table.runs) {
+        let slug: String = row
+            .strategy
+            .to_lowercase()
+            .split(|c: char| !c.is_ascii_alphanumeric())
+            .filter(|w| !w.is_empty())
+            .collect::<Vec<_>>()
+            .join("-");
+        let title = format!("{} — {}", scenario.name, row.strategy);
+        let write = |name: String, text: String| {
+            super::write_atomically(&out.join(&name), text.as_bytes())
+                .map_err(|e| format!("cannot write `{}`: {e}", out.join(&name).display()))
+        };
+        let trajectory = situ_sim::plot::trajectory_svg(&scenario.world, &metrics.samples, &title).map_err(|e| e.to_string())?;
+        write(format!("trajectory-{slug}.svg"), trajectory)?;
+        let timeline = situ_sim::plot::timeline_svg(&metrics.samples, &title).map_err(|e| e.to_string())?;
+        write(format!("timeline-{slug}.svg"), timeline)?;
+    }
+    Ok(())
 }
