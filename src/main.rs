@@ -217,6 +217,14 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // Output piped into a program that stops reading (`situ run … | head`)
+    // ends this one quietly, as it does any Unix tool, instead of a panic
+    // on the next write.
+    #[cfg(unix)]
+    // SAFETY: restoring the default action of one signal before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
     let code = match cli.command {
         Command::Check { files, format, deny_warnings } => cmd::check::run(&files, format, deny_warnings),

@@ -119,7 +119,7 @@ pub(crate) fn step_text(step: &ScriptStep, short: fn(u64) -> String, literal: fn
     // Times of a timeline read best in seconds (`90.5s`, `300s`), short
     // ones in their own unit (`100ms`).
     let duration = |nanos: u64| {
-        if nanos >= 1_000_000_000 && nanos % 1_000_000 == 0 {
+        if nanos >= 1_000_000_000 && nanos.is_multiple_of(1_000_000) {
             let (whole, ms) = (nanos / 1_000_000_000, nanos / 1_000_000 % 1000);
             if ms == 0 {
                 format!("{whole}s")

@@ -66,7 +66,14 @@ pub fn run(args: Args) -> u8 {
         Err(_) if args.scenario.is_none() && args.compare.is_none() => {
             // Any other robot: its first script, every agent a stand-in.
             let Args { file, until, out, record, .. } = args;
-            return super::scripted::run(super::scripted::Args { file, script: None, random: None, until, out, record });
+            return super::scripted::run(super::scripted::Args {
+                file,
+                script: None,
+                random: None,
+                until,
+                out,
+                record,
+            });
         }
         Err(e) => {
             eprintln!("error: `{}`: {e}", args.file.display());
@@ -248,7 +255,8 @@ fn write_comparison(out: &Path, scenario: &Scenario, table: &situ_sim::ugv::Comp
             super::write_atomically(&out.join(&name), text.as_bytes())
                 .map_err(|e| format!("cannot write `{}`: {e}", out.join(&name).display()))
         };
-        let trajectory = situ_sim::plot::trajectory_svg(&scenario.world, &metrics.samples, &title).map_err(|e| e.to_string())?;
+        let trajectory =
+            situ_sim::plot::trajectory_svg(&scenario.world, &metrics.samples, &title).map_err(|e| e.to_string())?;
         write(format!("trajectory-{slug}.svg"), trajectory)?;
         let timeline = situ_sim::plot::timeline_svg(&metrics.samples, &title).map_err(|e| e.to_string())?;
         write(format!("timeline-{slug}.svg"), timeline)?;

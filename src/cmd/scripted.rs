@@ -102,7 +102,8 @@ pub fn run(args: Args) -> u8 {
             // A script file's own scripts come after the rules' ones: the
             // first of the file is meant.
             let name = if script_file.is_some() { None } else { script.as_deref() };
-            let mut pool = Loaded { content: loaded.content.clone(), scripts: loaded.scripts.clone(), bundle: loaded.bundle };
+            let mut pool =
+                Loaded { content: loaded.content.clone(), scripts: loaded.scripts.clone(), bundle: loaded.bundle };
             if let Some(f) = script_file {
                 let theirs: Vec<ScriptSpec> =
                     pool.scripts.iter().filter(|s| Path::new(&s.place.file) == f).cloned().collect();

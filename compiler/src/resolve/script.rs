@@ -136,7 +136,10 @@ fn script_event(cx: &mut Cx, file: FileId, e: &ast::ScriptEvent) -> Option<Scrip
                     ident.span.join(e.event.span),
                     "another agent's event",
                 )
-                .with_help(format!("write `{owner_name}.{}`, or the event of `{}` you meant", e.event.name, ident.name)),
+                .with_help(format!(
+                    "write `{owner_name}.{}`, or the event of `{}` you meant",
+                    e.event.name, ident.name
+                )),
             );
             return None;
         }

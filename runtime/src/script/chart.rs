@@ -45,7 +45,12 @@ pub fn timeline_svg(content: &Content, tracked: &Tracked, end: u64, title: &str)
 
     // The state band.
     let y0 = TOP;
-    let _ = writeln!(s, r##"<text x="{}" y="{:.1}" text-anchor="end" font-weight="bold">state</text>"##, LEFT - 8.0, y0 + 17.0);
+    let _ = writeln!(
+        s,
+        r##"<text x="{}" y="{:.1}" text-anchor="end" font-weight="bold">state</text>"##,
+        LEFT - 8.0,
+        y0 + 17.0
+    );
     let mut changes: Vec<(u64, u32)> = vec![(0, content.initial)];
     changes.extend(tracked.states.iter().copied());
     for (i, &(t, state)) in changes.iter().enumerate() {
@@ -66,7 +71,13 @@ pub fn timeline_svg(content: &Content, tracked: &Tracked, end: u64, title: &str)
     // One band per agent.
     for (a, def) in content.agents.iter().enumerate() {
         let y = TOP + (a + 1) as f64 * (BAND + GAP);
-        let _ = writeln!(s, r##"<text x="{}" y="{:.1}" text-anchor="end">{}</text>"##, LEFT - 8.0, y + 17.0, esc(&def.name));
+        let _ = writeln!(
+            s,
+            r##"<text x="{}" y="{:.1}" text-anchor="end">{}</text>"##,
+            LEFT - 8.0,
+            y + 17.0,
+            esc(&def.name)
+        );
         let stretches = tracked.agents.get(a).map(Vec::as_slice).unwrap_or(&[]);
         for (i, st) in stretches.iter().enumerate() {
             let until = stretches.get(i + 1).map_or(end, |n| n.time);
@@ -84,7 +95,9 @@ pub fn timeline_svg(content: &Content, tracked: &Tracked, end: u64, title: &str)
                 Mode::Sleeping => "sleeping",
             };
             let tip = match function {
-                Some(f) if st.mode != Mode::Sleeping => format!("{}: {mode} {f}() {} – {}", def.name, secs(st.time), secs(until)),
+                Some(f) if st.mode != Mode::Sleeping => {
+                    format!("{}: {mode} {f}() {} – {}", def.name, secs(st.time), secs(until))
+                }
                 _ => format!("{}: {mode} {} – {}", def.name, secs(st.time), secs(until)),
             };
             let w = (x2 - x1).max(0.5);
@@ -125,7 +138,8 @@ pub fn timeline_svg(content: &Content, tracked: &Tracked, end: u64, title: &str)
 
     // The time axis.
     let axis = TOP + rows as f64 * (BAND + GAP) + 6.0;
-    let _ = writeln!(s, r##"<line x1="{LEFT}" y1="{axis:.1}" x2="{:.1}" y2="{axis:.1}" stroke="#333"/>"##, WIDTH - RIGHT);
+    let _ =
+        writeln!(s, r##"<line x1="{LEFT}" y1="{axis:.1}" x2="{:.1}" y2="{axis:.1}" stroke="#333"/>"##, WIDTH - RIGHT);
     let step = tick_step(end);
     let mut t = 0u64;
     while t <= end {
@@ -157,7 +171,13 @@ fn label(s: &mut String, x1: f64, x2: f64, y: f64, text: &str) {
     if text.is_empty() || (x2 - x1) < 7.0 * text.chars().count() as f64 + 6.0 {
         return;
     }
-    let _ = writeln!(s, r##"<text x="{:.2}" y="{:.1}" text-anchor="middle">{}</text>"##, (x1 + x2) / 2.0, y + 17.0, esc(text));
+    let _ = writeln!(
+        s,
+        r##"<text x="{:.2}" y="{:.1}" text-anchor="middle">{}</text>"##,
+        (x1 + x2) / 2.0,
+        y + 17.0,
+        esc(text)
+    );
 }
 
 /// A round tick spacing giving at most ~12 ticks.

@@ -117,17 +117,7 @@ impl ScriptRun {
         let mut sinks: Vec<Box<dyn Sink>> = vec![Box::new(track.clone())];
         sinks.extend(sink);
         let rt = SimRuntime::new(content.clone(), bound, Some(Box::new(Tee(sinks))), SimConfig::default());
-        ScriptRun {
-            content,
-            rt,
-            inboxes,
-            timeline,
-            next: None,
-            end,
-            track,
-            driver: driver.describe(),
-            changes: 0,
-        }
+        ScriptRun { content, rt, inboxes, timeline, next: None, end, track, driver: driver.describe(), changes: 0 }
     }
 
     /// When the run ends (ns), unless a final state comes first.

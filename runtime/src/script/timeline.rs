@@ -202,7 +202,8 @@ mod tests {
 
     fn program() -> (Arc<Content>, ScriptSpec) {
         let checked = situ_compiler::check_source("t.situ", SRC);
-        let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.severity == situ_compiler::Severity::Error).collect();
+        let errors: Vec<_> =
+            checked.diagnostics.iter().filter(|d| d.severity == situ_compiler::Severity::Error).collect();
         assert!(errors.is_empty(), "{errors:?}");
         (Arc::new(situ_compiler::bundle::build(&checked)), spec::scripts(&checked).remove(0))
     }
@@ -215,7 +216,8 @@ mod tests {
         let times: Vec<u64> = due.iter().map(|d| d.time).collect();
         assert!(times.windows(2).all(|w| w[0] <= w[1]), "{times:?}");
         let name = |d: &Due| c.events[d.event as usize].name.clone();
-        let heartbeats: Vec<u64> = due.iter().filter(|d| name(d) == "HB" && d.time < 1_000_000_000).map(|d| d.time).collect();
+        let heartbeats: Vec<u64> =
+            due.iter().filter(|d| name(d) == "HB" && d.time < 1_000_000_000).map(|d| d.time).collect();
         // 0, 100, …, 900 ms less 500 and 600 (silent).
         let ms: Vec<u64> = heartbeats.iter().map(|t| t / 1_000_000).collect();
         assert_eq!(ms, [0, 100, 200, 300, 400, 700, 800, 900]);
