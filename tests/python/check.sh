@@ -29,3 +29,10 @@ trap 'rm -rf "$work"' EXIT
 cd "$root"
 "$situ" run rules/outdoor.situ --record "$work/run.mcap" > "$work/run.txt"
 "$venv/bin/python" "$here/read_mcap.py" "$work/run.mcap"
+
+# A scripted run of a robot of its own (every agent a stand-in): the same
+# reader, the states of the script and every agent's modes.
+"$situ" run examples/mower/mower.situ --script "a day on the lawn" --record "$work/mower.mcap" > "$work/mower.txt"
+"$venv/bin/python" "$here/read_mcap.py" "$work/mower.mcap" --stand-ins | tee "$work/mower-read.txt"
+grep -q "states: RAIN_PAUSE -> MOWING -> STUCK -> MOWING -> DOCKING -> CHARGING -> MOWING -> FAULT" "$work/mower-read.txt" \
+  || { echo "check.sh: FAILED: the mower's recording does not hold the script's states" >&2; exit 1; }

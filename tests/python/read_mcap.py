@@ -8,7 +8,10 @@ per topic and checks the schemas Foxglove's panels need:
 - a /state channel whose messages have a `state` field (Foxglove's State
   Transitions panel draws it), and the attached bundle.
 
-Usage: read_mcap.py RECORDING.mcap   (exit 0 when everything holds)
+Usage: read_mcap.py RECORDING.mcap [--stand-ins]   (exit 0 when everything holds)
+
+With --stand-ins (a scripted run of any rules file: no vehicle), /pose and
+/obstacles are not expected; every agent's modes on /situ/modes are.
 """
 import json
 import sys
@@ -16,7 +19,7 @@ import sys
 from mcap.reader import make_reader
 
 
-def main(path):
+def main(path, stand_ins=False):
     counts = {}
     schemas = {}
     states = []
@@ -47,12 +50,15 @@ def main(path):
     for topic, n in sorted(counts.items()):
         name, enc, msg_enc = schemas[topic]
         print(f"{topic:<16} {n:>8}  {name} ({enc}, {msg_enc})")
-    want = {
-        "/events": "foxglove.Log",
-        "/pose": "foxglove.PoseInFrame",
-        "/obstacles": "foxglove.SceneUpdate",
-        "/state": None,
-    }
+    if stand_ins:
+        want = {"/events": "foxglove.Log", "/state": None, "/situ/modes": None}
+    else:
+        want = {
+            "/events": "foxglove.Log",
+            "/pose": "foxglove.PoseInFrame",
+            "/obstacles": "foxglove.SceneUpdate",
+            "/state": None,
+        }
     for topic, name in want.items():
         check(counts.get(topic, 0) > 0, f"no message on {topic}")
         if name and topic in schemas:
@@ -77,7 +83,8 @@ def main(path):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 2:
+    args = sys.argv[1:]
+    if len(args) not in (1, 2) or (len(args) == 2 and args[1] != "--stand-ins"):
         print(__doc__, file=sys.stderr)
         sys.exit(2)
-    sys.exit(main(sys.argv[1]))
+    sys.exit(main(args[0], stand_ins=len(args) == 2))
