@@ -179,3 +179,17 @@ fn a_file_of_another_robot_without_a_script_says_what_to_give() {
     assert_eq!(code(&o), 0, "{}", text(&o));
     assert!(stdout(&o).contains("path: A → B\n"), "{}", text(&o));
 }
+
+#[test]
+fn the_mower_example_prints_its_expected_summary() {
+    // The README's worked example, word for word (examples/mower/expected-summary.txt;
+    // to accept a deliberate change, run the command below and commit the file).
+    let o = common::situ(&["run", MOWER, "--script", "a day on the lawn"]);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let expected = std::fs::read_to_string("examples/mower/expected-summary.txt").unwrap();
+    assert_eq!(
+        stdout(&o),
+        expected,
+        "`situ run {MOWER} --script \"a day on the lawn\" > examples/mower/expected-summary.txt` changed"
+    );
+}
