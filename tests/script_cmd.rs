@@ -92,6 +92,13 @@ fn the_files_of_a_scripted_run_are_the_same_bytes_every_time() {
     }
     assert!(svg.contains("Drive: running home()"), "Drive's homing is a segment with a tooltip");
     assert!(svg.contains("Blades: sleeping"), "Blades' sleep is a segment");
+    // The wiring of a state as the run saw it: Blades' FSM asleep, Drive waiting.
+    let charging = std::fs::read_to_string(a.join("wiring-CHARGING.svg")).unwrap();
+    assert!(charging.contains("CHARGING — on the station, charging"), "a title");
+    assert!(charging.contains("Blades (Actuator): sleeping"), "{charging}");
+    assert!(charging.contains("Drive (Actuator): waiting"), "{charging}");
+    let stuck = std::fs::read_to_string(a.join("wiring-STUCK.svg")).unwrap();
+    assert!(stuck.contains("<title>Bumper → Drive</title>") && stuck.contains("<title>GPS → Drive</title>"), "{stuck}");
     let metrics: serde_json::Value = serde_json::from_slice(&std::fs::read(a.join("metrics.json")).unwrap()).unwrap();
     assert_eq!(metrics["runtime"]["final_state"], "FAULT");
     assert!(metrics["agent_times"]["Drive"]["functions"]["home"].as_f64().unwrap() > 10.0, "{metrics}");

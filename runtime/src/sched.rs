@@ -124,6 +124,11 @@ impl SimRuntime {
         self.board.board.state()
     }
 
+    /// The time of the next task, if any.
+    pub fn next_time(&self) -> Option<u64> {
+        self.queue.peek().map(|Reverse((time, _, _))| *time)
+    }
+
     /// Whether the run reached a final state (with `stop_on_final`).
     pub fn finished(&self) -> bool {
         self.finished

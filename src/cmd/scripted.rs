@@ -14,6 +14,7 @@ use situ_compiler::loader::FsLoader;
 use situ_compiler::spec::{self, ScriptSpec};
 use situ_runtime::record::mcap::McapRecorder;
 use situ_runtime::record::Sink;
+use situ_runtime::script::wiring::{self, Snapshot};
 use situ_runtime::script::{chart, Driver, ScriptRun};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -171,6 +172,7 @@ pub fn run(args: Args) -> u8 {
         eprint!("\r\x1b[K");
     }
     let tracked = run.tracked();
+    let snapshots = run.snapshots().to_vec();
     let end = run.now();
     let report = match run.finish() {
         Ok(r) => r,
@@ -202,7 +204,7 @@ pub fn run(args: Args) -> u8 {
     }
     if let Some(out) = &args.out {
         let title = format!("{} — {}", content.source, report.driver);
-        if let Err(e) = write_out(out, &content, &tracked, end, &title, &report) {
+        if let Err(e) = write_out(out, &content, &tracked, &snapshots, end, &title, &report) {
             eprintln!("error: {e}");
             return USAGE;
         }
@@ -218,11 +220,13 @@ pub fn run(args: Args) -> u8 {
     }
 }
 
-/// `timeline.svg`, `wiring-STATE.svg` of every state visited, `metrics.json`.
+/// `timeline.svg`, `wiring-STATE.svg` of every state visited (as the run
+/// saw it), `metrics.json`.
 fn write_out(
     out: &Path,
     content: &Content,
     tracked: &situ_runtime::script::report::Tracked,
+    snapshots: &[Option<Snapshot>],
     end: u64,
     title: &str,
     report: &situ_runtime::script::report::ScriptReport,
@@ -237,8 +241,13 @@ fn write_out(
     visited.sort_unstable();
     visited.dedup();
     for s in visited {
-        let dot = situ_compiler::graph::wiring(content, Some(s));
-        let svg = super::graph::svg(&dot).map_err(|e| format!("cannot lay out the wiring of a state: {e}"))?;
+        let svg = match snapshots.get(s as usize).and_then(Option::as_ref) {
+            Some(snap) => wiring::svg(content, snap),
+            // A state that was at rest only inside one step of the
+            // scheduler: its static wiring.
+            None => super::graph::svg(&situ_compiler::graph::wiring(content, Some(s)))
+                .map_err(|e| format!("cannot lay out the wiring of a state: {e}"))?,
+        };
         write(&format!("wiring-{}.svg", content.states[s as usize].name), svg.as_bytes())?;
     }
     write("metrics.json", report.to_json().as_bytes())?;

@@ -23,6 +23,7 @@ pub mod chart;
 pub mod report;
 pub mod standin;
 pub mod timeline;
+pub mod wiring;
 
 use crate::agent::{self, Agent};
 use crate::record::{Sink, Tee};
@@ -33,6 +34,7 @@ use situ_compiler::spec::ScriptSpec;
 use standin::{Inbox, StandIn};
 use std::sync::Arc;
 use timeline::{Due, Timeline};
+use wiring::Snapshot;
 
 /// How long a `--random` run lasts when not told (ns).
 pub const DEFAULT_RANDOM_NS: u64 = 60_000_000_000;
@@ -91,6 +93,8 @@ pub struct ScriptRun {
     track: Track,
     driver: String,
     changes: u64,
+    /// The organisation as it was when each state was first at rest.
+    snapshots: Vec<Option<Snapshot>>,
 }
 
 /// Simulated time between two calls of the progress callback (ns).
@@ -117,7 +121,20 @@ impl ScriptRun {
         let mut sinks: Vec<Box<dyn Sink>> = vec![Box::new(track.clone())];
         sinks.extend(sink);
         let rt = SimRuntime::new(content.clone(), bound, Some(Box::new(Tee(sinks))), SimConfig::default());
-        ScriptRun { content, rt, inboxes, timeline, next: None, end, track, driver: driver.describe(), changes: 0 }
+        let mut snapshots = vec![None; content.states.len()];
+        snapshots[rt.state() as usize] = Some(Snapshot::take(&rt.shared.org(), 0));
+        ScriptRun {
+            snapshots,
+            content,
+            rt,
+            inboxes,
+            timeline,
+            next: None,
+            end,
+            track,
+            driver: driver.describe(),
+            changes: 0,
+        }
     }
 
     /// When the run ends (ns), unless a final state comes first.
@@ -157,8 +174,6 @@ impl ScriptRun {
     /// Runs every task and scripted event up to `until` (ns, included).
     pub fn run_until(&mut self, until: u64) {
         let until = until.min(self.end);
-        let mut changes = 0u64;
-        let mut count = |_: &crate::rete::StateChange| changes += 1;
         loop {
             if self.next.is_none() {
                 self.next = self.timeline.next();
@@ -168,7 +183,7 @@ impl ScriptRun {
             // reports it; otherwise the agent is stepped for it.
             let (agent, time) = (due.agent, due.time);
             self.inboxes[agent as usize].push(time, due.event, due.payload);
-            self.rt.run_until(time, &mut count);
+            self.advance(time);
             if self.rt.finished() {
                 break;
             }
@@ -177,9 +192,30 @@ impl ScriptRun {
             }
         }
         if !self.rt.finished() {
-            self.rt.run_until(until, &mut count);
+            self.advance(until);
         }
-        self.changes += changes;
+    }
+
+    /// The scheduler's tasks up to `until` (included), one at a time, so
+    /// that the organisation is seen as each new state comes to rest.
+    fn advance(&mut self, until: u64) {
+        while !self.rt.finished() && self.rt.next_time().is_some_and(|t| t <= until) {
+            let mut changed = 0u64;
+            self.rt.step(&mut |_| changed += 1);
+            self.changes += changed;
+            let state = self.rt.state() as usize;
+            if changed > 0 && self.snapshots[state].is_none() {
+                self.snapshots[state] = Some(Snapshot::take(&self.rt.shared.org(), self.rt.now()));
+            }
+        }
+        if !self.rt.finished() {
+            self.rt.run_until(until, &mut |_| {});
+        }
+    }
+
+    /// The organisation when each state was first at rest (`None`: never visited).
+    pub fn snapshots(&self) -> &[Option<Snapshot>] {
+        &self.snapshots
     }
 
     /// Ends the run (and the recording): the report.
