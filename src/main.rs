@@ -198,6 +198,11 @@ enum Command {
         #[arg(long)]
         stats: bool,
     },
+    /// Generate code from the rules: `situ gen agent AGENT FILE --lang python|rust`.
+    Gen {
+        #[command(subcommand)]
+        what: cmd::gen::What,
+    },
     /// Export the abstraction and the properties of a rule file to another tool.
     Export {
         /// A Promela model for spin (one property per `-DPROP=k`).
@@ -250,6 +255,7 @@ fn main() -> ExitCode {
                 stats,
             })
         }
+        Command::Gen { what } => cmd::gen::run(what),
         Command::Export { promela: _, file, output, depth, max_states } => {
             cmd::export::run(&file, output.as_ref(), depth, max_states)
         }

@@ -117,11 +117,11 @@ fn a_damaged_bundle_is_refused_with_exit_2() {
 }
 
 #[test]
-fn rules_without_a_reference_stack_are_refused() {
+fn rules_without_a_reference_stack_or_a_script_say_what_to_give() {
     let dir = tempfile::tempdir().unwrap();
     let f = dir.path().join("tiny.situ");
     std::fs::write(&f, "states { IT initial RD final }\nagent Ready sensor { event RDY }\nrule ready { when state == IT and RDY then RD }\n").unwrap();
     let o = situ(&["run", s(&f)]);
     assert_eq!(code(&o), 2);
-    assert!(text(&o).contains("no simulated stack"), "{}", text(&o));
+    assert!(text(&o).contains("no reference stack") && text(&o).contains("--random SEED"), "{}", text(&o));
 }

@@ -27,6 +27,7 @@
 
 pub mod bundle;
 pub mod checks;
+pub mod codegen;
 pub mod codes;
 pub mod graph;
 pub mod load;

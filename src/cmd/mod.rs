@@ -7,6 +7,7 @@ pub mod distributed;
 pub mod explain;
 pub mod export;
 pub mod fmt;
+pub mod gen;
 pub mod graph;
 pub mod program;
 pub mod replay;

@@ -73,7 +73,11 @@ fn pick(loaded: &Loaded, file: &Path, name: Option<&str>) -> Result<ScriptSpec, 
     let names: Vec<String> = loaded.scripts.iter().map(|s| format!("\"{}\"", s.name)).collect();
     match name {
         None => loaded.scripts.first().cloned().ok_or_else(|| {
-            format!("`{}` has no `script` block: give `--script FILE` or `--random SEED`", file.display())
+            format!(
+                "`{}` has no reference stack (those of rules/outdoor.situ and rules/ugv.situ) and no `script` \
+                 block: give `--script FILE` or `--random SEED`",
+                file.display()
+            )
         }),
         Some(n) => loaded.scripts.iter().find(|s| s.name == n).cloned().ok_or_else(|| {
             if loaded.bundle {
