@@ -130,6 +130,11 @@ enum Command {
         #[arg(long, default_value_t = 10.0)]
         duration: f64,
     },
+    /// Step through the rules by hand: post events, let time pass, ask why (commands from stdin when not a terminal).
+    Repl {
+        /// A `.situ` source or a bundle.
+        file: PathBuf,
+    },
     /// Feed a recording's events to a bundle and say where the states differ from the recorded ones.
     Replay {
         /// An MCAP recording of `situ run --record`.
@@ -294,6 +299,7 @@ fn main() -> ExitCode {
                 })
             }
         }
+        Command::Repl { file } => cmd::repl::run(&file),
         Command::Replay { recording, bundle, format } => cmd::replay::run(&recording, bundle.as_ref(), format),
         Command::Up { deploy, file, stack, duration } => cmd::distributed::up(&deploy, &file, stack, duration),
         Command::Graph { file, view, state, format, output } => {

@@ -20,6 +20,7 @@ pub mod demo;
 pub mod organise;
 pub mod realtime;
 pub mod record;
+pub mod repl;
 pub mod replay;
 pub mod rete;
 pub mod sched;

@@ -10,6 +10,7 @@ pub mod fmt;
 pub mod gen;
 pub mod graph;
 pub mod program;
+pub mod repl;
 pub mod replay;
 pub mod run;
 pub mod scripted;

@@ -1,0 +1,565 @@
+//! `situ repl`: stepping through the rules by hand, in the language's own
+//! terms. A [`Session`] holds a Bulletinboard and the organisation around
+//! it, and takes one command line at a time:
+//!
+//! | command | does |
+//! |---|---|
+//! | `LAOBS distance=12 height=0.5`, `LADAR.LAOBS …`, `LAOBN x3` | posts the event now (N times) |
+//! | `wait 300ms` | lets time pass (staleness, windows) |
+//! | `state`, `why`, `agents`, `facts` | the state; the last change in source terms; every agent's mode, function and links; the working memory |
+//! | `undo` | takes back the last post or wait |
+//! | `reload`, `save FILE` | asks the caller to reload the rules or save the session ([`Reply`]) |
+//! | `help`, `quit` | |
+//!
+//! The organisation follows the events as the runtime's does: an agent's
+//! FSM sees its own event before the Bulletinboard posts it, and every FSM
+//! sees each new state at rest. The session does no I/O: reloading and
+//! saving are asked of the caller, which reads and writes the files.
+
+use crate::bulletinboard::Bulletinboard;
+use crate::organise::Organisation;
+use crate::rete::{describe_fact, format_time, show_value, StateChange};
+use situ_compiler::bundle::{Content, FieldType, Mode, Value};
+use std::fmt::Write as _;
+use std::sync::Arc;
+
+/// What the caller does with a command's result.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Reply {
+    /// Print this.
+    Text(String),
+    /// Reload the rules from their file and call [`Session::reload`].
+    Reload,
+    /// Write [`Session::test_block`] to this file.
+    Save(String),
+    Quit,
+}
+
+/// One thing that moved the session on, kept for `undo` and `save`.
+#[derive(Debug, Clone, PartialEq)]
+enum Step {
+    Post { event: u32, payload: Vec<Value>, time: u64, state: u32 },
+    Wait { to: u64, state: u32 },
+}
+
+/// The most copies one `E xN` posts.
+const MAX_REPEAT: u64 = 10_000;
+/// The longest `wait` (a day), so that time stays far from overflow.
+const MAX_WAIT_NS: u64 = 86_400_000_000_000;
+
+pub struct Session {
+    content: Arc<Content>,
+    board: Bulletinboard,
+    org: Organisation,
+    now: u64,
+    steps: Vec<Step>,
+    last: Option<StateChange>,
+}
+
+impl Session {
+    pub fn new(content: Arc<Content>) -> Session {
+        Session {
+            board: Bulletinboard::new(content.clone()),
+            org: Organisation::new(content.clone()),
+            content,
+            now: 0,
+            steps: Vec::new(),
+            last: None,
+        }
+    }
+
+    pub fn content(&self) -> &Arc<Content> {
+        &self.content
+    }
+
+    /// The state at rest now.
+    pub fn state(&self) -> &str {
+        &self.content.states[self.board.state() as usize].name
+    }
+
+    /// Names to complete: commands, agents, events, `field=` of every event, symbols.
+    pub fn words(&self) -> Vec<String> {
+        let c = &self.content;
+        let mut w: Vec<String> = ["wait", "state", "why", "agents", "facts", "undo", "reload", "save", "help", "quit"]
+            .map(String::from)
+            .into();
+        w.extend(c.agents.iter().map(|a| a.name.clone()));
+        for e in &c.events {
+            w.push(e.name.clone());
+            w.push(format!("{}.{}", c.agents[e.agent as usize].name, e.name));
+            for f in &e.fields {
+                w.push(format!("{}=", f.name));
+                if let FieldType::Symbols(s) = &f.ty {
+                    w.extend(s.iter().map(|x| format!("{}={x}", f.name)));
+                }
+            }
+        }
+        w.sort();
+        w.dedup();
+        w
+    }
+
+    /// Runs one command line; an error is a message for the person, and
+    /// the session goes on unchanged.
+    pub fn execute(&mut self, line: &str) -> Result<Reply, String> {
+        let line = line.split("//").next().unwrap_or("").trim();
+        let mut words = line.split_whitespace();
+        let Some(first) = words.next() else { return Ok(Reply::Text(String::new())) };
+        let rest: Vec<&str> = words.collect();
+        let none = |r: &[&str], what: &str| -> Result<(), String> {
+            if r.is_empty() {
+                Ok(())
+            } else {
+                Err(format!("`{what}` takes nothing after it"))
+            }
+        };
+        match first {
+            "state" => {
+                none(&rest, first).map(|()| Reply::Text(format!("{} at {}", self.state(), format_time(self.now))))
+            }
+            "why" => none(&rest, first).map(|()| Reply::Text(self.why())),
+            "agents" => none(&rest, first).map(|()| Reply::Text(self.agents())),
+            "facts" => none(&rest, first).map(|()| Reply::Text(self.facts())),
+            "undo" => none(&rest, first).and_then(|()| self.undo()).map(Reply::Text),
+            "reload" => none(&rest, first).map(|()| Reply::Reload),
+            "help" => Ok(Reply::Text(HELP.trim_end().to_string())),
+            "quit" | "exit" => Ok(Reply::Quit),
+            "save" => match rest.as_slice() {
+                [file] => Ok(Reply::Save(file.to_string())),
+                _ => Err("`save FILE`: one file name".into()),
+            },
+            "wait" => match rest.as_slice() {
+                [d] => self.wait(parse_duration(d)?).map(Reply::Text),
+                _ => Err("`wait DURATION`, e.g. `wait 300ms`".into()),
+            },
+            _ => self.post_line(first, &rest).map(Reply::Text),
+        }
+    }
+
+    fn post_line(&mut self, name: &str, args: &[&str]) -> Result<String, String> {
+        let c = self.content.clone();
+        let (agent, event_name) = match name.split_once('.') {
+            Some((a, e)) => (Some(a), e),
+            None => (None, name),
+        };
+        let Some(event) = c.event_id(event_name) else {
+            let mut msg = format!("no event or command `{name}`");
+            if let Some(s) = closest(event_name, c.events.iter().map(|e| e.name.as_str())) {
+                msg.push_str(&format!("; did you mean `{s}`?"));
+            }
+            return Err(format!("{msg} (`help` lists the commands)"));
+        };
+        let def = &c.events[event as usize];
+        if let Some(a) = agent {
+            let owner = &c.agents[def.agent as usize].name;
+            if a != owner {
+                return Err(format!("`{event_name}` is an event of `{owner}`, not of `{a}`"));
+            }
+        }
+        let mut payload: Vec<Option<Value>> = vec![None; def.fields.len()];
+        let mut repeat = 1u64;
+        for arg in args {
+            if let Some(n) = arg.strip_prefix('x').and_then(|n| n.parse::<u64>().ok()) {
+                if n == 0 || n > MAX_REPEAT {
+                    return Err(format!("a repeat count is 1 to {MAX_REPEAT}, not {n}"));
+                }
+                repeat = n;
+                continue;
+            }
+            let Some((field, value)) = arg.split_once('=') else {
+                return Err(format!("`{arg}`: write each field as `name=value`, a repeat as `x3`"));
+            };
+            let Some(i) = def.fields.iter().position(|f| f.name == field) else {
+                let names: Vec<&str> = def.fields.iter().map(|f| f.name.as_str()).collect();
+                let mut msg = format!("`{event_name}` has no field `{field}`");
+                if let Some(s) = closest(field, names.iter().copied()) {
+                    msg.push_str(&format!("; did you mean `{s}`?"));
+                }
+                return Err(msg);
+            };
+            if payload[i].is_some() {
+                return Err(format!("`{field}` is given twice"));
+            }
+            payload[i] = Some(parse_value(&def.fields[i].ty, field, value)?);
+        }
+        let missing: Vec<&str> =
+            def.fields.iter().zip(&payload).filter(|(_, v)| v.is_none()).map(|(f, _)| f.name.as_str()).collect();
+        if !missing.is_empty() {
+            return Err(format!("`{event_name}` needs every field: {} missing", missing.join(", ")));
+        }
+        let payload: Vec<Value> = payload.into_iter().flatten().collect();
+        let mut out = Vec::new();
+        for _ in 0..repeat {
+            out.push(self.post(event, payload.clone())?);
+        }
+        Ok(out.into_iter().filter(|s| !s.is_empty()).collect::<Vec<_>>().join("\n"))
+    }
+
+    /// Posts one event now, as the runtime does: the agent's FSM first, then
+    /// the rules, then every FSM on a new state.
+    fn post(&mut self, event: u32, payload: Vec<Value>) -> Result<String, String> {
+        let agent = self.content.events[event as usize].agent;
+        self.board.engine().validate(event, &payload).map_err(|e| e.describe(&self.content))?;
+        self.org.on_event(agent, event);
+        let result = self.board.post(event, self.now, &payload);
+        let text = self.after(result);
+        self.steps.push(Step::Post { event, payload, time: self.now, state: self.board.state() });
+        Ok(text)
+    }
+
+    fn wait(&mut self, d: u64) -> Result<String, String> {
+        if d > MAX_WAIT_NS {
+            return Err("wait at most a day at a time".into());
+        }
+        self.now += d;
+        let result = self.board.advance(self.now);
+        let text = self.after(result);
+        self.steps.push(Step::Wait { to: self.now, state: self.board.state() });
+        Ok(if text.is_empty() { format!("{} at {}", self.state(), format_time(self.now)) } else { text })
+    }
+
+    fn after(&mut self, result: Result<Option<StateChange>, crate::rete::PostError>) -> String {
+        match result {
+            Ok(Some(change)) if change.changed() => {
+                self.org.on_state(change.to);
+                let text = format!(
+                    "{} -> {} ({})",
+                    self.content.states[change.from as usize].name,
+                    self.content.states[change.to as usize].name,
+                    change
+                        .firings
+                        .iter()
+                        .map(|f| self.content.rules[f.rule as usize].name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                );
+                self.last = Some(change);
+                text
+            }
+            Ok(_) => String::new(),
+            Err(e) => {
+                let state = self.board.state();
+                if self.org.state() != state {
+                    self.org.on_state(state);
+                }
+                format!("error: {} (now in {})", e.describe(&self.content), self.state())
+            }
+        }
+    }
+
+    fn why(&self) -> String {
+        match &self.last {
+            None => format!("{} is the initial state: no rule has fired yet", self.state()),
+            Some(change) => {
+                let mut s = change.explain(&self.content);
+                for f in &change.firings {
+                    let rule = &self.content.rules[f.rule as usize];
+                    let _ =
+                        write!(s, "\n  {}:{}: {}", rule.source.file, rule.source.line, first_line(&rule.source.text));
+                }
+                s
+            }
+        }
+    }
+
+    fn agents(&self) -> String {
+        let c = &self.content;
+        let width = c.agents.iter().map(|a| a.name.chars().count()).max().unwrap_or(0);
+        let mut s = String::new();
+        for (a, def) in c.agents.iter().enumerate() {
+            let a = a as u32;
+            let mode = self.org.mode(a);
+            let mut line = format!("{:<width$}  {}", def.name, mode.adjective());
+            if let Some(f) = self.org.function(a).filter(|_| mode != Mode::Sleeping) {
+                let _ = write!(line, " {f}()");
+            }
+            if let Some(action) = self.org.action(a).filter(|_| mode == Mode::Running) {
+                let names = |ids: &[u32]| {
+                    ids.iter().map(|&i| c.agents[i as usize].name.as_str()).collect::<Vec<_>>().join(", ")
+                };
+                if !action.from.is_empty() {
+                    let _ = write!(line, " from {}", names(&action.from));
+                }
+                if !action.to.is_empty() {
+                    let _ = write!(line, " to {}", names(&action.to));
+                }
+            }
+            let _ = writeln!(s, "{line}");
+        }
+        let links: Vec<String> = self
+            .org
+            .links()
+            .iter()
+            .map(|&(x, y)| format!("{} -> {}", c.agents[x as usize].name, c.agents[y as usize].name))
+            .collect();
+        let _ =
+            write!(s, "links in {}: {}", self.state(), if links.is_empty() { "none".into() } else { links.join(", ") });
+        s
+    }
+
+    fn facts(&self) -> String {
+        let c = &self.content;
+        let engine = self.board.engine();
+        let mut lines = Vec::new();
+        for (a, def) in c.agents.iter().enumerate() {
+            let a = a as u32;
+            if engine.is_stale(a) {
+                lines.push(format!("{}: stale", def.name));
+            } else if let Some(f) = engine.fact(a) {
+                let age = self.now.saturating_sub(f.time);
+                lines.push(format!("{}: {} (age {})", def.name, describe_fact(c, &f), format_time(age)));
+            }
+        }
+        if lines.is_empty() {
+            return format!("no facts at {}", format_time(self.now));
+        }
+        lines.join("\n")
+    }
+
+    /// Takes back the last post or wait: the session is replayed without it.
+    fn undo(&mut self) -> Result<String, String> {
+        let Some(undone) = self.steps.pop() else { return Err("nothing to undo".into()) };
+        let steps = std::mem::take(&mut self.steps);
+        self.replay_steps(steps);
+        let what = match undone {
+            Step::Post { event, .. } => format!("took back {}", self.content.events[event as usize].name),
+            Step::Wait { .. } => "took back a wait".to_string(),
+        };
+        Ok(format!("{what}; {} at {}", self.state(), format_time(self.now)))
+    }
+
+    fn replay_steps(&mut self, steps: Vec<Step>) {
+        self.board = Bulletinboard::new(self.content.clone());
+        self.org = Organisation::new(self.content.clone());
+        self.now = 0;
+        self.last = None;
+        for step in steps {
+            match step {
+                Step::Post { event, payload, time, .. } => {
+                    self.now = time;
+                    let _ = self.post(event, payload);
+                }
+                Step::Wait { to, .. } => {
+                    let _ = self.wait(to.saturating_sub(self.now));
+                }
+            }
+        }
+    }
+
+    /// Takes new rules, keeping the facts (a hot swap), and says what
+    /// changed; on failure the old rules stay.
+    pub fn reload(&mut self, new: Arc<Content>) -> Result<String, String> {
+        let old = self.content.clone();
+        // The history in the new rules' ids, by name, for `undo` and `save`.
+        let steps: Option<Vec<Step>> = self.steps.iter().map(|s| remap(&old, &new, s)).collect();
+        let report = self.board.swap(new.clone()).map_err(|e| format!("{e:?}; the old rules stay"))?;
+        let fsm: Vec<(String, Option<u32>)> = (0..old.agents.len() as u32)
+            .map(|a| (old.agents[a as usize].name.clone(), self.org.fsm_state(a)))
+            .collect();
+        self.content = new.clone();
+        self.org = Organisation::new(new.clone());
+        self.org.set_state(self.board.state());
+        for (name, state) in fsm {
+            if let (Some(a), Some(s)) = (new.agent_id(&name), state) {
+                self.org.set_fsm_state(a, s);
+            }
+        }
+        let mut out = Vec::new();
+        let rules = |c: &Content| c.rules.iter().map(|r| (r.name.clone(), r.source.text.clone())).collect::<Vec<_>>();
+        let (was, now) = (rules(&old), rules(&new));
+        for (name, text) in &now {
+            match was.iter().find(|(n, _)| n == name) {
+                None => out.push(format!("rule `{name}` added")),
+                Some((_, t)) if t != text => out.push(format!("rule `{name}` changed")),
+                _ => {}
+            }
+        }
+        out.extend(
+            was.iter().filter(|(n, _)| !now.iter().any(|(m, _)| m == n)).map(|(n, _)| format!("rule `{n}` removed")),
+        );
+        if out.is_empty() {
+            out.push("no rule changed".into());
+        }
+        if !report.carried.is_empty() {
+            out.push(format!("facts kept: {}", report.carried.join(", ")));
+        }
+        for (agent, why) in &report.dropped {
+            out.push(format!("fact of {agent} dropped: {why}"));
+        }
+        if let Some(c) = report.change.as_ref().filter(|c| c.changed()) {
+            self.org.on_state(c.to);
+            out.push(format!(
+                "the new rules fired: {} -> {}",
+                new.states[c.from as usize].name, new.states[c.to as usize].name
+            ));
+            self.last = Some(c.clone());
+        }
+        match steps {
+            Some(s) => self.steps = s,
+            None => {
+                self.steps.clear();
+                out.push("the history could not be carried over: `undo` and `save` start from here".into());
+            }
+        }
+        Ok(out.join("\n"))
+    }
+
+    /// The session as a `test` block that reproduces it (preceded by
+    /// `include_line`, e.g. `include "rules.situ"`, when given).
+    pub fn test_block(&self, name: &str, include_line: Option<&str>) -> String {
+        let c = &self.content;
+        let mut s = String::new();
+        if let Some(inc) = include_line {
+            let _ = writeln!(s, "{inc}\n");
+        }
+        let _ = writeln!(s, "test \"{}\" {{", name.replace('\\', "\\\\").replace('"', "\\\""));
+        let mut state = c.initial;
+        let mut pending_wait = None;
+        for step in &self.steps {
+            match step {
+                Step::Post { event, payload, time, state: after } => {
+                    let def = &c.events[*event as usize];
+                    let mut text = def.name.clone();
+                    if !def.fields.is_empty() {
+                        let args: Vec<String> = def
+                            .fields
+                            .iter()
+                            .zip(payload)
+                            .map(|(f, v)| format!("{}: {}", f.name, show_value(&f.ty, *v)))
+                            .collect();
+                        text = format!("{text}({})", args.join(", "));
+                    }
+                    let _ = writeln!(s, "    on {text} at {}", duration(*time));
+                    if *after != state || pending_wait.take().is_some() {
+                        let _ = writeln!(s, "    expect state {}", c.states[*after as usize].name);
+                    }
+                    state = *after;
+                }
+                Step::Wait { to, state: after } => {
+                    let _ = writeln!(s, "    // wait to {}: {}", duration(*to), c.states[*after as usize].name);
+                    if *after != state {
+                        pending_wait = Some(*after);
+                    }
+                    state = *after;
+                }
+            }
+        }
+        if self.steps.is_empty() {
+            let _ = writeln!(s, "    expect state {}", c.states[c.initial as usize].name);
+        }
+        s.push_str("}\n");
+        s
+    }
+}
+
+fn remap(old: &Content, new: &Content, step: &Step) -> Option<Step> {
+    let state = |s: u32| new.state_id(&old.states[s as usize].name);
+    Some(match step {
+        Step::Post { event, payload, time, state: st } => {
+            let e = &old.events[*event as usize];
+            let id = new.event_id(&e.name)?;
+            let ne = &new.events[id as usize];
+            let mut p = Vec::new();
+            for f in &ne.fields {
+                let i = e.fields.iter().position(|g| g.name == f.name && g.ty == f.ty)?;
+                p.push(payload[i]);
+            }
+            Step::Post { event: id, payload: p, time: *time, state: state(*st).unwrap_or(new.initial) }
+        }
+        Step::Wait { to, state: st } => Step::Wait { to: *to, state: state(*st).unwrap_or(new.initial) },
+    })
+}
+
+/// `300ms`, `1.5s`, `2min`, `10us`, `5ns`.
+pub fn parse_duration(text: &str) -> Result<u64, String> {
+    let split = text.find(|c: char| !(c.is_ascii_digit() || c == '.')).unwrap_or(text.len());
+    let (number, unit) = text.split_at(split);
+    let scale: f64 = match unit {
+        "ns" => 1.0,
+        "us" => 1e3,
+        "ms" => 1e6,
+        "s" => 1e9,
+        "min" => 60e9,
+        _ => return Err(format!("`{text}` is not a duration: a number and ns, us, ms, s or min (`300ms`)")),
+    };
+    let value: f64 = number.parse().map_err(|_| format!("`{text}` is not a duration (`300ms`)"))?;
+    let ns = (value * scale).round();
+    if !(ns.is_finite() && (0.0..=MAX_WAIT_NS as f64).contains(&ns)) {
+        return Err(format!("`{text}`: wait at most a day at a time"));
+    }
+    Ok(ns as u64)
+}
+
+fn parse_value(ty: &FieldType, field: &str, text: &str) -> Result<Value, String> {
+    let bad = |what: &str| format!("`{field}` is {what}, not `{text}`");
+    match ty {
+        FieldType::F64 => match text.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(Value::F64(v)),
+            _ => Err(bad("a number (f64)")),
+        },
+        FieldType::I64 => text.parse::<i64>().map(Value::I64).map_err(|_| bad("an integer (i64)")),
+        FieldType::Bool => match text {
+            "true" => Ok(Value::Bool(true)),
+            "false" => Ok(Value::Bool(false)),
+            _ => Err(bad("`true` or `false`")),
+        },
+        FieldType::Symbols(symbols) => match symbols.iter().position(|s| s == text) {
+            Some(i) => Ok(Value::Symbol(i as u32)),
+            None => Err(bad(&format!("one of {}", symbols.join(", ")))),
+        },
+    }
+}
+
+/// A time as a test writes it: `1500ms`, or in nanoseconds when finer.
+fn duration(ns: u64) -> String {
+    if ns.is_multiple_of(1_000_000) {
+        format!("{}ms", ns / 1_000_000)
+    } else {
+        format!("{ns}ns")
+    }
+}
+
+fn first_line(text: &str) -> &str {
+    text.lines().next().unwrap_or("")
+}
+
+/// The closest name, if it is a likely typo.
+fn closest<'a>(name: &str, names: impl Iterator<Item = &'a str>) -> Option<&'a str> {
+    let limit = (name.chars().count() / 3).max(1);
+    names
+        .map(|n| (distance(&name.to_lowercase(), &n.to_lowercase()), n))
+        .filter(|(d, _)| *d <= limit)
+        .min_by_key(|(d, _)| *d)
+        .map(|(_, n)| n)
+}
+
+fn distance(a: &str, b: &str) -> usize {
+    let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for i in 1..=a.len() {
+        let mut prev = row[0];
+        row[0] = i;
+        for j in 1..=b.len() {
+            let cur = row[j];
+            row[j] = (row[j] + 1).min(row[j - 1] + 1).min(prev + usize::from(a[i - 1] != b[j - 1]));
+            prev = cur;
+        }
+    }
+    row[b.len()]
+}
+
+const HELP: &str = "\
+EVENT field=value … [xN]   post an event now (also AGENT.EVENT), N times
+wait DURATION              let time pass: wait 300ms, wait 2s
+state                      the state at rest and the time
+why                        the last change: the rules, their lines, the facts they matched
+agents                     every agent's mode, function and links now
+facts                      every agent's latest fact (or staleness) and its age
+undo                       take back the last event or wait
+reload                     read the rules again, keep the facts, say what changed
+save FILE                  write the session as a `test` block that reproduces it
+help, quit
+";
+
+#[cfg(test)]
+mod tests;
