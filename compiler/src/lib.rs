@@ -38,6 +38,7 @@ mod resolve;
 pub mod rete;
 pub mod source;
 pub mod spec;
+pub mod suggest;
 
 pub use load::RootError;
 pub use loader::Loader;

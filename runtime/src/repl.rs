@@ -20,6 +20,7 @@ use crate::bulletinboard::Bulletinboard;
 use crate::organise::Organisation;
 use crate::rete::{describe_fact, format_time, show_value, StateChange};
 use situ_compiler::bundle::{Content, FieldType, Mode, Value};
+use situ_compiler::suggest::suggest;
 use std::fmt::Write as _;
 use std::sync::Arc;
 
@@ -144,7 +145,7 @@ impl Session {
         };
         let Some(event) = c.event_id(event_name) else {
             let mut msg = format!("no event or command `{name}`");
-            if let Some(s) = closest(event_name, c.events.iter().map(|e| e.name.as_str())) {
+            if let Some(s) = suggest(event_name, c.events.iter().map(|e| e.name.as_str())) {
                 msg.push_str(&format!("; did you mean `{s}`?"));
             }
             return Err(format!("{msg} (`help` lists the commands)"));
@@ -172,7 +173,7 @@ impl Session {
             let Some(i) = def.fields.iter().position(|f| f.name == field) else {
                 let names: Vec<&str> = def.fields.iter().map(|f| f.name.as_str()).collect();
                 let mut msg = format!("`{event_name}` has no field `{field}`");
-                if let Some(s) = closest(field, names.iter().copied()) {
+                if let Some(s) = suggest(field, names.iter().copied()) {
                     msg.push_str(&format!("; did you mean `{s}`?"));
                 }
                 return Err(msg);
@@ -521,31 +522,6 @@ fn duration(ns: u64) -> String {
 
 fn first_line(text: &str) -> &str {
     text.lines().next().unwrap_or("")
-}
-
-/// The closest name, if it is a likely typo.
-fn closest<'a>(name: &str, names: impl Iterator<Item = &'a str>) -> Option<&'a str> {
-    let limit = (name.chars().count() / 3).max(1);
-    names
-        .map(|n| (distance(&name.to_lowercase(), &n.to_lowercase()), n))
-        .filter(|(d, _)| *d <= limit)
-        .min_by_key(|(d, _)| *d)
-        .map(|(_, n)| n)
-}
-
-fn distance(a: &str, b: &str) -> usize {
-    let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
-    let mut row: Vec<usize> = (0..=b.len()).collect();
-    for i in 1..=a.len() {
-        let mut prev = row[0];
-        row[0] = i;
-        for j in 1..=b.len() {
-            let cur = row[j];
-            row[j] = (row[j] + 1).min(row[j - 1] + 1).min(prev + usize::from(a[i - 1] != b[j - 1]));
-            prev = cur;
-        }
-    }
-    row[b.len()]
 }
 
 const HELP: &str = "\
