@@ -790,7 +790,7 @@ impl Builder<'_> {
         Some(Operand::Literal(self.literal(inner)?))
     }
 
-    pub(crate) fn literal(&mut self, pair: P) -> Option<Literal> {
+    fn literal(&mut self, pair: P) -> Option<Literal> {
         let span = self.span(&pair);
         let inner = pair.into_inner().next()?;
         let value = match inner.as_rule() {
@@ -849,21 +849,27 @@ impl Builder<'_> {
         for p in pair.into_inner() {
             match p.as_rule() {
                 Rule::ident => event = Some(self.ident(p)),
-                Rule::arguments => {
-                    for a in p.into_inner() {
-                        let aspan = self.span(&a);
-                        let mut ai = a.into_inner();
-                        let field = self.ident(ai.next()?);
-                        let Some(value) = self.literal(ai.next()?) else { continue };
-                        arguments.push(Argument { field, value, span: aspan });
-                    }
-                }
+                Rule::arguments => arguments = self.arguments(p)?,
                 Rule::run_length => repeat = self.run_length(p),
                 Rule::at_time => at = self.duration(p.into_inner().next()?),
                 _ => {}
             }
         }
         Some(EventInstance { event: event?, arguments, repeat, at, span })
+    }
+
+    /// `(field: value, …)` of an event instance; a literal out of range is
+    /// reported and its argument left out.
+    pub(crate) fn arguments(&mut self, pair: P) -> Option<Vec<Argument>> {
+        let mut arguments = Vec::new();
+        for a in pair.into_inner() {
+            let span = self.span(&a);
+            let mut ai = a.into_inner();
+            let field = self.ident(ai.next()?);
+            let Some(value) = self.literal(ai.next()?) else { continue };
+            arguments.push(Argument { field, value, span });
+        }
+        Some(arguments)
     }
 
     fn expectation(&mut self, pair: P) -> Option<Expectation> {

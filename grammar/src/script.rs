@@ -67,15 +67,7 @@ impl Builder<'_> {
             match p.as_rule() {
                 Rule::script_agent => agent = Some(self.ident(p.into_inner().next()?)),
                 Rule::ident => event = Some(self.ident(p)),
-                Rule::arguments => {
-                    for a in p.into_inner() {
-                        let aspan = self.span(&a);
-                        let mut ai = a.into_inner();
-                        let field = self.ident(ai.next()?);
-                        let Some(value) = self.literal(ai.next()?) else { continue };
-                        arguments.push(Argument { field, value, span: aspan });
-                    }
-                }
+                Rule::arguments => arguments = self.arguments(p)?,
                 _ => {}
             }
         }
