@@ -26,6 +26,38 @@ pub const FAILED: u8 = 1;
 /// A usage or I/O error.
 pub const USAGE: u8 = 2;
 
+/// The progress line of a run on standard error, redrawn at most every
+/// 200 ms of wall time and only on a terminal; wiped when the run ends.
+pub struct LiveLine {
+    live: bool,
+    last: Option<std::time::Instant>,
+    drawn: bool,
+}
+
+impl LiveLine {
+    const REDRAW: std::time::Duration = std::time::Duration::from_millis(200);
+
+    pub fn new() -> LiveLine {
+        LiveLine { live: std::io::stderr().is_terminal(), last: None, drawn: false }
+    }
+
+    /// Draws the line `line` makes, if it is time to.
+    pub fn draw(&mut self, line: impl FnOnce() -> String) {
+        if self.live && self.last.is_none_or(|t| t.elapsed() >= Self::REDRAW) {
+            self.last = Some(std::time::Instant::now());
+            self.drawn = true;
+            eprint!("\r{}\x1b[K", line());
+        }
+    }
+
+    /// Wipes the line, if one was drawn.
+    pub fn clear(&mut self) {
+        if self.drawn {
+            eprint!("\r\x1b[K");
+        }
+    }
+}
+
 /// The style of human reports on this terminal.
 pub fn style() -> situ_compiler::render::Style {
     let colour = std::io::stdout().is_terminal() && std::env::var_os("NO_COLOR").is_none();

@@ -14,10 +14,8 @@ use situ_runtime::record::mcap::McapRecorder;
 use situ_sim::scenario::{self, Scenario};
 use situ_sim::stack::{self, Recording, StackConfig, StackKind, StackRun};
 use situ_sim::ugv::Strategy;
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
 
 pub struct Args {
     pub file: PathBuf,
@@ -28,9 +26,6 @@ pub struct Args {
     pub until: Option<f64>,
     pub compare: Option<Vec<String>>,
 }
-
-/// How often the progress line is redrawn (wall time).
-const REDRAW: Duration = Duration::from_millis(200);
 
 /// A built-in scenario by name, or a TOML file; the error names the field
 /// or the place.
@@ -124,19 +119,9 @@ pub fn run(args: Args) -> u8 {
                 return USAGE;
             }
         };
-    let live = std::io::stderr().is_terminal();
-    let mut last = Instant::now().checked_sub(REDRAW).unwrap_or_else(Instant::now);
-    let mut drawn = false;
-    run.run(&mut |r| {
-        if live && last.elapsed() >= REDRAW {
-            last = Instant::now();
-            drawn = true;
-            eprint!("\r{}\x1b[K", r.progress().line());
-        }
-    });
-    if drawn {
-        eprint!("\r\x1b[K");
-    }
+    let mut live = super::LiveLine::new();
+    run.run(&mut |r| live.draw(|| r.progress().line()));
+    live.clear();
     let report = match run.finish() {
         Ok(r) => r,
         Err(e) => {

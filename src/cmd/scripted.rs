@@ -16,10 +16,8 @@ use situ_runtime::record::mcap::McapRecorder;
 use situ_runtime::record::Sink;
 use situ_runtime::script::wiring::{self, Snapshot};
 use situ_runtime::script::{chart, Driver, ScriptRun};
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
 
 pub struct Args {
     pub file: PathBuf,
@@ -29,9 +27,6 @@ pub struct Args {
     pub out: Option<PathBuf>,
     pub record: Option<PathBuf>,
 }
-
-/// How often the live line is redrawn (wall time).
-const REDRAW: Duration = Duration::from_millis(200);
 
 /// The rules and the scripts they can be run with.
 struct Loaded {
@@ -162,19 +157,9 @@ pub fn run(args: Args) -> u8 {
         None => None,
     };
     let mut run = ScriptRun::new(content.clone(), driver.clone(), until, sink);
-    let live = std::io::stderr().is_terminal();
-    let mut last = Instant::now().checked_sub(REDRAW).unwrap_or_else(Instant::now);
-    let mut drawn = false;
-    run.run(&mut |r| {
-        if live && last.elapsed() >= REDRAW {
-            last = Instant::now();
-            drawn = true;
-            eprint!("\r{}\x1b[K", r.progress().line());
-        }
-    });
-    if drawn {
-        eprint!("\r\x1b[K");
-    }
+    let mut live = super::LiveLine::new();
+    run.run(&mut |r| live.draw(|| r.progress().line()));
+    live.clear();
     let tracked = run.tracked();
     let snapshots = run.snapshots().to_vec();
     let end = run.now();
