@@ -208,6 +208,20 @@ pub fn camel(name: &str) -> String {
         .collect()
 }
 
+/// The names of the enums of an agent's symbol fields, `EventField` in
+/// CamelCase, in the order of the events and their fields, made unique.
+pub(crate) fn symbol_enums(events: &[&bundle::EventDef]) -> Vec<String> {
+    let mut names = Vec::new();
+    for e in events {
+        for f in &e.fields {
+            if let bundle::FieldType::Symbols(_) = f.ty {
+                names.push(format!("{}{}", camel(&e.name), camel(&f.name)));
+            }
+        }
+    }
+    unique(names)
+}
+
 /// Makes every name of `names` unique by appending a number to repeats.
 pub(crate) fn unique(names: Vec<String>) -> Vec<String> {
     let mut seen: Vec<String> = Vec::new();

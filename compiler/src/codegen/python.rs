@@ -14,7 +14,7 @@
 //! settings): one item per line with trailing commas wherever a line could
 //! grow past 88 characters.
 
-use super::{camel, links_out, one_line, quote, snake, table_actions, unique, Header};
+use super::{links_out, one_line, quote, snake, symbol_enums, table_actions, unique, Header};
 use crate::bundle::{Action, AgentDef, Behaviour, Content, FieldType, Mode, Trigger};
 use std::fmt::Write;
 
@@ -83,15 +83,7 @@ pub(crate) fn generate(content: &Content, me: u32, header: &Header<'_>) -> Strin
 
     // An enum per symbol field, a function per event.
     let events: Vec<&crate::bundle::EventDef> = def.events.iter().map(|&e| &content.events[e as usize]).collect();
-    let mut enum_names = Vec::new();
-    for e in &events {
-        for f in &e.fields {
-            if let FieldType::Symbols(_) = f.ty {
-                enum_names.push(format!("{}{}", camel(&e.name), camel(&f.name)));
-            }
-        }
-    }
-    let enum_names = unique(enum_names);
+    let enum_names = symbol_enums(&events);
     let mut enums = enum_names.iter();
     let mut field_types: Vec<Vec<String>> = Vec::new();
     for e in &events {

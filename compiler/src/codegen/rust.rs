@@ -8,7 +8,7 @@
 //! 120, `use_small_heuristics = "Max"`): code lines are kept short, and the
 //! data tables carry `#[rustfmt::skip]`, one entry a line.
 
-use super::{camel, one_line, quote, snake, table_actions, unique, Header};
+use super::{camel, one_line, quote, snake, symbol_enums, table_actions, unique, Header};
 use crate::bundle::{Action, AgentDef, Behaviour, Content, FieldType, Mode, Trigger};
 use std::fmt::Write;
 
@@ -183,15 +183,7 @@ pub struct Transition {
     }
 
     // An enum per symbol field.
-    let mut enum_names = Vec::new();
-    for e in &events {
-        for f in &e.fields {
-            if let FieldType::Symbols(_) = f.ty {
-                enum_names.push(format!("{}{}", camel(&e.name), camel(&f.name)));
-            }
-        }
-    }
-    let enum_names = unique(enum_names);
+    let enum_names = symbol_enums(&events);
     let mut enums = enum_names.iter();
     let mut field_types: Vec<Vec<String>> = Vec::new();
     for e in &events {
