@@ -63,19 +63,19 @@ fn load(file: &Path, script_file: Option<&Path>) -> Result<Loaded, u8> {
     Ok(Loaded { content, scripts: spec::scripts(&checked), bundle: false })
 }
 
-/// The script named `name`, or why not.
-fn pick(loaded: &Loaded, file: &Path, name: Option<&str>) -> Result<ScriptSpec, String> {
-    let names: Vec<String> = loaded.scripts.iter().map(|s| format!("\"{}\"", s.name)).collect();
+/// The script named `name` (the first without one), or why not.
+fn pick(scripts: &[ScriptSpec], bundle: bool, file: &Path, name: Option<&str>) -> Result<ScriptSpec, String> {
     match name {
-        None => loaded.scripts.first().cloned().ok_or_else(|| {
+        None => scripts.first().cloned().ok_or_else(|| {
             format!(
                 "`{}` has no reference stack (those of rules/outdoor.situ and rules/ugv.situ) and no `script` \
                  block: give `--script FILE` or `--random SEED`",
                 file.display()
             )
         }),
-        Some(n) => loaded.scripts.iter().find(|s| s.name == n).cloned().ok_or_else(|| {
-            if loaded.bundle {
+        Some(n) => scripts.iter().find(|s| s.name == n).cloned().ok_or_else(|| {
+            let names: Vec<String> = scripts.iter().map(|s| format!("\"{}\"", s.name)).collect();
+            if bundle {
                 format!("a bundle carries no scripts: run `{}`'s source to use script \"{n}\"", file.display())
             } else if names.is_empty() {
                 format!("no script \"{n}\": `{}` has no `script` block, and no file `{n}` exists", file.display())
@@ -92,28 +92,21 @@ pub fn run(args: Args) -> u8 {
         Ok(l) => l,
         Err(code) => return code,
     };
-    let driver = match (args.random, &args.script) {
-        (Some(seed), None) => Driver::Random { seed },
-        (Some(_), Some(_)) => {
-            eprintln!("error: --script and --random exclude each other (a script has `random` steps of its own)");
-            return USAGE;
-        }
-        (None, script) => {
-            // A script file's own scripts come after the rules' ones: the
-            // first of the file is meant.
-            let name = if script_file.is_some() { None } else { script.as_deref() };
-            let mut pool =
-                Loaded { content: loaded.content.clone(), scripts: loaded.scripts.clone(), bundle: loaded.bundle };
+    // `--script` and `--random` exclude each other (clap says so).
+    let driver = match args.random {
+        Some(seed) => Driver::Random { seed },
+        None => {
+            let mut scripts = loaded.scripts.clone();
+            // A script file's own scripts, the first of them unless named.
             if let Some(f) = script_file {
-                let theirs: Vec<ScriptSpec> =
-                    pool.scripts.iter().filter(|s| Path::new(&s.place.file) == f).cloned().collect();
-                if theirs.is_empty() {
+                scripts.retain(|s| Path::new(&s.place.file) == f);
+                if scripts.is_empty() {
                     eprintln!("error: `{}` has no `script` block", f.display());
                     return USAGE;
                 }
-                pool.scripts = theirs;
             }
-            match pick(&pool, &args.file, name) {
+            let name = if script_file.is_some() { None } else { args.script.as_deref() };
+            match pick(&scripts, loaded.bundle, &args.file, name) {
                 Ok(s) => Driver::Script(s),
                 Err(e) => {
                     eprintln!("error: {e}");
