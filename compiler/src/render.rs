@@ -70,6 +70,7 @@ impl Report {
                     help: None,
                     witness: None,
                     allowed: false,
+                    fixes: Vec::new(),
                 };
                 related.push(Report::new(sources, &note));
             }

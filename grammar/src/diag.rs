@@ -33,6 +33,22 @@ pub struct Label {
     pub text: String,
 }
 
+/// One replacement of source text: `span` of `file` becomes `text`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Edit {
+    pub file: FileId,
+    pub span: Span,
+    pub text: String,
+}
+
+/// A mechanical fix a tool may apply (an editor's code action): what it does,
+/// in a few words, and the edits that do it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Fix {
+    pub title: String,
+    pub edits: Vec<Edit>,
+}
+
 /// One finding: a stable code, a message, a primary place with its label,
 /// further places, and a help line where a fix is known.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -48,6 +64,9 @@ pub struct Diagnostic {
     pub witness: Option<serde_json::Value>,
     /// Set when an `allow(...)` attribute silenced this finding.
     pub allowed: bool,
+    /// Fixes that apply the help mechanically, best first.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub fixes: Vec<Fix>,
 }
 
 impl Diagnostic {
@@ -67,6 +86,7 @@ impl Diagnostic {
             help: None,
             witness: None,
             allowed: false,
+            fixes: Vec::new(),
         }
     }
 
@@ -87,6 +107,12 @@ impl Diagnostic {
 
     pub fn with_label(mut self, file: FileId, span: Span, text: impl Into<String>) -> Self {
         self.secondary.push(Label { file, span, text: text.into() });
+        self
+    }
+
+    /// Adds a fix that replaces `span` of `file` by `text`.
+    pub fn with_fix(mut self, title: impl Into<String>, file: FileId, span: Span, text: impl Into<String>) -> Self {
+        self.fixes.push(Fix { title: title.into(), edits: vec![Edit { file, span, text: text.into() }] });
         self
     }
 

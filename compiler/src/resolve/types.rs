@@ -48,16 +48,18 @@ pub(super) fn literal(cx: &mut Cx, file: FileId, lit: &ast::Literal, ty: &Type, 
         (L::Symbol(s), Type::Symbols(symbols)) => match symbols.iter().position(|x| x == s) {
             Some(i) => Some(Value::Symbol(i as u32)),
             None => {
-                cx.diags.push(
-                    Diagnostic::error(
-                        codes::UNKNOWN_SYMBOL,
-                        format!("`{s}` is not a value of field `{field}`"),
-                        file,
-                        lit.span,
-                        "unknown symbol",
-                    )
-                    .with_help(format!("`{field}` is one of: {}", symbols.join(", "))),
-                );
+                let mut d = Diagnostic::error(
+                    codes::UNKNOWN_SYMBOL,
+                    format!("`{s}` is not a value of field `{field}`"),
+                    file,
+                    lit.span,
+                    "unknown symbol",
+                )
+                .with_help(format!("`{field}` is one of: {}", symbols.join(", ")));
+                if let Some(close) = crate::suggest::suggest(s, symbols.iter().map(String::as_str)) {
+                    d = d.with_fix(format!("change to `{close}`"), file, lit.span, close);
+                }
+                cx.diags.push(d);
                 return None;
             }
         },
@@ -72,7 +74,10 @@ pub(super) fn literal(cx: &mut Cx, file: FileId, lit: &ast::Literal, ty: &Type, 
             format!("expected {}", ty.describe()),
         );
         d = match (&lit.value, ty) {
-            (L::Float(f), Type::I64) if f.fract() == 0.0 => d.with_help(format!("write the integer `{}`", *f as i64)),
+            (L::Float(f), Type::I64) if f.fract() == 0.0 => {
+                let int = (*f as i64).to_string();
+                d.with_help(format!("write the integer `{int}`")).with_fix(format!("write `{int}`"), file, lit.span, int)
+            }
             (L::Float(_), Type::I64) => d.with_help("an i64 field holds whole numbers only"),
             (_, Type::Bool) => d.with_help("write `true` or `false`"),
             (_, Type::Symbols(s)) => d.with_help(format!("write one of: {}", s.join(", "))),
