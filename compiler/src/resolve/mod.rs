@@ -79,9 +79,12 @@ impl Cx {
                 "no state of this name",
             );
             if let Some(s) = suggest(&name.name, self.model.states.iter().map(|s| s.name.as_str())) {
-                d = d
-                    .with_help(format!("a state with a similar name exists: `{s}`"))
-                    .with_fix(format!("change to `{s}`"), file, name.span, s);
+                d = d.with_help(format!("a state with a similar name exists: `{s}`")).with_fix(
+                    format!("change to `{s}`"),
+                    file,
+                    name.span,
+                    s,
+                );
             } else {
                 d = d.with_help("declare it in the `states { ... }` block");
             }
@@ -101,9 +104,12 @@ impl Cx {
                 "no agent of this name",
             );
             if let Some(s) = suggest(&name.name, self.model.agents.iter().map(|a| a.name.as_str())) {
-                d = d
-                    .with_help(format!("an agent with a similar name exists: `{s}`"))
-                    .with_fix(format!("change to `{s}`"), file, name.span, s);
+                d = d.with_help(format!("an agent with a similar name exists: `{s}`")).with_fix(
+                    format!("change to `{s}`"),
+                    file,
+                    name.span,
+                    s,
+                );
             }
             self.diags.push(d);
         }
@@ -121,9 +127,12 @@ impl Cx {
                 "no agent reports an event of this name",
             );
             if let Some(s) = suggest(&name.name, self.model.events.iter().map(|e| e.name.as_str())) {
-                d = d
-                    .with_help(format!("an event with a similar name exists: `{s}`"))
-                    .with_fix(format!("change to `{s}`"), file, name.span, s);
+                d = d.with_help(format!("an event with a similar name exists: `{s}`")).with_fix(
+                    format!("change to `{s}`"),
+                    file,
+                    name.span,
+                    s,
+                );
             } else {
                 d = d.with_help("declare it in the agent that reports it: `event NAME { ... }`");
             }
@@ -146,7 +155,9 @@ impl Cx {
                 "not a function of this agent",
             );
             d = match suggest(&name.name, a.functions.iter().map(|f| f.name.as_str())) {
-                Some(s) => d.with_help(format!("did you mean `{s}`?")).with_fix(format!("change to `{s}`"), file, name.span, s),
+                Some(s) => {
+                    d.with_help(format!("did you mean `{s}`?")).with_fix(format!("change to `{s}`"), file, name.span, s)
+                }
                 None => d.with_help(format!("declare it in agent `{agent_name}`: `function {}`", name.name)),
             };
             self.diags.push(d);

@@ -76,7 +76,12 @@ pub(super) fn literal(cx: &mut Cx, file: FileId, lit: &ast::Literal, ty: &Type, 
         d = match (&lit.value, ty) {
             (L::Float(f), Type::I64) if f.fract() == 0.0 => {
                 let int = (*f as i64).to_string();
-                d.with_help(format!("write the integer `{int}`")).with_fix(format!("write `{int}`"), file, lit.span, int)
+                d.with_help(format!("write the integer `{int}`")).with_fix(
+                    format!("write `{int}`"),
+                    file,
+                    lit.span,
+                    int,
+                )
             }
             (L::Float(_), Type::I64) => d.with_help("an i64 field holds whole numbers only"),
             (_, Type::Bool) => d.with_help("write `true` or `false`"),
