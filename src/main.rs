@@ -3,7 +3,7 @@
 
 mod cmd;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -28,6 +28,10 @@ enum Command {
         /// Fail (exit 1) on warnings too.
         #[arg(long)]
         deny_warnings: bool,
+        /// Check again on every save of a file or of any file it includes, until Ctrl-C
+        /// (exit 0); each round ends with a line of the time and the summary.
+        #[arg(long)]
+        watch: bool,
     },
     /// Format rule files in place; with --check, only report which would change.
     Fmt {
@@ -224,6 +228,28 @@ enum Command {
         #[arg(long, default_value_t = 20_000)]
         max_states: usize,
     },
+    /// Print the completion script of a shell for situ.
+    #[command(long_about = "Print the completion script of a shell for situ to standard output.\n\n\
+        Install it where the shell looks for completions, for example:\n\
+        \x20 situ completions bash > ~/.local/share/bash-completion/completions/situ\n\
+        \x20 situ completions zsh > ~/.zfunc/_situ   (with `fpath+=~/.zfunc` before `compinit`)\n\
+        \x20 situ completions fish > ~/.config/fish/completions/situ.fish\n\
+        \x20 situ completions powershell >> $PROFILE\n\
+        \x20 situ completions elvish > ~/.config/elvish/lib/situ.elv   (then `use situ`)")]
+    Completions {
+        /// The shell.
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
+    /// Print situ's man page, or write one page per subcommand into a directory.
+    #[command(long_about = "Print the man page of situ (roff) to standard output: `situ man | man -l -`.\n\n\
+        With -o DIR, write situ.1 and a page per subcommand (situ-check.1, situ-gen-agent.1, ...) \
+        into DIR, each atomically; for example `situ man -o ~/.local/share/man/man1`.")]
+    Man {
+        /// Write situ.1 and a page per subcommand into this directory instead.
+        #[arg(short, long, value_name = "DIR")]
+        output: Option<PathBuf>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -237,7 +263,9 @@ fn main() -> ExitCode {
     }
     let cli = Cli::parse();
     let code = match cli.command {
-        Command::Check { files, format, deny_warnings } => cmd::check::run(&files, format, deny_warnings),
+        Command::Check { files, format, deny_warnings, watch } => cmd::check::run(&files, format, deny_warnings, watch),
+        Command::Completions { shell } => cmd::manners::completions(shell, Cli::command()),
+        Command::Man { output } => cmd::manners::man(Cli::command(), output.as_deref()),
         Command::Fmt { files, check } => cmd::fmt::run(&files, check),
         Command::Explain { code } => cmd::explain::run(code.as_deref()),
         Command::Build { file, output, binary, stats, deny_warnings } => {

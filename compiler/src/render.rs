@@ -3,7 +3,7 @@
 
 use crate::codes;
 use crate::source::SourceMap;
-use crate::Checked;
+use crate::{Checked, RootError};
 use miette::{GraphicalReportHandler, GraphicalTheme, LabeledSpan, NamedSource, SourceSpan};
 use serde_json::{json, Value};
 use situ_grammar::diag::{Diagnostic, FileId, Label, Severity};
@@ -178,19 +178,16 @@ pub fn json_lines(checked: &Checked) -> String {
 
 /// A SARIF 2.1.0 log of several checks.
 pub fn sarif(checks: &[&Checked]) -> String {
-    let rules: Vec<Value> = codes::ALL
-        .iter()
-        .map(|c| {
-            json!({
-                "id": format!("situ::{}", c.code),
-                "name": c.title,
-                "shortDescription": { "text": c.title },
-                "fullDescription": { "text": c.explain },
-                "help": { "text": c.explain, "markdown": c.explain },
-                "defaultConfiguration": { "level": level(c.severity) },
-            })
-        })
-        .collect();
+    sarif_with_failures(checks, &[])
+}
+
+/// A SARIF 2.1.0 log of several checks and of the roots that could not be
+/// read at all. With a failure the run's invocation says
+/// `executionSuccessful: false` and names each unread file in a tool
+/// execution notification, so that a CI reading only the log does not take
+/// an unread file for a clean one.
+pub fn sarif_with_failures(checks: &[&Checked], failures: &[&RootError]) -> String {
+    let rules: Vec<Value> = codes::ALL.iter().map(sarif_rule).collect();
     let mut results = Vec::new();
     for checked in checks {
         for d in &checked.diagnostics {
@@ -215,6 +212,22 @@ pub fn sarif(checks: &[&Checked]) -> String {
             results.push(r);
         }
     }
+    let notifications: Vec<Value> = failures
+        .iter()
+        .map(|f| {
+            json!({
+                "level": "error",
+                "message": { "text": f.to_string() },
+                "locations": [{
+                    "physicalLocation": { "artifactLocation": { "uri": uri(&f.path.display().to_string()) } },
+                }],
+            })
+        })
+        .collect();
+    let mut invocation = json!({ "executionSuccessful": failures.is_empty() });
+    if !notifications.is_empty() {
+        invocation["toolExecutionNotifications"] = json!(notifications);
+    }
     let log = json!({
         "$schema": "https://json.schemastore.org/sarif-2.1.0.json",
         "version": "2.1.0",
@@ -222,14 +235,89 @@ pub fn sarif(checks: &[&Checked]) -> String {
             "tool": { "driver": {
                 "name": "situ",
                 "version": env!("CARGO_PKG_VERSION"),
-                "informationUri": "https://example.invalid/situ",
                 "rules": rules,
             }},
+            "invocations": [invocation],
             "columnKind": "unicodeCodePoints",
             "results": results,
         }],
     });
     serde_json::to_string_pretty(&log).expect("JSON values always serialize")
+}
+
+/// A root that could not be read, as one JSON line (the `--format json`
+/// counterpart of a finding): `{"error": {"kind": "io", "file", "message"}}`.
+pub fn json_failure(failure: &RootError) -> String {
+    let line = json!({
+        "error": {
+            "kind": "io",
+            "file": failure.path.display().to_string(),
+            "message": failure.to_string(),
+        }
+    });
+    format!("{line}\n")
+}
+
+/// A code as a SARIF reporting descriptor, documented inline from its page
+/// (`docs/codes/CODE.md`, the text of `situ explain`): the project has no
+/// public home for a `helpUri`.
+fn sarif_rule(c: &codes::Code) -> Value {
+    let page = c.explain;
+    // The page without its `# CODE: title` line, which the other properties say.
+    let body = match page.split_once('\n') {
+        Some((first, rest)) if first.starts_with("# ") => rest.trim_start(),
+        _ => page,
+    };
+    let what = section(page, "What it does").unwrap_or(c.title);
+    json!({
+        "id": format!("situ::{}", c.code),
+        "name": c.title,
+        "shortDescription": { "text": c.title },
+        "fullDescription": { "text": plain(what), "markdown": what },
+        "help": { "text": plain(body), "markdown": body },
+        "defaultConfiguration": { "level": level(c.severity) },
+    })
+}
+
+/// The text of a `## heading` section of a Markdown page, trimmed.
+fn section<'a>(page: &'a str, heading: &str) -> Option<&'a str> {
+    let marker = format!("## {heading}\n");
+    let start = page.find(&marker)? + marker.len();
+    let rest = &page[start..];
+    let end = rest.find("\n## ").map_or(rest.len(), |i| i + 1);
+    Some(rest[..end].trim())
+}
+
+/// Markdown as plain text: headings lose their `#`s, fenced code is
+/// indented by four spaces instead of fenced; the rest reads as it is.
+fn plain(markdown: &str) -> String {
+    let mut out = String::new();
+    let mut fenced = false;
+    for line in markdown.lines() {
+        if line.trim_start().starts_with("```") {
+            fenced = !fenced;
+            continue;
+        }
+        if fenced {
+            if !line.is_empty() {
+                out.push_str("    ");
+                out.push_str(line);
+            }
+        } else {
+            let hashes = line.trim_start_matches('#');
+            match hashes.strip_prefix(' ') {
+                Some(heading) if hashes.len() < line.len() => out.push_str(heading),
+                _ => out.push_str(line),
+            }
+        }
+        out.push('\n');
+    }
+    out.trim_end().to_string()
+}
+
+/// A file name as a SARIF URI reference (forward slashes).
+fn uri(name: &str) -> String {
+    name.replace('\\', "/")
 }
 
 fn level(s: Severity) -> &'static str {
@@ -245,7 +333,7 @@ fn sarif_location(sources: &SourceMap, l: &Label) -> Value {
     let (end_line, end_column) = file.line_col(l.span.end);
     json!({
         "physicalLocation": {
-            "artifactLocation": { "uri": file.name.replace('\\', "/") },
+            "artifactLocation": { "uri": uri(&file.name) },
             "region": { "startLine": line, "startColumn": column, "endLine": end_line, "endColumn": end_column },
         },
         "message": { "text": l.text },
@@ -255,4 +343,50 @@ fn sarif_location(sources: &SourceMap, l: &Label) -> Value {
 /// Which file a finding is in, for grouping.
 pub fn file_of(d: &Diagnostic) -> FileId {
     d.primary.file
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_sarif_rule_carries_its_documentation_inline() {
+        let log: Value = serde_json::from_str(&sarif(&[])).unwrap();
+        let driver = &log["runs"][0]["tool"]["driver"];
+        assert!(driver.get("informationUri").is_none(), "no made-up home page");
+        let rules = driver["rules"].as_array().unwrap();
+        assert_eq!(rules.len(), codes::ALL.len());
+        for (rule, code) in rules.iter().zip(codes::ALL) {
+            let full = rule["fullDescription"]["text"].as_str().unwrap();
+            assert!(!full.is_empty() && !full.contains("## "), "{}: {full}", code.code);
+            let help = &rule["help"];
+            let (text, markdown) = (help["text"].as_str().unwrap(), help["markdown"].as_str().unwrap());
+            assert!(markdown.contains("## What it does") && markdown.contains("## Use instead"), "{}", code.code);
+            assert!(text.contains("What it does") && !text.contains("```") && !text.contains("## "), "{}", code.code);
+        }
+        assert_eq!(log["runs"][0]["invocations"][0]["executionSuccessful"], true);
+    }
+
+    #[test]
+    fn an_unread_root_makes_the_run_unsuccessful() {
+        let failure = RootError {
+            path: "no/such.situ".into(),
+            error: std::io::Error::new(std::io::ErrorKind::NotFound, "not found"),
+        };
+        let log: Value = serde_json::from_str(&sarif_with_failures(&[], &[&failure])).unwrap();
+        let invocation = &log["runs"][0]["invocations"][0];
+        assert_eq!(invocation["executionSuccessful"], false);
+        let note = &invocation["toolExecutionNotifications"][0];
+        assert_eq!(note["level"], "error");
+        assert!(note["message"]["text"].as_str().unwrap().contains("no/such.situ"));
+        assert_eq!(note["locations"][0]["physicalLocation"]["artifactLocation"]["uri"], "no/such.situ");
+        let line: Value = serde_json::from_str(json_failure(&failure).trim_end()).unwrap();
+        assert_eq!(line["error"]["file"], "no/such.situ");
+    }
+
+    #[test]
+    fn plain_text_unfences_code_and_drops_heading_marks() {
+        let md = "## Example\nSome `x`.\n```situ\n#[allow(E0101)]\nrule r {}\n```\n#[not a heading]";
+        assert_eq!(plain(md), "Example\nSome `x`.\n    #[allow(E0101)]\n    rule r {}\n#[not a heading]");
+    }
 }

@@ -1,7 +1,7 @@
-//! `situ check FILE… [--format human|json|sarif] [--deny-warnings]`.
+//! `situ check FILE… [--format human|json|sarif] [--deny-warnings] [--watch]`.
 
 use super::{FAILED, OK, USAGE};
-use situ_compiler::loader::FsLoader;
+use situ_compiler::loader::{FsLoader, Loader};
 use situ_compiler::render;
 use std::path::PathBuf;
 
@@ -16,15 +16,25 @@ pub enum Format {
     Sarif,
 }
 
-pub fn run(files: &[PathBuf], format: Format, deny_warnings: bool) -> u8 {
+pub fn run(files: &[PathBuf], format: Format, deny_warnings: bool, watch: bool) -> u8 {
+    if watch {
+        let machine = !matches!(format, Format::Human);
+        return super::watch::run(|loader| check_all(files, format, deny_warnings, loader).1, machine);
+    }
+    check_all(files, format, deny_warnings, &FsLoader).0
+}
+
+/// Checks every root and prints the report; the exit code and a one-line
+/// summary of the whole (for `--watch`).
+fn check_all(files: &[PathBuf], format: Format, deny_warnings: bool, loader: &dyn Loader) -> (u8, String) {
     let mut checks = Vec::new();
-    let mut io_failed = false;
+    let mut failures = Vec::new();
     for path in files {
-        match situ_compiler::check(path, &FsLoader) {
+        match situ_compiler::check(path, loader) {
             Ok(checked) => checks.push((path, checked)),
             Err(err) => {
                 eprintln!("error: {err}");
-                io_failed = true;
+                failures.push(err);
             }
         }
     }
@@ -37,22 +47,37 @@ pub fn run(files: &[PathBuf], format: Format, deny_warnings: bool) -> u8 {
             }
         }
         Format::Json => {
+            for failure in &failures {
+                print!("{}", render::json_failure(failure));
+            }
             for (_, checked) in &checks {
                 print!("{}", render::json_lines(checked));
             }
         }
         Format::Sarif => {
             let all: Vec<_> = checks.iter().map(|(_, c)| c).collect();
-            println!("{}", render::sarif(&all));
+            let failed: Vec<_> = failures.iter().collect();
+            println!("{}", render::sarif_with_failures(&all, &failed));
         }
     }
-    if io_failed {
+    let code = if !failures.is_empty() {
         USAGE
     } else if checks.iter().any(|(_, c)| c.fails(deny_warnings)) {
         FAILED
     } else {
         OK
+    };
+    let (errors, warnings) = checks.iter().fold((0, 0), |(e, w), (_, c)| (e + c.errors(), w + c.warnings()));
+    let mut parts = Vec::new();
+    if errors + warnings > 0 || failures.is_empty() {
+        parts.push(if errors + warnings > 0 {
+            format!("{}, {}", count(errors, "error"), count(warnings, "warning"))
+        } else {
+            "no findings".to_string()
+        });
     }
+    parts.extend(failures.iter().map(|f| format!("cannot read `{}`", f.path.display())));
+    (code, parts.join("; "))
 }
 
 fn summary(path: &std::path::Path, c: &situ_compiler::Checked) -> String {

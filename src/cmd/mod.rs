@@ -9,12 +9,14 @@ pub mod export;
 pub mod fmt;
 pub mod gen;
 pub mod graph;
+pub mod manners;
 pub mod program;
 pub mod repl;
 pub mod replay;
 pub mod run;
 pub mod scripted;
 pub mod test;
+pub mod watch;
 
 use std::io::IsTerminal;
 use std::path::Path;
