@@ -6,8 +6,12 @@
 //! What is fed: the accepted events of `/situ/events` and the heartbeats of
 //! `/situ/ticks`, in the order they were recorded. Time comes from them
 //! only, so the replay is exact: the same bundle gives the same changes.
+//!
+//! A recording cut short (a run that was killed) is replayed up to the cut
+//! and the report says so ([`ReplayReport::cut`]); a damaged recording, or
+//! one with nothing of situ's in it, is an error.
 
-use crate::record::mcap::{read_messages, topics};
+use crate::record::mcap::{read_recording, topics, Reading};
 use crate::rete::{format_time, Engine};
 use serde::Serialize;
 use serde_json::Value as Json;
@@ -42,6 +46,8 @@ pub struct ReplayReport {
     pub first_difference: Option<usize>,
     /// The recording ends abruptly (a run that was killed).
     pub cut: bool,
+    /// Where and why it ends abruptly.
+    pub cut_reason: Option<String>,
 }
 
 impl ReplayReport {
@@ -51,16 +57,27 @@ impl ReplayReport {
 
     /// What a person reads.
     pub fn describe(&self) -> String {
-        let mut s = format!(
-            "{} events and {} heartbeats replayed{}",
-            self.events,
-            self.ticks,
-            if self.cut { " (the recording ends abruptly: everything before the cut)" } else { "" }
-        );
+        let mut s = format!("{} events and {} heartbeats replayed", self.events, self.ticks);
+        if self.cut {
+            s.push_str(&format!(
+                " (the recording ends abruptly: everything before the cut)\ncut short: {}",
+                self.cut_reason.as_deref().unwrap_or("it ends abruptly")
+            ));
+        }
         if !self.skipped.is_empty() {
             s.push_str(&format!("\n{} recorded events skipped: {}", self.skipped.len(), summarize(&self.skipped)));
         }
+        let beyond = self.replayed.len().saturating_sub(self.recorded.len());
+        if self.cut && beyond > 0 {
+            s.push_str(&format!(
+                "\n{beyond} replayed changes after the last recorded one: not compared (the recording ends first)"
+            ));
+        }
         match self.first_difference {
+            None if self.cut => s.push_str(&format!(
+                "\nsame states up to the cut: {} changes, identical (what came after the cut is not in the recording)",
+                self.recorded.len()
+            )),
             None => s.push_str(&format!("\nsame states: {} changes, identical", self.recorded.len())),
             Some(i) => {
                 s.push_str(&format!("\nthe states differ at change {} of {}:", i + 1, self.recorded.len()));
@@ -88,7 +105,20 @@ fn summarize(items: &[String]) -> String {
 
 /// Replays a recording's bytes on `content`.
 pub fn replay(recording: &[u8], content: Arc<Content>) -> Result<ReplayReport, String> {
-    let (messages, cut) = read_messages(recording)?;
+    replay_reading(&read_recording(recording)?, content)
+}
+
+/// Replays a recording read by [`read_recording`] on `content`; an error
+/// when it holds no message of situ's own channels (nothing to replay).
+pub fn replay_reading(reading: &Reading, content: Arc<Content>) -> Result<ReplayReport, String> {
+    let messages = &reading.messages;
+    let ours = [topics::EVENTS, topics::TICKS, topics::STATE];
+    if !messages.iter().any(|(topic, _, _)| ours.contains(&topic.as_str())) {
+        return Err(match &reading.cut {
+            Some(why) => format!("nothing to replay before the cut: {why}"),
+            None => format!("no message on {}: not a recording of a situ run", ours.join(", ")),
+        });
+    }
     let mut engine = Engine::new(content.clone());
     let mut report = ReplayReport {
         events: 0,
@@ -97,10 +127,11 @@ pub fn replay(recording: &[u8], content: Arc<Content>) -> Result<ReplayReport, S
         recorded: Vec::new(),
         replayed: Vec::new(),
         first_difference: None,
-        cut,
+        cut: reading.cut.is_some(),
+        cut_reason: reading.cut.clone(),
     };
     let name = |s: u32| content.states[s as usize].name.clone();
-    for (topic, time, msg) in &messages {
+    for (topic, time, msg) in messages {
         let outcome = match topic.as_str() {
             topics::EVENTS if msg["accepted"] == Json::Bool(true) => match event_of(&content, msg) {
                 Ok((event, payload)) => {
@@ -143,7 +174,9 @@ pub fn replay(recording: &[u8], content: Arc<Content>) -> Result<ReplayReport, S
             Err(e) => report.skipped.push(format!("cascade error: {}", e.describe(&content))),
         }
     }
-    let n = report.recorded.len().max(report.replayed.len());
+    // Cut short, the recording may end between an event and the change it
+    // made: changes replayed past the last recorded one are not compared.
+    let n = if report.cut { report.recorded.len() } else { report.recorded.len().max(report.replayed.len()) };
     report.first_difference = (0..n).find(|&i| report.recorded.get(i) != report.replayed.get(i));
     Ok(report)
 }

@@ -2,11 +2,18 @@
 //! recording's events to a bundle — the one attached to the recording, or
 //! `--bundle` (a bundle or a `.situ` source) — and reports where the states
 //! differ from the recorded ones. Exit 0 when they are the same, 1 when
-//! they differ, 2 on an unreadable recording or bundle.
+//! they differ, 2 on an unreadable recording or bundle: not a regular file,
+//! larger than 1 GiB, not MCAP, damaged (a record or chunk that does not
+//! hold together), or with nothing of situ's to replay.
+//!
+//! A recording cut short (a run that was killed: no summary, or a last
+//! record cut off) is replayed up to the cut; the report and a warning on
+//! standard error say so, and the exit code compares what was replayed
+//! (0 the same, 1 different).
 
 use super::{FAILED, OK, USAGE};
 use situ_compiler::bundle;
-use situ_runtime::record::mcap::attached_bundle;
+use situ_runtime::record::mcap::{attached_bundle, read_file, read_recording};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -17,10 +24,17 @@ pub enum Format {
 }
 
 pub fn run(recording: &Path, bundle_path: Option<&PathBuf>, format: Format) -> u8 {
-    let bytes = match std::fs::read(recording) {
+    let bytes = match read_file(recording) {
         Ok(b) => b,
         Err(e) => {
-            eprintln!("error: cannot read `{}`: {e}", recording.display());
+            eprintln!("error: `{}`: {e}", recording.display());
+            return USAGE;
+        }
+    };
+    let reading = match read_recording(&bytes) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: `{}` is not a readable recording: {e}", recording.display());
             return USAGE;
         }
     };
@@ -41,13 +55,20 @@ pub fn run(recording: &Path, bundle_path: Option<&PathBuf>, format: Format) -> u
             }
         },
     };
-    let report = match situ_runtime::replay::replay(&bytes, content) {
+    let report = match situ_runtime::replay::replay_reading(&reading, content) {
         Ok(r) => r,
         Err(e) => {
             eprintln!("error: `{}`: {e}", recording.display());
             return USAGE;
         }
     };
+    if let Some(why) = &report.cut_reason {
+        eprintln!(
+            "warning: `{}` is cut short ({} messages read): {why}; the replay covers the part before the cut",
+            recording.display(),
+            reading.messages.len()
+        );
+    }
     match format {
         Format::Human => println!("{}", report.describe()),
         Format::Json => println!("{}", serde_json::to_string(&report).expect("the report serializes")),

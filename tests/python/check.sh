@@ -36,3 +36,20 @@ cd "$root"
 "$venv/bin/python" "$here/read_mcap.py" "$work/mower.mcap" --stand-ins | tee "$work/mower-read.txt"
 grep -q "states: RAIN_PAUSE -> MOWING -> STUCK -> MOWING -> DOCKING -> CHARGING -> MOWING -> FAULT" "$work/mower-read.txt" \
   || { echo "check.sh: FAILED: the mower's recording does not hold the script's states" >&2; exit 1; }
+
+# A run killed with SIGKILL mid-recording: every flush left a valid file,
+# so the standard reader (make_reader) reads everything up to the kill.
+"$situ" run examples/fig5/fig5.situ --stack demo --duration 120 --record "$work/killed.mcap" > /dev/null 2>&1 &
+pid=$!
+grown=0; last=0
+for _ in $(seq 1 600); do   # at most 60 s
+  sleep 0.1
+  size=$(stat -c %s "$work/killed.mcap" 2>/dev/null || echo 0)
+  if (( size > last )); then grown=$((grown + 1)); last=$size; fi
+  (( grown >= 3 )) && break
+done
+kill -9 "$pid" 2>/dev/null || true
+wait "$pid" 2>/dev/null || true
+(( grown >= 3 )) || { echo "check.sh: FAILED: the killed run's recording did not grow" >&2; exit 1; }
+"$venv/bin/python" "$here/read_killed.py" "$work/killed.mcap" \
+  || { echo "check.sh: FAILED: the recording of a killed run does not read with make_reader" >&2; exit 1; }

@@ -18,22 +18,34 @@
 //!
 //! The bundle that ran is attached (`bundle.json`), so that a replay needs
 //! nothing else. Chunks are closed and the file flushed at least once a
-//! second (of wall time) while records come, so a process killed mid-run
-//! loses at most its last second of records; the file then has no summary,
-//! and readers that stream it (`situ replay`, `mcap` in Python with its
-//! non-seeking reader) read everything before the cut.
+//! second (of wall time, or of the messages' time for simulated runs) while
+//! records come. Each chunk is written whole, and every flush leaves a
+//! valid MCAP file (the records so far and a provisional end, see
+//! [`staged`]), so a process killed mid-run loses at most its last second
+//! of records and every reader (`situ replay`, Python's `mcap` with
+//! `make_reader`, Foxglove) reads everything before the cut. Reading back
+//! is bounded ([`read`]): a damaged file is an error, never an abort.
 
 use super::{DataRecord, EventRecord, Level, ModeRecord, Sink, Verdict};
 use crate::rete::{describe_fact, format_time, MatchedFact, StateChange};
 use mcap::records::MessageHeader;
 use serde_json::{json, Value as Json};
 use situ_compiler::bundle::{Content, FieldType, Value};
+use staged::Staged;
 use std::collections::BTreeMap;
 use std::fs::File;
-use std::io::{self, BufWriter};
+use std::io;
 use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
+
+pub mod read;
+pub mod staged;
+#[cfg(test)]
+mod tests;
+
+pub use read::{attached_bundle, read_file, read_messages, read_recording, Reading};
 
 /// Topic names, for readers.
 pub mod topics {
@@ -48,6 +60,10 @@ pub mod topics {
 
 /// How often chunks are closed and the file flushed, at most.
 pub const FLUSH_EVERY: Duration = Duration::from_secs(1);
+
+/// Message bytes after which a flush comes whatever the time (what a
+/// recording keeps in memory between flushes stays bounded).
+pub const FLUSH_AFTER_BYTES: usize = 16 << 20;
 
 const LOG_SCHEMA: &str = r#"{"title":"foxglove.Log","type":"object","properties":{"timestamp":{"type":"object","properties":{"sec":{"type":"integer","minimum":0},"nsec":{"type":"integer","minimum":0,"maximum":999999999}}},"level":{"type":"integer","description":"0 UNKNOWN, 1 DEBUG, 2 INFO, 3 WARNING, 4 ERROR, 5 FATAL"},"message":{"type":"string"},"name":{"type":"string"},"file":{"type":"string"},"line":{"type":"integer","minimum":0}}}"#;
 
@@ -69,7 +85,11 @@ struct Channels {
 pub type Counts = BTreeMap<String, u64>;
 
 pub struct McapRecorder {
-    writer: Option<mcap::Writer<BufWriter<File>>>,
+    writer: Option<mcap::Writer<Staged>>,
+    /// Set before the summary is written (see [`staged`]).
+    finishing: Arc<AtomicBool>,
+    /// Message bytes written since the last flush.
+    since_flush: usize,
     content: Arc<Content>,
     channels: Channels,
     counts: Counts,
@@ -91,11 +111,14 @@ impl McapRecorder {
     /// Starts a recording at `path` for the bundle `content` (its file bytes
     /// in `bundle`, attached for replays).
     pub fn create(path: &Path, content: Arc<Content>, bundle: &[u8]) -> io::Result<McapRecorder> {
-        let file = BufWriter::new(File::create(path)?);
+        let (file, finishing) = Staged::new(File::create(path)?);
+        // Seeking disabled: each chunk is buffered and written whole, so no
+        // chunk with a placeholder length is ever on disk.
         let mut w = mcap::WriteOptions::new()
             .compression(Some(mcap::Compression::Zstd))
             .profile("")
             .library(format!("situ {}", env!("CARGO_PKG_VERSION")))
+            .disable_seeking(true)
             .create(file)
             .map_err(mcap_err)?;
         let mut channel = |topic: &str, name: &str, schema_text: &str| -> io::Result<u16> {
@@ -155,8 +178,12 @@ impl McapRecorder {
             data: std::borrow::Cow::Borrowed(bundle),
         })
         .map_err(mcap_err)?;
+        // A valid file from the start: the header and the bundle.
+        w.flush().map_err(mcap_err)?;
         Ok(McapRecorder {
             writer: Some(w),
+            finishing,
+            since_flush: 0,
             content,
             channels,
             counts: Counts::new(),
@@ -213,6 +240,10 @@ impl McapRecorder {
             None => {
                 self.counts.insert(topic.to_string(), 1);
             }
+        }
+        self.since_flush = self.since_flush.saturating_add(bytes.len());
+        if self.since_flush >= FLUSH_AFTER_BYTES {
+            let _ = self.flush();
         }
         match self.by_message_time {
             Some(last) => {
@@ -344,6 +375,7 @@ impl Sink for McapRecorder {
 
     fn flush(&mut self) -> io::Result<()> {
         self.last_flush = Instant::now();
+        self.since_flush = 0;
         if let Some(w) = self.writer.as_mut() {
             w.flush().map_err(mcap_err)?;
         }
@@ -355,6 +387,9 @@ impl Sink for McapRecorder {
 
     fn finish(&mut self) -> io::Result<()> {
         if let Some(mut w) = self.writer.take() {
+            // The summary, the footer and the magic, written over the last
+            // provisional end (the writer flushes once they are written).
+            self.finishing.store(true, Ordering::SeqCst);
             w.finish().map_err(mcap_err)?;
         }
         match self.error.take() {
@@ -373,40 +408,3 @@ impl Drop for McapRecorder {
 
 /// A recorded message: its topic, its log time (ns) and its JSON.
 pub type Recorded = (String, u64, Json);
-
-/// Reads every message of a recording, whole or cut short, in file order,
-/// and whether the file was cut short.
-pub fn read_messages(bytes: &[u8]) -> Result<(Vec<Recorded>, bool), String> {
-    let stream = mcap::MessageStream::new_with_options(bytes, mcap::read::Options::IgnoreEndMagic.into())
-        .map_err(|e| format!("not an MCAP file: {e}"))?;
-    let mut out = Vec::new();
-    let mut cut = false;
-    for m in stream {
-        match m {
-            Ok(m) => {
-                let json: Json = serde_json::from_slice(&m.data).unwrap_or(Json::Null);
-                out.push((m.channel.topic.clone(), m.log_time, json));
-            }
-            Err(_) => {
-                cut = true;
-                break;
-            }
-        }
-    }
-    Ok((out, cut))
-}
-
-/// The bundle attached to a recording, if any.
-pub fn attached_bundle(bytes: &[u8]) -> Option<Vec<u8>> {
-    let stream = mcap::read::LinearReader::new_with_options(bytes, mcap::read::Options::IgnoreEndMagic.into()).ok()?;
-    for record in stream {
-        match record {
-            Ok(mcap::records::Record::Attachment { header, data, .. }) if header.name == "bundle.json" => {
-                return Some(data.into_owned());
-            }
-            Ok(_) => {}
-            Err(_) => break,
-        }
-    }
-    None
-}
