@@ -4,6 +4,8 @@
 //!
 //! ```toml
 //! robot = "amr"                      # the key prefix: situ/amr/…
+//! max_skew_ms = 50                   # optional: events stamped further ahead
+//!                                    # of the Bulletinboard's clock are refused
 //!
 //! [tls]                              # optional: TLS with client certificates
 //! ca = "certs/ca.pem"                # (mTLS) and access control by name
@@ -34,6 +36,10 @@ use std::path::{Path, PathBuf};
 #[serde(deny_unknown_fields)]
 pub struct Deployment {
     pub robot: String,
+    /// How far ahead of the Bulletinboard's clock an event may be stamped
+    /// (ms); [`DEFAULT_MAX_SKEW_MS`] when not given.
+    #[serde(default)]
+    pub max_skew_ms: Option<u64>,
     #[serde(default)]
     pub tls: Option<Tls>,
     #[serde(rename = "process")]
@@ -82,6 +88,14 @@ impl Process {
     }
 }
 
+/// How far ahead of the Bulletinboard's clock an event may be stamped,
+/// when the file does not say (the runtime's default).
+pub const DEFAULT_MAX_SKEW_MS: u64 = situ_runtime::stack::DEFAULT_MAX_SKEW / 1_000_000;
+
+/// The largest `max_skew_ms` a file may give: beyond, one event could age
+/// every fact of a typical stack past its `stale after`.
+pub const MAX_SKEW_LIMIT_MS: u64 = 10_000;
+
 /// Why a deployment file is refused.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct DeployError(pub String);
@@ -109,6 +123,12 @@ impl Deployment {
         let d: Deployment = toml::from_str(text).map_err(|e| DeployError(e.to_string()))?;
         if d.robot.is_empty() || !d.robot.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
             return Err(DeployError(format!("`robot = \"{}\"`: letters, digits, `_` and `-` only", d.robot)));
+        }
+        if d.max_skew_ms.is_some_and(|ms| ms > MAX_SKEW_LIMIT_MS) {
+            return Err(DeployError(format!(
+                "`max_skew_ms = {}`: at most {MAX_SKEW_LIMIT_MS} (the default is {DEFAULT_MAX_SKEW_MS})",
+                d.max_skew_ms.unwrap_or_default()
+            )));
         }
         let boards: Vec<&str> = d.processes.iter().filter(|p| p.board).map(|p| p.name.as_str()).collect();
         if boards.len() != 1 {
@@ -154,6 +174,11 @@ impl Deployment {
             }
         }
         Ok(d)
+    }
+
+    /// How far ahead of the Bulletinboard's clock an event may be stamped.
+    pub fn max_skew(&self) -> std::time::Duration {
+        std::time::Duration::from_millis(self.max_skew_ms.unwrap_or(DEFAULT_MAX_SKEW_MS))
     }
 
     pub fn process(&self, name: &str) -> Option<&Process> {
@@ -264,6 +289,9 @@ connect = ["tcp/127.0.0.1:7447"]
         assert_eq!(cfg["scouting"]["multicast"]["enabled"], false);
         assert_eq!(cfg["connect"]["endpoints"][0], "tcp/127.0.0.1:7447");
         assert!(cfg.get("access_control").is_none());
+        assert_eq!(d.max_skew(), std::time::Duration::from_millis(DEFAULT_MAX_SKEW_MS));
+        let d = Deployment::parse(&GOOD.replace("robot = \"amr\"", "robot = \"amr\"\nmax_skew_ms = 5"), &agents());
+        assert_eq!(d.unwrap().max_skew(), std::time::Duration::from_millis(5));
     }
 
     #[test]
@@ -281,6 +309,7 @@ connect = ["tcp/127.0.0.1:7447"]
             (GOOD.replace("robot = \"amr\"", "robot = \"a/b\""), "letters, digits"),
             (GOOD.replace("agents = [", "agent = ["), "unknown field `agent`"),
             (format!("{GOOD}\n[tls]\nca = \"ca.pem\"\n"), "use `tls/` endpoints"),
+            (GOOD.replace("robot = \"amr\"", "robot = \"amr\"\nmax_skew_ms = 3600000"), "at most 10000"),
         ];
         for (text, want) in cases {
             let e = Deployment::parse(&text, &agents()).unwrap_err().to_string();

@@ -14,6 +14,7 @@
 //! is batched (throughput first).
 
 pub mod deploy;
+pub mod limit;
 pub mod wire;
 
 use situ_compiler::bundle::Content;
@@ -44,6 +45,18 @@ struct Counters {
     published: AtomicU64,
 }
 
+/// The reasons kept between two [`Bus::take_refusals`], at most.
+const REASONS_KEPT: usize = 100;
+
+/// Refusals not yet reported: the first reasons word for word, how many
+/// more there were, and per agent the events refused over its limit.
+#[derive(Default)]
+struct Refusals {
+    reasons: Vec<String>,
+    omitted: u64,
+    flooded: Vec<u64>,
+}
+
 pub struct ZenohBus {
     local: Arc<InProc>,
     session: zenoh::Session,
@@ -51,7 +64,9 @@ pub struct ZenohBus {
     placement: Placement,
     counters: Arc<Counters>,
     /// The latest refusals, for whoever reports them.
-    refusals: Arc<Mutex<Vec<String>>>,
+    refusals: Arc<Mutex<Refusals>>,
+    /// Per agent, the events refused for going over its limit.
+    limits: Arc<Mutex<limit::EventLimits>>,
     _subscribers: Vec<zenoh::pubsub::Subscriber<()>>,
 }
 
@@ -81,7 +96,8 @@ impl ZenohBus {
             zenoh::open(config).wait().map_err(|e| BusError(format!("cannot open the Zenoh session: {e}")))?;
         let local = Arc::new(InProc::new(content.agents.len(), capacity));
         let counters = Arc::new(Counters::default());
-        let refusals = Arc::new(Mutex::new(Vec::new()));
+        let refusals = Arc::new(Mutex::new(Refusals { flooded: vec![0; content.agents.len()], ..Refusals::default() }));
+        let limits = Arc::new(Mutex::new(limit::EventLimits::new(&content)));
         let robot = placement.robot.clone();
         let mut subscribers = Vec::new();
         let refuse = {
@@ -89,13 +105,27 @@ impl ZenohBus {
             move |why: String| {
                 counters.rejected.fetch_add(1, Ordering::Relaxed);
                 let mut r = refusals.lock().unwrap_or_else(|p| p.into_inner());
-                if r.len() < 1000 {
-                    r.push(why);
+                if r.reasons.len() < REASONS_KEPT {
+                    r.reasons.push(why);
+                } else {
+                    r.omitted += 1;
+                }
+            }
+        };
+        // An event over its agent's limit: counted, and reported as one
+        // line per agent (a flood must not become a flood of records).
+        let flooded = {
+            let (counters, refusals) = (counters.clone(), refusals.clone());
+            move |agent: u32| {
+                counters.rejected.fetch_add(1, Ordering::Relaxed);
+                let mut r = refusals.lock().unwrap_or_else(|p| p.into_inner());
+                if let Some(n) = r.flooded.get_mut(agent as usize) {
+                    *n += 1;
                 }
             }
         };
         if placement.board {
-            let (local, content, refuse) = (local.clone(), content.clone(), refuse.clone());
+            let (local, content, refuse, limits) = (local.clone(), content.clone(), refuse.clone(), limits.clone());
             let prefix = format!("situ/{robot}/event/");
             let sub = session
                 .declare_subscriber(format!("situ/{robot}/event/*"))
@@ -106,7 +136,19 @@ impl ZenohBus {
                     match wire::parse::<EventWire>(&bytes) {
                         Ok(w) => match wire::event_of(&content, key_agent, &w) {
                             Ok((agent, event, payload)) => {
-                                local.send_event(EventMsg { agent, event, time: w.time_ns, payload, urgent: w.urgent })
+                                let within =
+                                    limits.lock().unwrap_or_else(|p| p.into_inner()).take(agent, Instant::now());
+                                if within {
+                                    local.send_event(EventMsg {
+                                        agent,
+                                        event,
+                                        time: w.time_ns,
+                                        payload,
+                                        urgent: w.urgent,
+                                    })
+                                } else {
+                                    flooded(agent)
+                                }
                             }
                             Err(e) => refuse(format!("{key}: {e}")),
                         },
@@ -162,7 +204,7 @@ impl ZenohBus {
                 .map_err(|e| BusError(format!("cannot subscribe to data: {e}")))?;
             subscribers.push(sub);
         }
-        Ok(ZenohBus { local, session, content, placement, counters, refusals, _subscribers: subscribers })
+        Ok(ZenohBus { local, session, content, placement, counters, refusals, limits, _subscribers: subscribers })
     }
 
     /// Publishes; `express` messages skip Zenoh's batching (status,
@@ -262,9 +304,25 @@ impl Bus for ZenohBus {
     fn close(&self) {
         self.local.close();
     }
-    /// The latest refused messages (at most 1,000 kept between calls).
+    /// The latest refused messages (at most 100 word for word between
+    /// calls, then how many more), and one line per agent whose events
+    /// went over its limit.
     fn take_refusals(&self) -> Vec<String> {
-        std::mem::take(&mut *self.refusals.lock().unwrap_or_else(|p| p.into_inner()))
+        let mut r = self.refusals.lock().unwrap_or_else(|p| p.into_inner());
+        let mut out = std::mem::take(&mut r.reasons);
+        if r.omitted > 0 {
+            out.push(format!("and {} more message(s) refused", std::mem::take(&mut r.omitted)));
+        }
+        let limits = self.limits.lock().unwrap_or_else(|p| p.into_inner());
+        for (a, n) in r.flooded.iter_mut().enumerate().filter(|(_, n)| **n > 0) {
+            let per_s = limits.per_second(a as u32);
+            out.push(format!(
+                "{} event(s) of `{}` refused: over its limit of {per_s} per second (a flood)",
+                std::mem::take(n),
+                self.content.agents[a].name
+            ));
+        }
+        out
     }
     fn counters(&self) -> BusCounters {
         let mut c = self.local.counters();

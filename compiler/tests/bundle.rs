@@ -116,6 +116,31 @@ fn a_rehashed_content_that_lies_is_refused_as_invalid() {
     assert!(matches!(decode(&encode(&c, Encoding::Binary)), Err(LoadError::Invalid { .. })));
 }
 
+#[test]
+fn a_rate_out_of_range_is_refused_naming_the_agent() {
+    let ladar = outdoor().agent_id("LADAR").expect("LADAR") as usize;
+    for hz in [0.0, -10.0, 1e308, 1e9, 1000.5, 0.0005, f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        let mut c = outdoor();
+        c.agents[ladar].rate_hz = Some(hz);
+        // JSON has no NaN or infinity: those go through the binary encoding.
+        let encodings: &[Encoding] =
+            if hz.is_finite() { &[Encoding::Json, Encoding::Binary] } else { &[Encoding::Binary] };
+        for &enc in encodings {
+            match decode(&encode(&c, enc)) {
+                Err(e @ LoadError::Invalid { .. }) => {
+                    assert!(e.to_string().contains("agent `LADAR` has rate"), "{hz} {enc:?}: {e}")
+                }
+                other => panic!("{hz} {enc:?}: {other:?}"),
+            }
+        }
+    }
+    for hz in [bundle::MIN_RATE_HZ, 10.0, bundle::MAX_RATE_HZ] {
+        let mut c = outdoor();
+        c.agents[ladar].rate_hz = Some(hz);
+        assert_eq!(decode(&encode(&c, Encoding::Binary)).expect("in range"), c, "{hz}");
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
 

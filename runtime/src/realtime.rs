@@ -47,6 +47,9 @@ pub struct RealtimeConfig {
     pub safe_after: Duration,
     /// Raised from outside (Ctrl-C, SIGTERM): the run ends cleanly.
     pub stop: Option<Arc<AtomicBool>>,
+    /// How far ahead of the Bulletinboard's clock an event may be stamped
+    /// (further is refused: it would age every other fact).
+    pub max_skew: Duration,
 }
 
 impl Default for RealtimeConfig {
@@ -61,6 +64,7 @@ impl Default for RealtimeConfig {
             status_every: Duration::from_millis(200),
             safe_after: Duration::from_millis(600),
             stop: None,
+            max_skew: Duration::from_nanos(crate::stack::DEFAULT_MAX_SKEW),
         }
     }
 }
@@ -110,6 +114,7 @@ pub fn run_on(
     // Steps of agents that were not sleeping, since the summary last took them.
     let steps = &AtomicU64::new(0);
     let mut board = BoardRunner::new(content.clone());
+    board.set_max_skew(config.max_skew.as_nanos().min(u64::MAX as u128) as u64);
     let mut summary = Summary::new(&content).starting_at(epoch);
     if config.board {
         board.start(&shared, epoch);
@@ -178,14 +183,16 @@ pub fn run_on(
                 }
                 let _ = shared.bus.wait_events(next_beat.min(end));
                 let mut changes = board.pump(&shared, clock());
-                for why in shared.bus.take_refusals() {
-                    shared.record(|s| {
-                        s.diagnostic(clock(), crate::record::Level::Warning, &format!("message refused: {why}"))
-                    });
-                }
                 let now = Instant::now();
                 if now >= next_beat {
                     next_beat += config.heartbeat;
+                    // At most once a heartbeat: a flood of refusals is a
+                    // few records a period, not one per message.
+                    for why in shared.bus.take_refusals() {
+                        shared.record(|s| {
+                            s.diagnostic(clock(), crate::record::Level::Warning, &format!("message refused: {why}"))
+                        });
+                    }
                     changes.extend(board.tick(&shared, clock()));
                 }
                 if now >= next_status {
@@ -203,6 +210,9 @@ pub fn run_on(
             }
         }
         stop.store(true, Ordering::Release);
+        for why in shared.bus.take_refusals() {
+            shared.record(|s| s.diagnostic(clock(), crate::record::Level::Warning, &format!("message refused: {why}")));
+        }
         shared.bus.close();
     });
     let agents = std::mem::take(&mut *counters.lock().unwrap_or_else(|p| p.into_inner()));

@@ -286,12 +286,21 @@ pub struct BoardCounters {
     pub fired: BTreeMap<String, u64>,
 }
 
+/// How far ahead of the Bulletinboard's clock an event may be stamped, by
+/// default (ns): hosts kept in time by NTP on a local network agree within
+/// a few milliseconds, and 50 ms is a sixth of a typical `stale after`
+/// (300 ms), so that the events it lets through age the other facts by
+/// little.
+pub const DEFAULT_MAX_SKEW: u64 = 50_000_000;
+
 /// The events monitor of the Bulletinboard.
 pub struct BoardRunner {
     pub board: Bulletinboard,
     pub counters: BoardCounters,
     /// Per agent, the time of its latest accepted event.
     last_time: Vec<u64>,
+    /// How far ahead of the clock an event may be stamped (ns).
+    max_skew: u64,
     /// Per event, per field: compared with something by a rule.
     compared: Vec<Vec<bool>>,
     events: Vec<EventMsg>,
@@ -325,6 +334,7 @@ impl BoardRunner {
         let overflow_event = content.event_id("BUSOVF");
         BoardRunner {
             last_time: vec![0; content.agents.len()],
+            max_skew: DEFAULT_MAX_SKEW,
             modes: vec![None; content.agents.len()],
             board: Bulletinboard::new(content),
             counters: BoardCounters::default(),
@@ -333,6 +343,12 @@ impl BoardRunner {
             overflow_event,
             status_seq: 0,
         }
+    }
+
+    /// How far ahead of the Bulletinboard's clock (the `now` of
+    /// [`pump`](Self::pump)) an event may be stamped; further is refused.
+    pub fn set_max_skew(&mut self, ns: u64) {
+        self.max_skew = ns;
     }
 
     /// Broadcasts the initial status and records the initial modes.
@@ -365,7 +381,7 @@ impl BoardRunner {
         }
         let events = std::mem::take(&mut self.events);
         for msg in &events {
-            if let Some(c) = self.take(shared, msg) {
+            if let Some(c) = self.take(shared, msg, now) {
                 changes.push(c);
             }
         }
@@ -403,8 +419,8 @@ impl BoardRunner {
             .collect()
     }
 
-    /// Why an event is refused, if it is.
-    fn check(&self, c: &Content, msg: &EventMsg) -> Option<String> {
+    /// Why an event is refused, if it is; `now` is the Bulletinboard's clock.
+    fn check(&self, c: &Content, msg: &EventMsg, now: u64) -> Option<String> {
         let Some(def) = c.events.get(msg.event as usize) else {
             return Some(format!("unknown event id {}", msg.event));
         };
@@ -428,6 +444,17 @@ impl BoardRunner {
                 }
             }
         }
+        // Time at the boundary: an event from the future would move the
+        // clock and age every other fact (one stamped at 2^63 ns would end
+        // the mission); one behind its agent's previous event is out of order.
+        if msg.time > now.saturating_add(self.max_skew) {
+            return Some(format!(
+                "from the future: at {} ns, {} ns ahead of the Bulletinboard's clock (at most {} ns)",
+                msg.time,
+                msg.time - now,
+                self.max_skew
+            ));
+        }
         let last = self.last_time[msg.agent as usize];
         if msg.time < last {
             return Some(format!("out of order: at {} ns, after an event at {last} ns", msg.time));
@@ -435,9 +462,9 @@ impl BoardRunner {
         None
     }
 
-    fn take(&mut self, shared: &Shared, msg: &EventMsg) -> Option<StateChange> {
+    fn take(&mut self, shared: &Shared, msg: &EventMsg, now: u64) -> Option<StateChange> {
         let c = shared.content.clone();
-        if let Some(reason) = self.check(&c, msg) {
+        if let Some(reason) = self.check(&c, msg, now) {
             let key = reason_key(&reason);
             *self.counters.refused.entry(key).or_default() += 1;
             let rec = record_of(msg, Verdict::Refused(reason.clone()));
@@ -551,6 +578,8 @@ fn reason_key(reason: &str) -> String {
         "not a number".into()
     } else if reason.starts_with("out of order") {
         "out of order".into()
+    } else if reason.starts_with("from the future") {
+        "from the future".into()
     } else {
         "payload".into()
     }

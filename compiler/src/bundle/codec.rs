@@ -261,6 +261,16 @@ pub fn validate(c: &Content) -> Result<(), String> {
         }
     }
     for a in &c.agents {
+        if let Some(hz) = a.rate_hz {
+            if !super::rate_in_range(hz) {
+                return Err(format!(
+                    "agent `{}` has rate {hz} Hz (a rate must be between {} and {} Hz)",
+                    a.name,
+                    super::MIN_RATE_HZ,
+                    super::MAX_RATE_HZ
+                ));
+            }
+        }
         for &e in &a.events {
             idx(&format!("an event of agent `{}`: event", a.name), e, ne)?;
         }

@@ -33,6 +33,27 @@ pub const FORMAT_VERSION: u32 = 1;
 /// The value of the envelope's `format` field.
 pub const FORMAT_NAME: &str = "situ-bundle";
 
+/// The highest `rate` an agent may declare, in Hz (a period of 1 ms).
+///
+/// The Bulletinboard sees time in 10 ms heartbeats, the real-time
+/// scheduler sleeps with the operating system's millisecond granularity,
+/// and the boundary's per-agent event limit is derived from the rate: a
+/// faster rate buys nothing but a flood licence and, in simulated time, a
+/// run that takes longer than the time it simulates. (`docs/language.md`,
+/// 5.3.)
+pub const MAX_RATE_HZ: f64 = 1000.0;
+
+/// The lowest `rate` an agent may declare, in Hz (a period of 1000 s).
+/// Slower than that, an agent is better stepped on input (no `rate`); the
+/// bound also keeps every period, in nanoseconds, far from overflow.
+pub const MIN_RATE_HZ: f64 = 0.001;
+
+/// Whether `hz` is a rate an agent may have: finite, within
+/// [`MIN_RATE_HZ`]..=[`MAX_RATE_HZ`].
+pub fn rate_in_range(hz: f64) -> bool {
+    (MIN_RATE_HZ..=MAX_RATE_HZ).contains(&hz)
+}
+
 /// A checked, compiled program: states, agents, events, rules, the Rete
 /// network and the wiring of every state.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -103,8 +103,10 @@ fn declare_agent(cx: &mut Cx, file: FileId, agent: &ast::Agent) {
             }
             ast::AgentMember::Rate(r) => {
                 if once(cx, file, &mut rate_seen, r.span, "rate") {
-                    if r.hertz > 0.0 && r.hertz.is_finite() {
+                    if crate::bundle::rate_in_range(r.hertz) {
                         cx.model.agents[id.index()].rate_hz = Some(r.hertz);
+                    } else if r.hertz > 0.0 {
+                        rate_out_of_range(cx, file, &agent.name.name, r);
                     } else {
                         cx.positive(file, 0, r.span, "a rate");
                     }
@@ -115,6 +117,34 @@ fn declare_agent(cx: &mut Cx, file: FileId, agent: &ast::Agent) {
             ast::AgentMember::Table(_) | ast::AgentMember::Fsm(_) => {}
         }
     }
+}
+
+/// A positive rate outside [`crate::bundle::MIN_RATE_HZ`]..=[`crate::bundle::MAX_RATE_HZ`].
+fn rate_out_of_range(cx: &mut Cx, file: FileId, agent: &str, r: &ast::RateDecl) {
+    use crate::bundle::{MAX_RATE_HZ, MIN_RATE_HZ};
+    let (label, help) = if r.hertz > MAX_RATE_HZ {
+        (
+            format!("above {MAX_RATE_HZ}Hz"),
+            format!(
+                "step the agent at most every millisecond (`rate {MAX_RATE_HZ}Hz`); a faster source should batch its readings"
+            ),
+        )
+    } else {
+        (
+            format!("below {MIN_RATE_HZ}Hz"),
+            "leave `rate` out: an agent without one is stepped when data or a new status arrives".to_string(),
+        )
+    };
+    cx.diags.push(
+        Diagnostic::error(
+            codes::RATE_OUT_OF_RANGE,
+            format!("the rate of agent `{agent}` is out of range ({MIN_RATE_HZ}Hz to {MAX_RATE_HZ}Hz)"),
+            file,
+            r.span,
+            label,
+        )
+        .with_help(help),
+    );
 }
 
 /// Records a member that may appear once; reports the second.
