@@ -10,6 +10,11 @@ use pest::Parser as _;
 use std::num::NonZeroUsize;
 use std::sync::Once;
 
+mod hints;
+mod report;
+
+use report::syntax_error;
+
 /// The pest parser generated from `situ.pest`.
 #[derive(pest_derive::Parser)]
 #[grammar = "situ.pest"]
@@ -97,97 +102,6 @@ pub fn parse(src: &str, file: FileId) -> Parsed {
     Parsed { file: File { items }, comments: lex::comments(src), errors }
 }
 
-/// Turns a pest error into a diagnostic that says what was expected, and
-/// where, in the words of the language.
-fn syntax_error(err: &pest::error::Error<Rule>, text: &str, offset: usize, file: FileId) -> Diagnostic {
-    use pest::error::{ErrorVariant, InputLocation};
-    let pos = match err.location {
-        InputLocation::Pos(p) => p,
-        InputLocation::Span((s, _)) => s,
-    };
-    let mut expected: Vec<String> = Vec::new();
-    if let Some(attempts) = err.parse_attempts() {
-        for token in attempts.expected_tokens() {
-            // `ParsingToken` is not exported by name; only literal tokens help a reader.
-            let text = token.to_string();
-            if format!("{token:?}").starts_with("Sensitive") && !text.trim().is_empty() && text != "//" && text != "_" {
-                push_unique(&mut expected, format!("`{token}`"));
-            }
-        }
-    }
-    let mut custom = None;
-    match &err.variant {
-        ErrorVariant::ParsingError { positives, .. } => {
-            for r in positives {
-                if let Some(name) = describe(*r) {
-                    push_unique(&mut expected, name.to_string());
-                }
-            }
-        }
-        ErrorVariant::CustomError { message } => custom = Some(message.clone()),
-    }
-    let found = describe_found(text, pos);
-    let at = offset + pos;
-    let end = at + found.1;
-    let message = match (&custom, expected.is_empty()) {
-        (Some(m), _) => format!("syntax error: {m}"),
-        (None, true) => format!("syntax error: unexpected {}", found.0),
-        (None, false) => format!("syntax error: expected {}, found {}", one_of(&expected), found.0),
-    };
-    let label =
-        if expected.is_empty() { "unexpected here".to_string() } else { format!("expected {}", one_of(&expected)) };
-    let mut diag = Diagnostic::error(SYNTAX, message, file, Span::new(at, end), label);
-    if let Some(help) = hint(text, pos) {
-        diag = diag.with_help(help);
-    }
-    diag
-}
-
-fn push_unique(list: &mut Vec<String>, s: String) {
-    if !list.contains(&s) {
-        list.push(s);
-    }
-}
-
-fn one_of(items: &[String]) -> String {
-    match items {
-        [] => String::new(),
-        [one] => one.clone(),
-        [init @ .., last] => {
-            let mut init = init.to_vec();
-            init.truncate(8);
-            format!("{} or {}", init.join(", "), last)
-        }
-    }
-}
-
-/// What stands at `pos`: a description and its length in bytes.
-fn describe_found(text: &str, pos: usize) -> (String, usize) {
-    let rest = &text[pos.min(text.len())..];
-    let Some(c) = rest.chars().next() else { return ("the end of the item".into(), 0) };
-    if c.is_alphanumeric() || c == '_' {
-        let word: String = rest.chars().take_while(|c| c.is_alphanumeric() || *c == '_').take(40).collect();
-        (format!("`{word}`"), word.len())
-    } else if c.is_control() {
-        (format!("the character U+{:04X}", c as u32), c.len_utf8())
-    } else {
-        (format!("`{c}`"), c.len_utf8())
-    }
-}
-
-/// A help line for common mistakes.
-fn hint(text: &str, pos: usize) -> Option<String> {
-    let rest = &text[pos.min(text.len())..];
-    let word: String = rest.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
-    if KEYWORDS.contains(&word.as_str()) {
-        return Some(format!("`{word}` is a keyword and cannot be used as a name"));
-    }
-    if rest.starts_with('&') || rest.starts_with('|') {
-        return Some("conditions are joined with `and`; write `or` as two rules".into());
-    }
-    None
-}
-
 /// The reserved words of the language (mirrors `keyword` in the grammar).
 pub const KEYWORDS: &[&str] = &[
     "states",
@@ -244,67 +158,6 @@ pub const KEYWORDS: &[&str] = &[
     "i64",
     "bool",
 ];
-
-/// The words for grammar rules in error messages; `None` for rules that only
-/// ever appear inside others.
-fn describe(r: Rule) -> Option<&'static str> {
-    Some(match r {
-        Rule::ident => "a name",
-        Rule::variable => "a variable (`?name`)",
-        Rule::string => "a string",
-        Rule::int | Rule::uint => "an integer",
-        Rule::float => "a number",
-        Rule::duration => "a duration (`200ms`)",
-        Rule::frequency => "a frequency (`20Hz`)",
-        Rule::literal | Rule::operand => "a value",
-        Rule::include => "`include`",
-        Rule::states_block => "`states`",
-        Rule::agent => "`agent`",
-        Rule::rule => "`rule`",
-        Rule::test => "`test`",
-        Rule::property => "`property`",
-        Rule::script => "`script`",
-        Rule::script_at | Rule::script_every | Rule::script_silent | Rule::script_random => {
-            "a script step (`at`, `every`, `silent`, `random`)"
-        }
-        Rule::script_event => "an event (`Agent.EVENT(field: value)`)",
-        Rule::attribute => "an attribute (`#[allow(...)]`)",
-        Rule::state_decl => "a state",
-        Rule::state_flag => "`initial` or `final`",
-        Rule::agent_kind => "an agent kind (sensor, actuator, processing, interface)",
-        Rule::stale_decl | Rule::rate_decl | Rule::event_decl | Rule::function_decl | Rule::table | Rule::fsm => {
-            "an agent member (event, function, stale, rate, table, fsm)"
-        }
-        Rule::field_decl => "a field (`name: f64`)",
-        Rule::field_type => "a type (f64, i64, bool, {a, b})",
-        Rule::table_entry | Rule::selector => "a table entry (`RS => run f()`)",
-        Rule::action => "`run`, `wait` or `sleep`",
-        Rule::from_links => "`from`",
-        Rule::to_links => "`to`",
-        Rule::fsm_state | Rule::fsm_transition => "an FSM line",
-        Rule::trigger => "a trigger (`state == S` or an event)",
-        Rule::salience => "`salience`",
-        Rule::condition | Rule::cond_term => "a condition",
-        Rule::pattern | Rule::prop_pattern => "an event pattern",
-        Rule::state_test => "a state test (`state == S`)",
-        Rule::stale_test => "a staleness test (`stale AGENT`)",
-        Rule::constraint => "a field constraint",
-        Rule::cmp_op => "a comparison (`<`, `==`, ...)",
-        Rule::range_op => "`..` or `..=`",
-        Rule::run_length => "a run length (`x3`)",
-        Rule::window => "`within`",
-        Rule::given_clause | Rule::on_clause | Rule::expect_clause => "`given`, `on` or `expect`",
-        Rule::event_instance => "an event",
-        Rule::expectation => "an expectation",
-        Rule::mode_word => "`running`, `sleeping` or `waiting`",
-        Rule::quantifier => "`always` or `never`",
-        Rule::formula | Rule::predicate | Rule::atom => "a predicate",
-        Rule::consequent => "a consequent (`next`, `eventually`, or a predicate)",
-        Rule::bound => "`within`",
-        Rule::EOI => "the end of the item",
-        _ => return None,
-    })
-}
 
 /// Builds AST nodes from pest pairs of one item, shifting spans by `offset`.
 pub(crate) struct Builder<'e> {

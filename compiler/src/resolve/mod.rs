@@ -203,9 +203,18 @@ impl Cx {
     /// A count that must be positive.
     fn positive(&mut self, file: FileId, value: u64, span: Span, what: &str) -> bool {
         if value == 0 {
+            // Durations and rates are told what to write; counts, the least count.
+            let help = match what {
+                "a window" => "a window says how recent the event must be: write a positive duration, such as `within 500ms`, or leave the window out",
+                "a stale time" => "write a positive duration, such as `stale after 300ms`, or leave `stale after` out",
+                "a time bound" => "write a positive duration, such as `within 2s`",
+                "a period" => "write a positive period, such as `every 100ms`",
+                "a random section's length" => "write a positive length, such as `random 30s`",
+                "a rate" => "write a positive frequency, such as `rate 10Hz`, or leave `rate` out",
+                _ => "use at least 1 (or leave it out)",
+            };
             self.diags.push(
-                Diagnostic::error(codes::ZERO, format!("{what} must be positive"), file, span, "zero")
-                    .with_help("use at least 1 (or leave it out)"),
+                Diagnostic::error(codes::ZERO, format!("{what} must be positive"), file, span, "zero").with_help(help),
             );
         }
         value > 0
