@@ -143,14 +143,18 @@ fn static_checks() {
     run("tests/checks", Report::Json);
 }
 
-/// The annotations of every input of a folder and of its `include/` files.
+/// The annotations of every input of a folder and of its `include/` files
+/// (in subfolders too).
 fn announced_in(dir: &str) -> BTreeSet<Finding> {
     let mut out = BTreeSet::new();
-    for sub in [dir.to_string(), format!("{dir}/include")] {
+    let mut folders = vec![PathBuf::from(dir), Path::new(dir).join("include")];
+    while let Some(sub) = folders.pop() {
         let Ok(entries) = std::fs::read_dir(&sub) else { continue };
         for e in entries.flatten() {
             let path = e.path();
-            if path.extension().is_some_and(|x| x == "situ") {
+            if path.is_dir() && path.starts_with(Path::new(dir).join("include")) {
+                folders.push(path);
+            } else if path.extension().is_some_and(|x| x == "situ") {
                 let bytes = std::fs::read(&path).expect("readable input");
                 out.extend(annotations(&path.display().to_string(), &String::from_utf8_lossy(&bytes)));
             }

@@ -42,6 +42,7 @@ codes! {
     TOO_DEEP = "E0006", Error, "nesting too deep";
     BAD_LITERAL = "E0007", Error, "literal out of range";
     TOO_MANY_ERRORS = "E0008", Error, "too many syntax errors";
+    INCLUDE_TOO_DEEP = "E0009", Error, "include chain too deep";
     UNDEFINED_STATE = "E0101", Error, "undefined state";
     DUPLICATE = "E0102", Error, "duplicate definition";
     UNDEFINED_AGENT = "E0103", Error, "undefined agent";
@@ -64,6 +65,7 @@ codes! {
     OVERLAPPING_EVERY = "E0120", Error, "periodic script events that overlap";
     BAD_INTERVAL = "E0121", Error, "script interval that is empty or too dense";
     EVENT_IN_SILENCE = "E0122", Error, "script event of an agent told to be silent";
+    RATE_OUT_OF_RANGE = "E0123", Error, "agent rate out of range";
     TYPE_MISMATCH = "E0201", Error, "type mismatch";
     UNKNOWN_SYMBOL = "E0202", Error, "unknown symbol";
     BAD_OPERATOR = "E0203", Error, "operator does not apply to this type";

@@ -6,7 +6,13 @@ use crate::loader::Loader;
 use crate::source::{SourceFile, SourceMap};
 use situ_grammar::ast::{File, Item, Span};
 use situ_grammar::diag::{Diagnostic, FileId};
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
+
+/// How deep includes may nest: the root includes a file at depth 1, which
+/// includes one at depth 2, and so on. Deeper is E0009: loading recurses
+/// once per level, and no real layout of files needs more.
+pub const MAX_INCLUDE_DEPTH: usize = 64;
 
 /// Every file of one compilation, parsed.
 #[derive(Debug, Clone, Default)]
@@ -39,7 +45,7 @@ impl std::error::Error for RootError {}
 pub fn load(root: &Path, loader: &dyn Loader) -> Result<Loaded, RootError> {
     let bytes = loader.read(root).map_err(|error| RootError { path: root.to_path_buf(), error })?;
     let identity = loader.identity(root).unwrap_or_else(|_| root.to_path_buf());
-    let mut state = LoadState { loader, loaded: Loaded::default(), seen: Vec::new(), stack: Vec::new() };
+    let mut state = LoadState::new(loader, Loaded::default());
     state.visit(root, identity, bytes);
     Ok(state.loaded)
 }
@@ -53,11 +59,10 @@ pub fn load_with(root: &Path, extra: &[&Path], loader: &dyn Loader) -> Result<Lo
     for path in extra {
         let bytes = loader.read(path).map_err(|error| RootError { path: path.to_path_buf(), error })?;
         let identity = loader.identity(path).unwrap_or_else(|_| path.to_path_buf());
-        let seen: Vec<PathBuf> = loaded.sources_identities.clone();
-        if seen.contains(&identity) {
+        if loaded.sources_identities.contains(&identity) {
             continue;
         }
-        let mut state = LoadState { loader, loaded, seen, stack: Vec::new() };
+        let mut state = LoadState::new(loader, loaded);
         state.visit(path, identity, bytes);
         loaded = state.loaded;
     }
@@ -66,7 +71,7 @@ pub fn load_with(root: &Path, extra: &[&Path], loader: &dyn Loader) -> Result<Lo
 
 /// Loads a source given as text (no includes are possible unless `loader` serves them).
 pub fn load_text(name: &str, text: &str, loader: &dyn Loader) -> Loaded {
-    let mut state = LoadState { loader, loaded: Loaded::default(), seen: Vec::new(), stack: Vec::new() };
+    let mut state = LoadState::new(loader, Loaded::default());
     state.visit(Path::new(name), PathBuf::from(name), text.as_bytes().to_vec());
     state.loaded
 }
@@ -75,15 +80,22 @@ struct LoadState<'a> {
     loader: &'a dyn Loader,
     loaded: Loaded,
     /// Identities of the files read so far.
-    seen: Vec<PathBuf>,
+    seen: HashSet<PathBuf>,
     /// Identities of the files being read, root first, with the names they
     /// were reached by: an include of one of these is a cycle.
     stack: Vec<(PathBuf, String)>,
+    /// Where each identity of `stack` is in it.
+    on_stack: HashMap<PathBuf, usize>,
 }
 
-impl LoadState<'_> {
+impl<'a> LoadState<'a> {
+    fn new(loader: &'a dyn Loader, loaded: Loaded) -> Self {
+        let seen = loaded.sources_identities.iter().cloned().collect();
+        LoadState { loader, loaded, seen, stack: Vec::new(), on_stack: HashMap::new() }
+    }
+
     fn visit(&mut self, path: &Path, identity: PathBuf, bytes: Vec<u8>) -> FileId {
-        self.seen.push(identity.clone());
+        self.seen.insert(identity.clone());
         self.loaded.sources_identities.push(identity.clone());
         let name = path.display().to_string();
         let text = match String::from_utf8(bytes) {
@@ -110,13 +122,16 @@ impl LoadState<'_> {
         let id = self.loaded.sources.add(SourceFile::new(name, text));
         let parsed = situ_grammar::parse(&self.loaded.sources.get(id).text, id);
         self.loaded.diagnostics.extend(parsed.errors);
+        self.on_stack.insert(identity.clone(), self.stack.len());
         self.stack.push((identity, self.loaded.sources.get(id).name.clone()));
         for item in &parsed.file.items {
             if let Item::Include(inc) = item {
                 self.include(path, id, &inc.path.value, inc.path.span);
             }
         }
-        self.stack.pop();
+        if let Some((identity, _)) = self.stack.pop() {
+            self.on_stack.remove(&identity);
+        }
         self.loaded.files.push((id, parsed.file));
         id
     }
@@ -127,7 +142,7 @@ impl LoadState<'_> {
             Ok(identity) => identity,
             Err(err) => return self.not_found(&path, from_id, span, &err),
         };
-        if let Some(pos) = self.stack.iter().position(|(p, _)| *p == identity) {
+        if let Some(&pos) = self.on_stack.get(&identity) {
             // Named as the user wrote them, not by their canonical paths.
             let back = path.display().to_string();
             let cycle: Vec<&str> =
@@ -142,12 +157,40 @@ impl LoadState<'_> {
         if self.seen.contains(&identity) {
             return; // included before: each file is read once
         }
+        if self.stack.len() > MAX_INCLUDE_DEPTH {
+            return self.too_deep(&path, from_id, span);
+        }
         match self.loader.read(&path) {
             Ok(bytes) => {
                 self.visit(&path, identity, bytes);
             }
             Err(err) => self.not_found(&path, from_id, span, &err),
         }
+    }
+
+    /// An include one level deeper than [`MAX_INCLUDE_DEPTH`]: the file is not
+    /// read, and the help names the chain (its ends, when it is long).
+    fn too_deep(&mut self, path: &Path, from_id: FileId, span: Span) {
+        let target = path.display().to_string();
+        let chain: Vec<&str> = self.stack.iter().map(|(_, name)| name.as_str()).chain([target.as_str()]).collect();
+        let brief = if chain.len() > 6 {
+            format!("{} -> … -> {}", chain[..3].join(" -> "), chain[chain.len() - 3..].join(" -> "))
+        } else {
+            chain.join(" -> ")
+        };
+        self.loaded.diagnostics.push(
+            Diagnostic::error(
+                codes::INCLUDE_TOO_DEEP,
+                format!("include chain too deep: more than {MAX_INCLUDE_DEPTH} files, each included by the previous"),
+                from_id,
+                span,
+                format!("this include would be level {}", self.stack.len()),
+            )
+            .with_help(format!(
+                "the chain is {brief}; include the files from one file higher up instead of each from the previous"
+            ))
+            .with_witness(serde_json::json!({ "limit": MAX_INCLUDE_DEPTH, "chain": chain })),
+        );
     }
 
     fn not_found(&mut self, path: &Path, from_id: FileId, span: Span, err: &std::io::Error) {
@@ -161,5 +204,52 @@ impl LoadState<'_> {
             )
             .with_help("include paths are relative to the file that includes them"),
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::loader::MemLoader;
+
+    /// `a0.situ` includes `a1.situ`, which includes `a2.situ`, … up to `a{n-1}`.
+    fn chain(n: usize) -> MemLoader {
+        (0..n).fold(MemLoader::new(), |l, i| {
+            let text = if i + 1 < n { format!("include \"a{}.situ\"\n", i + 1) } else { "states { A initial }".into() };
+            l.with(format!("a{i}.situ"), text)
+        })
+    }
+
+    #[test]
+    fn a_chain_at_the_depth_limit_loads_whole() {
+        let loaded = load(Path::new("a0.situ"), &chain(MAX_INCLUDE_DEPTH + 1)).unwrap();
+        assert!(loaded.diagnostics.is_empty(), "{:?}", loaded.diagnostics);
+        assert_eq!(loaded.files.len(), MAX_INCLUDE_DEPTH + 1);
+    }
+
+    #[test]
+    fn a_chain_past_the_limit_stops_at_the_include_too_deep() {
+        let loaded = load(Path::new("a0.situ"), &chain(20_000)).unwrap();
+        let codes: Vec<&str> = loaded.diagnostics.iter().map(|d| d.code).collect();
+        assert_eq!(codes, [codes::INCLUDE_TOO_DEEP], "one finding, no stack trouble");
+        let d = &loaded.diagnostics[0];
+        assert_eq!(loaded.sources.get(d.primary.file).name, format!("a{MAX_INCLUDE_DEPTH}.situ"));
+        // Only the files up to the limit are read.
+        assert_eq!(loaded.files.len(), MAX_INCLUDE_DEPTH + 1);
+        let chain = d.witness.as_ref().unwrap()["chain"].as_array().unwrap().len();
+        assert_eq!(chain, MAX_INCLUDE_DEPTH + 2);
+    }
+
+    #[test]
+    fn a_cycle_is_still_a_cycle_and_a_shared_file_is_read_once() {
+        let loader = MemLoader::new()
+            .with("root.situ", "include \"a.situ\"\ninclude \"b.situ\"\n")
+            .with("a.situ", "include \"common.situ\"\n")
+            .with("b.situ", "include \"common.situ\"\ninclude \"root.situ\"\n")
+            .with("common.situ", "states { A initial }");
+        let loaded = load(Path::new("root.situ"), &loader).unwrap();
+        let codes: Vec<&str> = loaded.diagnostics.iter().map(|d| d.code).collect();
+        assert_eq!(codes, [codes::INCLUDE_CYCLE]);
+        assert_eq!(loaded.files.len(), 4, "common.situ once");
     }
 }

@@ -9,6 +9,72 @@ use std::path::{Component, Path, PathBuf};
 /// The largest source file the compiler reads.
 pub const MAX_FILE_BYTES: u64 = 16 * 1024 * 1024;
 
+/// The largest bundle a command reads.
+pub const MAX_BUNDLE_BYTES: u64 = 256 * 1024 * 1024;
+
+/// Reads a whole regular file of at most `limit` bytes: the one way the
+/// command line reads an input (a source, a bundle, a scenario, a stream).
+/// `what` names the kind of file in the error ("a source file").
+///
+/// What is not a regular file (a directory, a FIFO, a device such as
+/// `/dev/zero`) is refused from its metadata, before it is opened: opening a
+/// FIFO would wait for a writer. The read takes one byte more than the
+/// limit, so that a file that grows while it is read is refused too.
+pub fn read_bounded(path: &Path, limit: u64, what: &str) -> io::Result<Vec<u8>> {
+    use std::io::Read;
+    let kind = |meta: &std::fs::Metadata| -> io::Result<()> {
+        let file_type = meta.file_type();
+        if file_type.is_file() {
+            return Ok(());
+        }
+        if file_type.is_dir() {
+            return Err(io::Error::new(io::ErrorKind::InvalidInput, "is a directory"));
+        }
+        let is = not_regular(&file_type);
+        Err(io::Error::new(io::ErrorKind::InvalidInput, format!("is {is}, not a regular file")))
+    };
+    kind(&std::fs::metadata(path)?)?;
+    let file = std::fs::File::open(path)?;
+    let meta = file.metadata()?;
+    kind(&meta)?; // replaced between the two looks
+    let too_large = || {
+        let mib = limit / (1024 * 1024);
+        let limit = if mib > 0 { format!("{mib} MiB") } else { format!("{limit} bytes") };
+        io::Error::new(io::ErrorKind::InvalidData, format!("larger than the limit of {limit} for {what}"))
+    };
+    if meta.len() > limit {
+        return Err(too_large());
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(limit + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_large());
+    }
+    Ok(bytes)
+}
+
+/// What a file that is neither a regular file nor a directory is.
+fn not_regular(file_type: &std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if file_type.is_fifo() {
+            return "a FIFO";
+        }
+        if file_type.is_char_device() {
+            return "a character device";
+        }
+        if file_type.is_block_device() {
+            return "a block device";
+        }
+        if file_type.is_socket() {
+            return "a socket";
+        }
+    }
+    let _ = file_type;
+    "a special file"
+}
+
 /// A source of files.
 pub trait Loader {
     /// The bytes of the file at `path`.
@@ -27,23 +93,7 @@ pub struct FsLoader;
 
 impl Loader for FsLoader {
     fn read(&self, path: &Path) -> io::Result<Vec<u8>> {
-        use std::io::Read;
-        let file = std::fs::File::open(path)?;
-        let meta = file.metadata()?;
-        if meta.is_dir() {
-            return Err(io::Error::new(io::ErrorKind::InvalidInput, "is a directory"));
-        }
-        let mut bytes = Vec::new();
-        // Read one byte more than the limit to tell "at the limit" from "over it",
-        // also for files whose size the metadata does not know (pipes).
-        file.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes)?;
-        if bytes.len() as u64 > MAX_FILE_BYTES {
-            return Err(io::Error::new(
-                io::ErrorKind::InvalidData,
-                format!("larger than the limit of {} MiB for a source file", MAX_FILE_BYTES / (1024 * 1024)),
-            ));
-        }
-        Ok(bytes)
+        read_bounded(path, MAX_FILE_BYTES, "a source file")
     }
 
     fn identity(&self, path: &Path) -> io::Result<PathBuf> {
@@ -103,6 +153,32 @@ mod tests {
     fn normalize_resolves_dots() {
         assert_eq!(normalize(Path::new("a/./b/../c.situ")), PathBuf::from("a/c.situ"));
         assert_eq!(normalize(Path::new("../x.situ")), PathBuf::from("../x.situ"));
+    }
+
+    #[test]
+    fn bounded_reads_refuse_what_is_not_a_small_regular_file() {
+        let dir = std::env::temp_dir().join(format!("situ-loader-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let small = dir.join("small.situ");
+        std::fs::write(&small, b"states { A initial }").unwrap();
+        assert_eq!(read_bounded(&small, 20, "a source file").unwrap(), b"states { A initial }");
+        let err = read_bounded(&small, 19, "a source file").unwrap_err();
+        assert!(err.to_string().contains("larger than the limit of 19 bytes for a source file"), "{err}");
+        let err = read_bounded(&dir, 100, "a source file").unwrap_err();
+        assert!(err.to_string().contains("is a directory"), "{err}");
+        #[cfg(unix)]
+        {
+            let err = read_bounded(Path::new("/dev/zero"), 100, "a bundle").unwrap_err();
+            assert!(err.to_string().contains("is a character device, not a regular file"), "{err}");
+            let fifo = dir.join("fifo.situ");
+            let made = std::process::Command::new("mkfifo").arg(&fifo).status().is_ok_and(|s| s.success());
+            if made {
+                // Refused from its metadata: opening it would wait for a writer.
+                let err = FsLoader.read(&fifo).unwrap_err();
+                assert!(err.to_string().contains("is a FIFO, not a regular file"), "{err}");
+            }
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -7,7 +7,11 @@ use crate::{Checked, RootError};
 use miette::{GraphicalReportHandler, GraphicalTheme, LabeledSpan, NamedSource, SourceSpan};
 use serde_json::{json, Value};
 use situ_grammar::diag::{Diagnostic, FileId, Label, Severity};
+use snippet::Text;
+use std::cell::RefCell;
 use std::fmt;
+
+mod snippet;
 
 /// How to draw human reports.
 #[derive(Debug, Clone, Copy)]
@@ -23,10 +27,21 @@ impl Style {
 
 /// One finding as a miette report.
 pub fn human(sources: &SourceMap, d: &Diagnostic, style: Style) -> String {
+    human_with(&Texts::new(sources), d, style)
+}
+
+/// Findings as miette reports, one after the other: each file is indexed
+/// once for all of them.
+pub fn human_list<'a>(sources: &SourceMap, ds: impl IntoIterator<Item = &'a Diagnostic>, style: Style) -> String {
+    let texts = Texts::new(sources);
+    ds.into_iter().map(|d| human_with(&texts, d, style)).collect()
+}
+
+fn human_with(texts: &Texts, d: &Diagnostic, style: Style) -> String {
     let theme = if style.colour { GraphicalTheme::unicode() } else { GraphicalTheme::unicode_nocolor() };
     let handler = GraphicalReportHandler::new_themed(theme).with_width(style.width).with_links(false);
     let mut out = String::new();
-    let report = Report::new(sources, d);
+    let report = Report::new(texts, d);
     if handler.render_report(&mut out, &report).is_err() {
         out = format!("{}: {} [situ::{}]\n", d.severity.as_str(), d.message, d.code);
     }
@@ -35,57 +50,97 @@ pub fn human(sources: &SourceMap, d: &Diagnostic, style: Style) -> String {
 
 /// Every visible finding of a check, then a summary line.
 pub fn human_all(checked: &Checked, style: Style) -> String {
+    let texts = Texts::new(&checked.sources);
     let mut out = String::new();
     for d in checked.visible() {
-        out.push_str(&human(&checked.sources, d, style));
+        out.push_str(&human_with(&texts, d, style));
         out.push('\n');
     }
     out
 }
 
+/// The files of a source map as miette sources, each indexed when first
+/// drawn and then shared by every report on it.
+struct Texts<'a> {
+    sources: &'a SourceMap,
+    texts: RefCell<Vec<Option<Text>>>,
+}
+
+impl<'a> Texts<'a> {
+    fn new(sources: &'a SourceMap) -> Self {
+        Texts { sources, texts: RefCell::new(vec![None; sources.len()]) }
+    }
+
+    fn get(&self, file: FileId) -> Text {
+        let mut texts = self.texts.borrow_mut();
+        let i = file.0 as usize;
+        if texts.len() <= i {
+            texts.resize(i + 1, None);
+        }
+        texts[i].get_or_insert_with(|| Text::new(&self.sources.get(file).text)).clone()
+    }
+}
+
 /// A miette view of one [`Diagnostic`]: labels in the primary file are drawn
-/// on its source; labels in other files become related notes.
+/// on its source; labels in other files become related notes. When the
+/// primary label sits on a very long line, the report is drawn on a window
+/// of that line, and labels outside the window become related notes too.
 struct Report {
     d: Diagnostic,
-    source: NamedSource<String>,
+    source: NamedSource<Text>,
     labels: Vec<LabeledSpan>,
     related: Vec<Report>,
 }
 
 impl Report {
-    fn new(sources: &SourceMap, d: &Diagnostic) -> Report {
-        let file = sources.get(d.primary.file);
-        let mut labels = vec![labeled(&d.primary, file.text.len(), true)];
-        let mut related = Vec::new();
-        for l in &d.secondary {
-            if l.file == d.primary.file {
-                labels.push(labeled(l, file.text.len(), false));
-            } else {
-                let note = Diagnostic {
-                    code: "",
-                    severity: Severity::Warning,
-                    message: l.text.clone(),
-                    primary: l.clone(),
-                    secondary: Vec::new(),
-                    help: None,
-                    witness: None,
-                    allowed: false,
-                    fixes: Vec::new(),
-                };
-                related.push(Report::new(sources, &note));
+    fn new(texts: &Texts, d: &Diagnostic) -> Report {
+        let file = texts.sources.get(d.primary.file);
+        let len = file.text.len();
+        let mut text = texts.get(d.primary.file);
+        let same_file = || std::iter::once(&d.primary).chain(d.secondary.iter().filter(|l| l.file == d.primary.file));
+        let long = same_file().any(|l| text.on_long_line(l.span.start) || text.on_long_line(l.span.end));
+        let window = long.then(|| text.window((d.primary.span.start, d.primary.span.end)));
+        let mut labels = Vec::new();
+        let mut notes = Vec::new();
+        for (i, l) in same_file().enumerate() {
+            let (start, end) = (l.span.start.min(len), l.span.end.min(len));
+            let span = match &window {
+                None => Some((start, end)),
+                Some(w) => w.map(start, end),
+            };
+            match span {
+                Some(span) => labels.push(labeled(&l.text, span, i == 0)),
+                None => notes.push(l),
             }
+        }
+        if let Some(w) = window {
+            text = w.text;
+        }
+        let mut related = Vec::new();
+        for l in d.secondary.iter().filter(|l| l.file != d.primary.file).chain(notes) {
+            let note = Diagnostic {
+                code: "",
+                severity: Severity::Warning,
+                message: l.text.clone(),
+                primary: l.clone(),
+                secondary: Vec::new(),
+                help: None,
+                witness: None,
+                allowed: false,
+                fixes: Vec::new(),
+            };
+            related.push(Report::new(texts, &note));
         }
         // The witness is structured data for tools (JSON, SARIF); for people
         // each check writes it into its message, labels and help.
         let d = d.clone();
-        Report { d, source: NamedSource::new(file.name.clone(), file.text.clone()), labels, related }
+        Report { d, source: NamedSource::new(file.name.clone(), text), labels, related }
     }
 }
 
-fn labeled(l: &Label, len: usize, primary: bool) -> LabeledSpan {
-    let start = l.span.start.min(len);
-    let span = SourceSpan::new(start.into(), l.span.end.min(len).saturating_sub(start));
-    let text = (!l.text.is_empty()).then(|| l.text.clone());
+fn labeled(text: &str, (start, end): (usize, usize), primary: bool) -> LabeledSpan {
+    let span = SourceSpan::new(start.into(), end.saturating_sub(start));
+    let text = (!text.is_empty()).then(|| text.to_string());
     if primary {
         LabeledSpan::new_primary_with_span(text, span)
     } else {

@@ -15,9 +15,15 @@ fn blocks_after<'a>(doc: &'a str, heading: &str) -> Vec<&'a str> {
 
 /// Codes whose example cannot be one self-contained text: they need bytes
 /// that are not UTF-8, other files, or very long input.
-const NOT_SELF_CONTAINED: &[&str] =
-    [codes::NOT_UTF8, codes::INCLUDE_NOT_FOUND, codes::INCLUDE_CYCLE, codes::TOO_DEEP, codes::TOO_MANY_ERRORS]
-        .as_slice();
+const NOT_SELF_CONTAINED: &[&str] = [
+    codes::NOT_UTF8,
+    codes::INCLUDE_NOT_FOUND,
+    codes::INCLUDE_CYCLE,
+    codes::TOO_DEEP,
+    codes::TOO_MANY_ERRORS,
+    codes::INCLUDE_TOO_DEEP,
+]
+.as_slice();
 
 #[test]
 fn examples_raise_their_code_and_fixes_are_clean() {

@@ -316,8 +316,10 @@ pub struct Scenario {
 
 /// Reads and validates a scenario file.
 pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| ScenarioError::Io { path: path.display().to_string(), message: e.to_string() })?;
+    use situ_compiler::loader::{read_bounded, MAX_FILE_BYTES};
+    let io = |message: String| ScenarioError::Io { path: path.display().to_string(), message };
+    let bytes = read_bounded(path, MAX_FILE_BYTES, "a scenario file").map_err(|e| io(e.to_string()))?;
+    let text = String::from_utf8(bytes).map_err(|_| io("not UTF-8 text".into()))?;
     parse(&text)
 }
 
@@ -711,6 +713,13 @@ y = -1.75
         let bad = text.replace("speed = 1.2", "speed = -1.0");
         let e = parse(&bad).expect_err("negative speed");
         assert_eq!(e.to_string(), "obstacles[0] (\"walker\").motion.speed: must be a positive number, not -1");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_device_is_refused_not_read() {
+        let err = load(Path::new("/dev/zero")).unwrap_err().to_string();
+        assert!(err.contains("/dev/zero") && err.contains("is a character device, not a regular file"), "{err}");
     }
 
     #[test]

@@ -19,6 +19,9 @@ pub struct Args {
     pub no_reset: bool,
 }
 
+/// The largest event stream `--stream-in` reads.
+const MAX_STREAM_BYTES: u64 = 256 * 1024 * 1024;
+
 pub fn run(args: Args) -> u8 {
     let program = match super::program::load(&args.file, false) {
         Ok(p) => p,
@@ -28,7 +31,8 @@ pub fn run(args: Args) -> u8 {
     let events = match &args.stream_in {
         None => None,
         Some(path) => {
-            let text = match std::fs::read_to_string(path) {
+            let read = situ_compiler::loader::read_bounded(path, MAX_STREAM_BYTES, "an event stream");
+            let text = match read.and_then(|b| String::from_utf8(b).map_err(std::io::Error::other)) {
                 Ok(t) => t,
                 Err(e) => {
                     eprintln!("error: cannot read `{}`: {e}", path.display());

@@ -3,6 +3,7 @@
 //! half written.
 
 use super::{FAILED, OK, USAGE};
+use situ_compiler::loader::{read_bounded, MAX_FILE_BYTES};
 use situ_compiler::render;
 use situ_compiler::source::{SourceFile, SourceMap};
 use std::path::{Path, PathBuf};
@@ -17,7 +18,7 @@ pub fn run(files: &[PathBuf], check: bool) -> u8 {
 }
 
 fn one(path: &Path, check: bool) -> u8 {
-    let text = match std::fs::read(path).map(String::from_utf8) {
+    let text = match read_bounded(path, MAX_FILE_BYTES, "a source file").map(String::from_utf8) {
         Ok(Ok(text)) => text,
         Ok(Err(_)) => {
             eprintln!("error: `{}` is not UTF-8 text", path.display());
@@ -33,9 +34,7 @@ fn one(path: &Path, check: bool) -> u8 {
         Err(diags) => {
             let mut sources = SourceMap::new();
             sources.add(SourceFile::new(path.display().to_string(), text));
-            for d in &diags {
-                print!("{}", render::human(&sources, d, super::style()));
-            }
+            print!("{}", render::human_list(&sources, &diags, super::style()));
             eprintln!("error: `{}` has syntax errors; not formatted", path.display());
             return FAILED;
         }

@@ -40,14 +40,10 @@ fn load_scenario(name: &str) -> Result<Scenario, String> {
     scenario::load(path).map_err(|e| format!("scenario `{name}`: {e}"))
 }
 
-/// The bundle's bytes, to attach to the recording: the file itself, or the
-/// source compiled to JSON.
-fn bundle_bytes(file: &Path, content: &Content) -> Vec<u8> {
-    if super::program::is_source(file) {
-        bundle::encode(content, Encoding::Json)
-    } else {
-        std::fs::read(file).unwrap_or_else(|_| bundle::encode(content, Encoding::Json))
-    }
+/// The bundle's bytes, to attach to the recording: the file as it was read
+/// and checked (its signature with it), or the source compiled to JSON.
+fn bundle_bytes(bytes: Option<&[u8]>, content: &Content) -> Vec<u8> {
+    bytes.map(<[u8]>::to_vec).unwrap_or_else(|| bundle::encode(content, Encoding::Json))
 }
 
 pub fn run(args: Args) -> u8 {
@@ -56,6 +52,7 @@ pub fn run(args: Args) -> u8 {
         Err(code) => return code,
     };
     let content = program.content;
+    let file_bytes = program.bytes;
     let kind = match StackKind::of(&content) {
         Ok(k) => k,
         Err(_) if args.scenario.is_none() && args.compare.is_none() => {
@@ -101,7 +98,7 @@ pub fn run(args: Args) -> u8 {
     // The recording: at --record, else in --out.
     let record_path = args.record.clone().or_else(|| args.out.as_ref().map(|d| d.join("recording.mcap")));
     let mcap = match &record_path {
-        Some(path) => match McapRecorder::create(path, content.clone(), &bundle_bytes(&args.file, &content)) {
+        Some(path) => match McapRecorder::create(path, content.clone(), &bundle_bytes(file_bytes.as_deref(), &content)) {
             Ok(m) => Some(Arc::new(Mutex::new(m))),
             Err(e) => {
                 eprintln!("error: cannot write `{}`: {e}", path.display());
