@@ -13,6 +13,9 @@ python3 -m pip install --quiet --disable-pip-version-check -r examples/python/re
 echo "== cargo test --workspace --all-features"
 cargo test --workspace --all-features
 
+echo "== the VS Code extension's grammar on every .situ file (vscode-tmgrammar-test, from npm)"
+bash editors/vscode/test/run.sh
+
 echo "== a situ run recording reads with the mcap package from PyPI (Foxglove's schemas)"
 bash tests/python/check.sh target/debug/situ
 

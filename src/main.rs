@@ -61,6 +61,14 @@ enum Command {
         /// Refuse to build on warnings too.
         #[arg(long)]
         deny_warnings: bool,
+        /// Sign the bundle with this secret key (`situ key new NAME` writes NAME.key).
+        #[arg(long, value_name = "KEY")]
+        sign: Option<PathBuf>,
+    },
+    /// Signing keys: `situ key new NAME` writes NAME.key (secret) and NAME.pub (public).
+    Key {
+        #[command(subcommand)]
+        what: cmd::key::What,
     },
     /// Throughput and latency of the Bulletinboard on a seeded random event stream, as JSON.
     Bench {
@@ -84,6 +92,9 @@ enum Command {
         /// Do not reset to the initial state after a final state.
         #[arg(long)]
         no_reset: bool,
+        /// Bench only bundles signed by one of these public keys (`situ key new`); refuse others (exit 2).
+        #[arg(long, num_args = 1.., value_name = "PUBKEY")]
+        trust: Vec<PathBuf>,
     },
     /// Run rules: the reference stack on a mission, or any rules file on a script; exit 0 done, 1 failed, 2 usage.
     Run {
@@ -133,13 +144,16 @@ enum Command {
         /// Real-time runs (demo, none): how long, in seconds.
         #[arg(long, default_value_t = 10.0)]
         duration: f64,
+        /// Run only bundles signed by one of these public keys (`situ key new`); refuse others (exit 2).
+        #[arg(long, num_args = 1.., value_name = "PUBKEY")]
+        trust: Vec<PathBuf>,
     },
     /// Step through the rules by hand: post events, let time pass, ask why (commands from stdin when not a terminal).
     Repl {
         /// A `.situ` source or a bundle.
         file: PathBuf,
     },
-    /// Feed a recording's events to a bundle and say where the states differ from the recorded ones.
+    /// Feed a recording's events to a bundle and say where the states differ from the recorded ones; exit 0 same, 1 differ, 2 unreadable (not a regular file, over 1 GiB, not MCAP, damaged, nothing of situ's); a recording cut short (a killed run) replays up to the cut and says so.
     Replay {
         /// An MCAP recording of `situ run --record`.
         recording: PathBuf,
@@ -148,6 +162,9 @@ enum Command {
         bundle: Option<PathBuf>,
         #[arg(long, value_enum, default_value_t = cmd::replay::Format::Human)]
         format: cmd::replay::Format,
+        /// Replay only on bundles (the attached one or --bundle) signed by one of these public keys (`situ key new`); refuse others (exit 2).
+        #[arg(long, num_args = 1.., value_name = "PUBKEY")]
+        trust: Vec<PathBuf>,
     },
     /// Start every local process of a deployment (Zenoh) and stop them cleanly on Ctrl-C.
     Up {
@@ -160,6 +177,9 @@ enum Command {
         /// How long each process runs, in seconds.
         #[arg(long, default_value_t = 10.0)]
         duration: f64,
+        /// Run only bundles signed by one of these public keys (`situ key new`); refuse others (exit 2).
+        #[arg(long, num_args = 1.., value_name = "PUBKEY")]
+        trust: Vec<PathBuf>,
     },
     /// Pictures: the wiring of a state, the Rete network, the state transitions.
     Graph {
@@ -241,6 +261,8 @@ enum Command {
         #[arg(value_enum)]
         shell: clap_complete::Shell,
     },
+    /// The language server (LSP over standard input and output), for editors: see docs/editors.md.
+    Lsp,
     /// Print situ's man page, or write one page per subcommand into a directory.
     #[command(long_about = "Print the man page of situ (roff) to standard output: `situ man | man -l -`.\n\n\
         With -o DIR, write situ.1 and a page per subcommand (situ-check.1, situ-gen-agent.1, ...) \
@@ -268,11 +290,23 @@ fn main() -> ExitCode {
         Command::Man { output } => cmd::manners::man(Cli::command(), output.as_deref()),
         Command::Fmt { files, check } => cmd::fmt::run(&files, check),
         Command::Explain { code } => cmd::explain::run(code.as_deref()),
-        Command::Build { file, output, binary, stats, deny_warnings } => {
-            cmd::build::run(&file, &output, binary, stats, deny_warnings)
+        Command::Build { file, output, binary, stats, deny_warnings, sign } => {
+            cmd::build::run(&file, &output, binary, stats, deny_warnings, sign.as_deref())
         }
-        Command::Bench { file, events, seed, stream_in, stream_out, states_out, no_reset } => {
-            cmd::bench::run(cmd::bench::Args { file, events, seed, stream_in, stream_out, states_out, no_reset })
+        Command::Key { what } => cmd::key::run(what),
+        Command::Bench { file, events, seed, stream_in, stream_out, states_out, no_reset, trust } => {
+            match cmd::program::trust(&trust) {
+                Ok(()) => cmd::bench::run(cmd::bench::Args {
+                    file,
+                    events,
+                    seed,
+                    stream_in,
+                    stream_out,
+                    states_out,
+                    no_reset,
+                }),
+                Err(code) => code,
+            }
         }
         Command::Test { files, filter, format, engine, seed, cases, length, depth, max_states, stats } => {
             cmd::test::run(cmd::test::Args {
@@ -308,7 +342,11 @@ fn main() -> ExitCode {
             process,
             only,
             duration,
+            trust,
         } => {
+            if let Err(code) = cmd::program::trust(&trust) {
+                return ExitCode::from(code);
+            }
             let local = stack == cmd::distributed::Stack::Sim && transport == cmd::distributed::Transport::Inproc;
             if local && (script.is_some() || random.is_some()) {
                 cmd::scripted::run(cmd::scripted::Args { file, script, random, until, out, record })
@@ -328,8 +366,15 @@ fn main() -> ExitCode {
             }
         }
         Command::Repl { file } => cmd::repl::run(&file),
-        Command::Replay { recording, bundle, format } => cmd::replay::run(&recording, bundle.as_ref(), format),
-        Command::Up { deploy, file, stack, duration } => cmd::distributed::up(&deploy, &file, stack, duration),
+        Command::Lsp => cmd::lsp::run(),
+        Command::Replay { recording, bundle, format, trust } => match cmd::program::trust(&trust) {
+            Ok(()) => cmd::replay::run(&recording, bundle.as_ref(), format),
+            Err(code) => code,
+        },
+        Command::Up { deploy, file, stack, duration, trust } => match cmd::program::trust(&trust) {
+            Ok(()) => cmd::distributed::up(&deploy, &file, stack, duration, &trust),
+            Err(code) => code,
+        },
         Command::Graph { file, view, state, format, output } => {
             cmd::graph::run(&file, view, state.as_deref(), format, output.as_ref())
         }

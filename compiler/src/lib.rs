@@ -96,6 +96,19 @@ pub fn check_source(name: &str, text: &str) -> Checked {
     check_loaded(load::load_text(name, text, &loader::MemLoader::new()))
 }
 
+/// The parsed files of a compilation, by [`FileId`].
+pub type ParsedFiles = Vec<(FileId, situ_grammar::ast::File)>;
+
+/// [`check`] without the static checks: loading, names, types and `allow`
+/// only, for a tool that must answer at every keystroke (`situ lsp`) and
+/// runs the whole check afterwards; with the parsed files, by [`FileId`]
+/// order. When this finds an error, [`check`] finds the same (the static
+/// checks run only without errors).
+pub fn check_quick(root: &Path, loader: &dyn Loader) -> Result<(Checked, ParsedFiles), RootError> {
+    let loaded = load::load(root, loader)?;
+    Ok(check_phases(loaded, false))
+}
+
 /// Codes that only say a name is missing: after a syntax error the name may
 /// well be declared in the item that failed to parse, so these are not shown.
 const NAME_CODES: &[&str] = &[
@@ -109,16 +122,20 @@ const NAME_CODES: &[&str] = &[
 ];
 
 fn check_loaded(loaded: load::Loaded) -> Checked {
+    check_phases(loaded, true).0
+}
+
+fn check_phases(loaded: load::Loaded, static_checks: bool) -> (Checked, ParsedFiles) {
     let load::Loaded { sources, files, mut diagnostics, .. } = loaded;
     let syntax_failed = !diagnostics.is_empty();
     let (model, found) = resolve::resolve(&files);
     diagnostics.extend(found.into_iter().filter(|d| !(syntax_failed && NAME_CODES.contains(&d.code))));
-    if diagnostics.iter().all(|d| d.severity != Severity::Error) {
+    if static_checks && diagnostics.iter().all(|d| d.severity != Severity::Error) {
         diagnostics.extend(checks::run(&model));
     }
     resolve::allow::apply(&mut diagnostics, &files);
     diagnostics.sort_by(|a, b| {
         (a.primary.file, a.primary.span.start, a.code).cmp(&(b.primary.file, b.primary.span.start, b.code))
     });
-    Checked { sources, model, diagnostics }
+    (Checked { sources, model, diagnostics }, files)
 }

@@ -9,6 +9,8 @@ pub mod export;
 pub mod fmt;
 pub mod gen;
 pub mod graph;
+pub mod key;
+pub mod lsp;
 pub mod manners;
 pub mod program;
 pub mod repl;
