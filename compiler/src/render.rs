@@ -440,6 +440,31 @@ mod tests {
     }
 
     #[test]
+    fn labels_far_apart_are_drawn_apart_not_with_every_line_between() {
+        let filler: String = (0..30).map(|i| format!("// line {i}\n")).collect();
+        // Deep in a file (miette merged any two labels within twice the
+        // first one's line number).
+        let header: String = (0..60).map(|i| format!("// header {i}\n")).collect();
+        let text = format!(
+            "{header}states {{ A initial  B  C }}\nagent S sensor {{ event E }}\n\
+             rule one {{ when state == A and E then B }}\n{filler}\
+             rule two {{ when state == A and E then C }}\n"
+        );
+        let checked = crate::check_source("far.situ", &text);
+        let conflict = checked.diagnostics.iter().find(|d| d.code == codes::CONFLICTING_RULES).expect("a conflict");
+        let out = human(&checked.sources, conflict, Style { colour: false, width: 80 });
+        assert!(!out.contains("// line 15"), "the lines between the rules are not drawn:\n{out}");
+        assert!(out.contains("rule one") && out.contains("rule two"), "both rules are drawn:\n{out}");
+        assert_eq!(out.matches("╭─[").count(), 2, "two snippets:\n{out}");
+        // Near labels still share one snippet.
+        let near = text.replace(&filler, "");
+        let checked = crate::check_source("near.situ", &near);
+        let conflict = checked.diagnostics.iter().find(|d| d.code == codes::CONFLICTING_RULES).expect("a conflict");
+        let out = human(&checked.sources, conflict, Style { colour: false, width: 80 });
+        assert_eq!(out.matches("╭─[").count(), 1, "one snippet:\n{out}");
+    }
+
+    #[test]
     fn plain_text_unfences_code_and_drops_heading_marks() {
         let md = "## Example\nSome `x`.\n```situ\n#[allow(E0101)]\nrule r {}\n```\n#[not a heading]";
         assert_eq!(plain(md), "Example\nSome `x`.\n    #[allow(E0101)]\n    rule r {}\n#[not a heading]");
