@@ -111,8 +111,12 @@ impl std::error::Error for DeployError {}
 impl Deployment {
     /// Reads and checks a deployment file against the agents of a bundle.
     pub fn load(path: &Path, agents: &[String]) -> Result<Deployment, DeployError> {
-        let text =
-            std::fs::read_to_string(path).map_err(|e| DeployError(format!("cannot read `{}`: {e}", path.display())))?;
+        let cannot = |e: &dyn std::fmt::Display| DeployError(format!("cannot read `{}`: {e}", path.display()));
+        // A deployment is a small TOML file: what is not a regular file (a
+        // FIFO, a device) or is larger than a source file is refused.
+        let bytes = situ_compiler::loader::read_bounded(path, situ_compiler::loader::MAX_FILE_BYTES, "a deployment file")
+            .map_err(|e| cannot(&e))?;
+        let text = String::from_utf8(bytes).map_err(|e| cannot(&e))?;
         let mut d =
             Deployment::parse(&text, agents).map_err(|e| DeployError(format!("{}: {}", path.display(), e.0)))?;
         d.dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
@@ -279,6 +283,14 @@ name = "sensors"
 agents = ["RFCCD", "LADAR"]
 connect = ["tcp/127.0.0.1:7447"]
 "#;
+
+    #[test]
+    fn a_device_or_a_directory_is_refused_not_read() {
+        for path in ["/dev/zero", "/"] {
+            let e = Deployment::load(Path::new(path), &agents()).unwrap_err();
+            assert!(e.0.contains("cannot read") && e.0.contains(path), "{}", e.0);
+        }
+    }
 
     #[test]
     fn a_good_file_gives_each_process_its_config() {
