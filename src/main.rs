@@ -93,7 +93,7 @@ enum Command {
         #[arg(long)]
         no_reset: bool,
         /// Bench only bundles signed by one of these public keys (`situ key new`); refuse others (exit 2).
-        #[arg(long, num_args = 1.., value_name = "PUBKEY")]
+        #[arg(long, value_name = "PUBKEY")]
         trust: Vec<PathBuf>,
     },
     /// Run rules: the reference stack on a mission, or any rules file on a script; exit 0 done, 1 failed, 2 usage.
@@ -145,7 +145,7 @@ enum Command {
         #[arg(long, default_value_t = 10.0)]
         duration: f64,
         /// Run only bundles signed by one of these public keys (`situ key new`); refuse others (exit 2).
-        #[arg(long, num_args = 1.., value_name = "PUBKEY")]
+        #[arg(long, value_name = "PUBKEY")]
         trust: Vec<PathBuf>,
     },
     /// Step through the rules by hand: post events, let time pass, ask why (commands from stdin when not a terminal).
@@ -163,7 +163,7 @@ enum Command {
         #[arg(long, value_enum, default_value_t = cmd::replay::Format::Human)]
         format: cmd::replay::Format,
         /// Replay only on bundles (the attached one or --bundle) signed by one of these public keys (`situ key new`); refuse others (exit 2).
-        #[arg(long, num_args = 1.., value_name = "PUBKEY")]
+        #[arg(long, value_name = "PUBKEY")]
         trust: Vec<PathBuf>,
     },
     /// Start every local process of a deployment (Zenoh) and stop them cleanly on Ctrl-C.
@@ -178,7 +178,7 @@ enum Command {
         #[arg(long, default_value_t = 10.0)]
         duration: f64,
         /// Run only bundles signed by one of these public keys (`situ key new`); refuse others (exit 2).
-        #[arg(long, num_args = 1.., value_name = "PUBKEY")]
+        #[arg(long, value_name = "PUBKEY")]
         trust: Vec<PathBuf>,
     },
     /// Pictures: the wiring of a state, the Rete network, the state transitions.

@@ -114,8 +114,9 @@ impl Deployment {
         let cannot = |e: &dyn std::fmt::Display| DeployError(format!("cannot read `{}`: {e}", path.display()));
         // A deployment is a small TOML file: what is not a regular file (a
         // FIFO, a device) or is larger than a source file is refused.
-        let bytes = situ_compiler::loader::read_bounded(path, situ_compiler::loader::MAX_FILE_BYTES, "a deployment file")
-            .map_err(|e| cannot(&e))?;
+        let bytes =
+            situ_compiler::loader::read_bounded(path, situ_compiler::loader::MAX_FILE_BYTES, "a deployment file")
+                .map_err(|e| cannot(&e))?;
         let text = String::from_utf8(bytes).map_err(|e| cannot(&e))?;
         let mut d =
             Deployment::parse(&text, agents).map_err(|e| DeployError(format!("{}: {}", path.display(), e.0)))?;

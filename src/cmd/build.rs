@@ -1,18 +1,30 @@
-//! `situ build FILE -o BUNDLE [--binary] [--stats]`: compiles a checked
-//! source to a bundle, written atomically.
+//! `situ build FILE -o BUNDLE [--binary] [--stats] [--sign KEY]`: compiles
+//! a checked source to a bundle, written atomically; with `--sign`, signed
+//! with the secret key of `situ key new` (`docs/signing.md`).
 
 use super::{OK, USAGE};
 use situ_compiler::bundle::{self, codec, Encoding};
 use std::path::Path;
 
-pub fn run(file: &Path, out: &Path, binary: bool, stats: bool, deny_warnings: bool) -> u8 {
+pub fn run(file: &Path, out: &Path, binary: bool, stats: bool, deny_warnings: bool, sign: Option<&Path>) -> u8 {
+    // The key first: a build that cannot sign writes nothing.
+    let key = match sign.map(super::key::read_secret).transpose() {
+        Ok(k) => k,
+        Err(e) => {
+            eprintln!("error: --sign: {e}");
+            return USAGE;
+        }
+    };
     let checked = match super::program::check(file, deny_warnings) {
         Ok(c) => c,
         Err(code) => return code,
     };
     let content = bundle::build(&checked);
     let encoding = if binary { Encoding::Binary } else { Encoding::Json };
-    let bytes = bundle::encode(&content, encoding);
+    let bytes = match &key {
+        Some(key) => bundle::sign::encode_signed(&content, encoding, key),
+        None => bundle::encode(&content, encoding),
+    };
     if let Err(e) = super::write_atomically(out, &bytes) {
         eprintln!("error: cannot write `{}`: {e}", out.display());
         return USAGE;
@@ -33,6 +45,9 @@ pub fn run(file: &Path, out: &Path, binary: bool, stats: bool, deny_warnings: bo
         if binary { "binary" } else { "JSON" },
         &hash[..16]
     );
+    if let Some(key) = &key {
+        println!("signed by key {}", key.key_id());
+    }
     if stats {
         let s = content.network.stats;
         let unshared = s.alpha_unshared + s.beta_unshared;

@@ -81,14 +81,19 @@ fn agents_of(stack: Stack, names: &[String]) -> Result<Vec<Box<dyn Agent>>, Stri
     }
 }
 
-fn recorder(args: &Args, content: &Arc<Content>) -> Result<Option<Box<dyn Sink>>, u8> {
+/// The recording, with the bundle attached: the file's bytes as they were
+/// read and checked (its signature with them), or the source compiled.
+fn recorder(args: &Args, content: &Arc<Content>, file: Option<&[u8]>) -> Result<Option<Box<dyn Sink>>, u8> {
     let Some(path) = &args.record else { return Ok(None) };
-    let bytes = if super::program::is_source(&args.file) {
-        bundle::encode(content, Encoding::Json)
-    } else {
-        std::fs::read(&args.file).unwrap_or_default()
+    let compiled;
+    let bytes = match file {
+        Some(b) => b,
+        None => {
+            compiled = bundle::encode(content, Encoding::Json);
+            &compiled
+        }
     };
-    match McapRecorder::create(path, content.clone(), &bytes) {
+    match McapRecorder::create(path, content.clone(), bytes) {
         Ok(r) => Ok(Some(Box::new(r))),
         Err(e) => {
             eprintln!("error: cannot write `{}`: {e}", path.display());
@@ -106,10 +111,10 @@ pub fn run(args: Args) -> u8 {
         Ok(p) => p,
         Err(code) => return code,
     };
-    let content = program.content;
+    let file = program.bytes.as_deref();
     match args.transport {
-        Transport::Inproc => inproc(&args, content),
-        Transport::Zenoh => zenoh(&args, content),
+        Transport::Inproc => inproc(&args, program.content.clone(), file),
+        Transport::Zenoh => zenoh(&args, program.content.clone(), file),
     }
 }
 
@@ -133,13 +138,13 @@ fn finish(summary: situ_runtime::summary::Summary) -> u8 {
     }
 }
 
-fn inproc(args: &Args, content: Arc<Content>) -> u8 {
+fn inproc(args: &Args, content: Arc<Content>, file: Option<&[u8]>) -> u8 {
     let names: Vec<String> = content.agents.iter().map(|a| a.name.clone()).collect();
     let bound = match bound_agents(args.stack, &content, &names) {
         Ok(b) => b,
         Err(code) => return code,
     };
-    let sink = match recorder(args, &content) {
+    let sink = match recorder(args, &content, file) {
         Ok(s) => s,
         Err(code) => return code,
     };
@@ -151,14 +156,14 @@ fn inproc(args: &Args, content: Arc<Content>) -> u8 {
 }
 
 #[cfg(not(feature = "zenoh"))]
-fn zenoh(args: &Args, _content: Arc<Content>) -> u8 {
+fn zenoh(args: &Args, _content: Arc<Content>, _file: Option<&[u8]>) -> u8 {
     let _ = (&args.deploy, &args.process, &args.only);
     eprintln!("error: {NO_ZENOH}");
     USAGE
 }
 
 #[cfg(feature = "zenoh")]
-fn zenoh(args: &Args, content: Arc<Content>) -> u8 {
+fn zenoh(args: &Args, content: Arc<Content>, file: Option<&[u8]>) -> u8 {
     use situ_bus_zenoh::deploy::Deployment;
     use situ_bus_zenoh::{Placement, ZenohBus};
     use situ_runtime::bus::Bus;
@@ -174,6 +179,9 @@ fn zenoh(args: &Args, content: Arc<Content>) -> u8 {
             return USAGE;
         }
     };
+    if d.tls.is_none() {
+        eprintln!("{}", open_deployment_warning(deploy, &d.robot));
+    }
     let process = match (&args.process, &args.only) {
         (Some(p), None) => d.process(p).ok_or_else(|| format!("no process `{p}` in `{}`", deploy.display())),
         (None, Some(only)) => d
@@ -202,13 +210,14 @@ fn zenoh(args: &Args, content: Arc<Content>) -> u8 {
             return USAGE;
         }
     };
-    let sink = match recorder(args, &content) {
+    let sink = match recorder(args, &content, file) {
         Ok(s) => s,
         Err(code) => return code,
     };
     let bus: Arc<dyn Bus> = Arc::new(bus);
     let config = RealtimeConfig {
         board: process.board,
+        max_skew: d.max_skew(),
         stop_on_final: true,
         stop: Some(stop_flag()),
         ..RealtimeConfig::default()
@@ -227,6 +236,19 @@ fn zenoh(args: &Args, content: Arc<Content>) -> u8 {
 const NO_ZENOH: &str =
     "this situ was built without the Zenoh transport; build it with `cargo build --release --features zenoh`";
 
+/// What a deployment without `[tls]` allows, said on standard error by
+/// every process of it (`docs/protocol.md`, "What an open deployment allows").
+#[cfg(feature = "zenoh")]
+fn open_deployment_warning(deploy: &Path, robot: &str) -> String {
+    format!(
+        "warning: `{}` has no [tls] section: no TLS and no access control. Anyone who reaches its endpoints can \
+         put on situ/{robot}/…: forged events, forged data, and forged status messages that the agents' processes \
+         follow (they can drive the stack to a final state, such as a stop). Add [tls] with certificates \
+         (docs/protocol.md, \"What an open deployment allows\").",
+        deploy.display()
+    )
+}
+
 /// The processes of the deployment that run on this host.
 #[cfg(feature = "zenoh")]
 fn local_processes(deploy: &Path, agents: &[String]) -> Result<Vec<String>, String> {
@@ -239,8 +261,10 @@ fn local_processes(_deploy: &Path, _agents: &[String]) -> Result<Vec<String>, St
     Err(NO_ZENOH.into())
 }
 
-/// `situ up DEPLOY FILE [--stack …] [--duration S]`.
-pub fn up(deploy: &Path, file: &Path, stack: Stack, duration: f64) -> u8 {
+/// `situ up DEPLOY FILE [--stack …] [--duration S] [--trust PUBKEY]…`: the
+/// processes get the same `--trust` keys (each checks the bundle itself)
+/// and each warns when the deployment is open (no `[tls]`).
+pub fn up(deploy: &Path, file: &Path, stack: Stack, duration: f64, trust: &[PathBuf]) -> u8 {
     let program = match super::program::load(file, false) {
         Ok(p) => p,
         Err(code) => return code,
@@ -266,6 +290,8 @@ pub fn up(deploy: &Path, file: &Path, stack: Stack, duration: f64) -> u8 {
         Stack::Demo => "demo",
         Stack::None => "none",
     };
+    // Each process checks the bundle against the same keys.
+    let trust_args: Vec<&std::ffi::OsStr> = trust.iter().flat_map(|k| ["--trust".as_ref(), k.as_os_str()]).collect();
     let mut children = Vec::new();
     for p in &processes {
         let child = std::process::Command::new(&exe)
@@ -274,6 +300,7 @@ pub fn up(deploy: &Path, file: &Path, stack: Stack, duration: f64) -> u8 {
             .args(["--transport", "zenoh", "--deploy"])
             .arg(deploy)
             .args(["--process", p, "--stack", stack, "--duration", &duration.to_string()])
+            .args(trust_args.iter())
             .spawn();
         match child {
             Ok(c) => children.push((p.clone(), c)),

@@ -2,10 +2,10 @@
 //! (checked and compiled here) or a bundle file (decoded and verified).
 
 use super::{FAILED, USAGE};
+use situ_compiler::bundle::sign::{self, PublicKey};
 use situ_compiler::bundle::{self, Content};
 use situ_compiler::loader::{read_bounded, FsLoader, MAX_BUNDLE_BYTES};
 use situ_compiler::{render, Checked};
-use situ_compiler::bundle::sign::{self, PublicKey};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};
 

@@ -10,9 +10,12 @@
 //! record cut off) is replayed up to the cut; the report and a warning on
 //! standard error say so, and the exit code compares what was replayed
 //! (0 the same, 1 different).
+//!
+//! With `--trust PUBKEY` (once per key), the bundle replayed on (attached or `--bundle`)
+//! must be signed by one of the keys: a recording whose attached bundle was
+//! swapped or edited is refused (exit 2, naming the key).
 
 use super::{FAILED, OK, USAGE};
-use situ_compiler::bundle;
 use situ_runtime::record::mcap::{attached_bundle, read_file, read_recording};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -43,7 +46,9 @@ pub fn run(recording: &Path, bundle_path: Option<&PathBuf>, format: Format) -> u
             Ok(p) => p.content,
             Err(code) => return code,
         },
-        None => match attached_bundle(&bytes).map(|b| bundle::decode(&b)) {
+        None => match attached_bundle(&bytes)
+            .map(|b| super::program::decode_bundle(&b, &format!("the bundle attached to `{}`", recording.display())))
+        {
             Some(Ok(c)) => Arc::new(c),
             Some(Err(e)) => {
                 eprintln!("error: the bundle attached to `{}`: {e}", recording.display());

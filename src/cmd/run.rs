@@ -42,8 +42,8 @@ fn load_scenario(name: &str) -> Result<Scenario, String> {
 
 /// The bundle's bytes, to attach to the recording: the file as it was read
 /// and checked (its signature with it), or the source compiled to JSON.
-fn bundle_bytes(bytes: Option<&[u8]>, content: &Content) -> Vec<u8> {
-    bytes.map(<[u8]>::to_vec).unwrap_or_else(|| bundle::encode(content, Encoding::Json))
+fn bundle_bytes(bytes: Option<Vec<u8>>, content: &Content) -> Vec<u8> {
+    bytes.unwrap_or_else(|| bundle::encode(content, Encoding::Json))
 }
 
 pub fn run(args: Args) -> u8 {
@@ -98,7 +98,7 @@ pub fn run(args: Args) -> u8 {
     // The recording: at --record, else in --out.
     let record_path = args.record.clone().or_else(|| args.out.as_ref().map(|d| d.join("recording.mcap")));
     let mcap = match &record_path {
-        Some(path) => match McapRecorder::create(path, content.clone(), &bundle_bytes(file_bytes.as_deref(), &content)) {
+        Some(path) => match McapRecorder::create(path, content.clone(), &bundle_bytes(file_bytes, &content)) {
             Ok(m) => Some(Arc::new(Mutex::new(m))),
             Err(e) => {
                 eprintln!("error: cannot write `{}`: {e}", path.display());

@@ -34,6 +34,9 @@ struct Loaded {
     scripts: Vec<ScriptSpec>,
     /// Whether the rules came as a bundle (no scripts then).
     bundle: bool,
+    /// The bundle file's bytes, to attach to the recording as they are
+    /// (signature included).
+    bytes: Option<Vec<u8>>,
 }
 
 fn load(file: &Path, script_file: Option<&Path>) -> Result<Loaded, u8> {
@@ -43,8 +46,9 @@ fn load(file: &Path, script_file: Option<&Path>) -> Result<Loaded, u8> {
             return Err(USAGE);
         }
         let p = super::program::load(file, false)?;
-        return Ok(Loaded { content: p.content, scripts: Vec::new(), bundle: true });
+        return Ok(Loaded { content: p.content, scripts: Vec::new(), bundle: true, bytes: p.bytes });
     }
+    super::program::refuse_source_under_trust(file)?;
     let extra: Vec<&Path> = script_file.into_iter().collect();
     let checked = situ_compiler::check_with(file, &extra, &FsLoader).map_err(|e| {
         eprintln!("error: {e}");
@@ -60,7 +64,7 @@ fn load(file: &Path, script_file: Option<&Path>) -> Result<Loaded, u8> {
         return Err(FAILED);
     }
     let content = Arc::new(bundle::build(&checked));
-    Ok(Loaded { content, scripts: spec::scripts(&checked), bundle: false })
+    Ok(Loaded { content, scripts: spec::scripts(&checked), bundle: false, bytes: None })
 }
 
 /// The script named `name` (the first without one), or why not.
@@ -138,7 +142,7 @@ pub fn run(args: Args) -> u8 {
     });
     let sink: Option<Box<dyn Sink>> = match &partial {
         Some(path) => {
-            let bytes = bundle::encode(&content, Encoding::Json);
+            let bytes = loaded.bytes.clone().unwrap_or_else(|| bundle::encode(&content, Encoding::Json));
             match McapRecorder::create(path, content.clone(), &bytes) {
                 Ok(m) => Some(Box::new(m.flush_by_message_time())),
                 Err(e) => {

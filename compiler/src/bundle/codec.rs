@@ -8,11 +8,19 @@
 //!   (u32 LE), the content length (u64 LE), the SHA-256 of the content, the
 //!   compiler version (u32 LE length, UTF-8), then the content in postcard.
 //!
+//! A signed bundle ([`super::sign`]) has a `signature` field after `sha256`
+//! in JSON (`{"key_id": HEX, "ed25519": HEX}`), and in binary a trailer
+//! after the content: `SITUSIG1`, the key id (8 bytes), the signature (64
+//! bytes). Unsigned bundles are as before, and still load.
+//!
 //! Reading checks, in order: that the file is a bundle at all, that it is
 //! complete, that its format version is this one, that the content's hash
 //! is the recorded one, that the content decodes, and that every index in it
-//! is in range ([`validate`]). Each failure is its own [`LoadError`].
+//! is in range ([`validate`]). Each failure is its own [`LoadError`]. A
+//! signature is only read here (a malformed one is damage); whether it is
+//! trusted is [`super::sign::verify`]'s question.
 
+use super::sign::{KeyId, Signature, SignatureJson, KEY_ID_BYTES};
 use super::{Content, FORMAT_NAME, FORMAT_VERSION};
 use serde::{Deserialize, Serialize};
 use serde_json::value::RawValue;
@@ -27,6 +35,10 @@ pub enum Encoding {
 }
 
 const MAGIC: &[u8; 8] = b"SITUBNDL";
+
+/// The start of a binary bundle's signature trailer.
+const SIGNATURE_MAGIC: &[u8; 8] = b"SITUSIG1";
+const SIGNATURE_TRAILER: usize = 8 + KEY_ID_BYTES + 64;
 
 /// The version of the compiler that writes bundles.
 pub const COMPILER_VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -81,6 +93,8 @@ struct EnvelopeOut<'a> {
     format_version: u32,
     compiler_version: &'static str,
     sha256: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    signature: Option<SignatureJson>,
     content: &'a RawValue,
 }
 
@@ -90,6 +104,8 @@ struct EnvelopeIn<'a> {
     format_version: Option<u32>,
     compiler_version: Option<String>,
     sha256: Option<String>,
+    #[serde(default)]
+    signature: Option<SignatureJson>,
     #[serde(borrow)]
     content: Option<&'a RawValue>,
 }
@@ -107,15 +123,23 @@ pub fn content_sha256(content: &Content) -> String {
 
 /// The file bytes of a bundle.
 pub fn encode(content: &Content, encoding: Encoding) -> Vec<u8> {
+    encode_with(content, encoding, None)
+}
+
+/// The file bytes of a bundle, signed by `sign` (given the content hash)
+/// when there is one ([`super::sign::encode_signed`]).
+pub(crate) fn encode_with(content: &Content, encoding: Encoding, sign: Option<&dyn Fn(&str) -> Signature>) -> Vec<u8> {
     match encoding {
         Encoding::Json => {
             let body = serde_json::to_string_pretty(content).expect("bundle content serializes");
             let raw = RawValue::from_string(body).expect("serde_json writes valid JSON");
+            let sha256 = sha256_hex(raw.get().as_bytes());
             let envelope = EnvelopeOut {
                 format: FORMAT_NAME,
                 format_version: FORMAT_VERSION,
                 compiler_version: COMPILER_VERSION,
-                sha256: sha256_hex(raw.get().as_bytes()),
+                signature: sign.map(|s| s(&sha256).to_json()),
+                sha256,
                 content: &raw,
             };
             let mut out = serde_json::to_vec(&envelope).expect("the envelope serializes");
@@ -132,6 +156,12 @@ pub fn encode(content: &Content, encoding: Encoding) -> Vec<u8> {
             out.extend_from_slice(&(COMPILER_VERSION.len() as u32).to_le_bytes());
             out.extend_from_slice(COMPILER_VERSION.as_bytes());
             out.extend_from_slice(&body);
+            if let Some(sign) = sign {
+                let signature = sign(&sha256_hex(&body));
+                out.extend_from_slice(SIGNATURE_MAGIC);
+                out.extend_from_slice(&signature.key_id.0);
+                out.extend_from_slice(&signature.ed25519);
+            }
             out
         }
     }
@@ -139,18 +169,34 @@ pub fn encode(content: &Content, encoding: Encoding) -> Vec<u8> {
 
 /// Reads a bundle file, JSON or binary (told apart by the first bytes).
 pub fn decode(bytes: &[u8]) -> Result<Content, LoadError> {
-    let content = if bytes.starts_with(MAGIC) {
+    decode_envelope(bytes).map(|d| d.content)
+}
+
+/// A bundle read with [`decode_envelope`]: its content, and what the
+/// envelope says of it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Decoded {
+    pub content: Content,
+    /// The content hash the envelope records (and the content has).
+    pub sha256: String,
+    pub signature: Option<Signature>,
+}
+
+/// [`decode`], keeping the envelope's hash and signature (for
+/// [`super::sign::verify`]).
+pub fn decode_envelope(bytes: &[u8]) -> Result<Decoded, LoadError> {
+    let decoded = if bytes.starts_with(MAGIC) {
         decode_binary(&bytes[MAGIC.len()..])?
     } else if MAGIC.starts_with(bytes) && !bytes.is_empty() {
         return Err(LoadError::Truncated { reason: format!("the file ends after {} bytes", bytes.len()) });
     } else {
         decode_json(bytes)?
     };
-    validate(&content).map_err(|reason| LoadError::Invalid { reason })?;
-    Ok(content)
+    validate(&decoded.content).map_err(|reason| LoadError::Invalid { reason })?;
+    Ok(decoded)
 }
 
-fn decode_json(bytes: &[u8]) -> Result<Content, LoadError> {
+fn decode_json(bytes: &[u8]) -> Result<Decoded, LoadError> {
     let text = std::str::from_utf8(bytes)
         .map_err(|e| LoadError::NotABundle { reason: format!("it is neither a JSON nor a binary bundle ({e})") })?;
     // The writer always starts with this: a file that is a piece of it is
@@ -186,7 +232,12 @@ fn decode_json(bytes: &[u8]) -> Result<Content, LoadError> {
     if found != expected {
         return Err(LoadError::Modified { expected, found });
     }
-    serde_json::from_str(raw.get()).map_err(|e| LoadError::Invalid { reason: e.to_string() })
+    let signature = match &envelope.signature {
+        Some(s) => Some(Signature::from_json(s).map_err(|reason| LoadError::Damaged { reason })?),
+        None => None,
+    };
+    let content = serde_json::from_str(raw.get()).map_err(|e| LoadError::Invalid { reason: e.to_string() })?;
+    Ok(Decoded { content, sha256: found, signature })
 }
 
 fn check_version(found: Option<u32>, compiler: String) -> Result<(), LoadError> {
@@ -202,7 +253,7 @@ fn check_version(found: Option<u32>, compiler: String) -> Result<(), LoadError> 
     }
 }
 
-fn decode_binary(bytes: &[u8]) -> Result<Content, LoadError> {
+fn decode_binary(bytes: &[u8]) -> Result<Decoded, LoadError> {
     let mut at = 0usize;
     let mut take = |n: usize, what: &str| -> Result<&[u8], LoadError> {
         let end = at
@@ -222,18 +273,29 @@ fn decode_binary(bytes: &[u8]) -> Result<Content, LoadError> {
     }
     let compiler = String::from_utf8_lossy(take(name_len, "compiler version")?).into_owned();
     check_version(Some(version), compiler)?;
-    let body = &bytes[at..];
-    if (body.len() as u64) < length {
-        return Err(LoadError::Truncated { reason: format!("{} of {length} content bytes", body.len()) });
+    let rest = &bytes[at..];
+    if (rest.len() as u64) < length {
+        return Err(LoadError::Truncated { reason: format!("{} of {length} content bytes", rest.len()) });
     }
-    if (body.len() as u64) > length {
-        return Err(LoadError::Damaged { reason: format!("{} bytes follow the content", body.len() as u64 - length) });
-    }
+    // `length` fits: it is at most `rest.len()`.
+    let (body, trailer) = rest.split_at(length as usize);
+    let signature = match trailer.len() {
+        0 => None,
+        SIGNATURE_TRAILER if trailer.starts_with(SIGNATURE_MAGIC) => {
+            let (id, sig) = trailer[SIGNATURE_MAGIC.len()..].split_at(KEY_ID_BYTES);
+            Some(Signature {
+                key_id: KeyId(id.try_into().expect("KEY_ID_BYTES bytes")),
+                ed25519: sig.try_into().expect("64 bytes"),
+            })
+        }
+        n => return Err(LoadError::Damaged { reason: format!("{n} bytes follow the content") }),
+    };
     let found = sha256_hex(body);
     if found != expected {
         return Err(LoadError::Modified { expected, found });
     }
-    postcard::from_bytes(body).map_err(|e| LoadError::Invalid { reason: e.to_string() })
+    let content = postcard::from_bytes(body).map_err(|e| LoadError::Invalid { reason: e.to_string() })?;
+    Ok(Decoded { content, sha256: found, signature })
 }
 
 /// Checks that every index of the content points at something, and that

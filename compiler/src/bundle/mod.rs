@@ -20,6 +20,7 @@
 
 pub mod build;
 pub mod codec;
+pub mod sign;
 
 use serde::{Deserialize, Serialize};
 
