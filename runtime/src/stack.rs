@@ -299,6 +299,10 @@ pub struct BoardRunner {
     pub counters: BoardCounters,
     /// Per agent, the time of its latest accepted event.
     last_time: Vec<u64>,
+    /// A heartbeat that moved the clock without a change and is not yet in
+    /// the recording: written before the next accepted event stamped
+    /// earlier than it, so that a replay's clock is where the board's was.
+    pending_tick: Option<u64>,
     /// How far ahead of the clock an event may be stamped (ns).
     max_skew: u64,
     /// Per event, per field: compared with something by a rule.
@@ -335,6 +339,7 @@ impl BoardRunner {
         BoardRunner {
             last_time: vec![0; content.agents.len()],
             max_skew: DEFAULT_MAX_SKEW,
+            pending_tick: None,
             modes: vec![None; content.agents.len()],
             board: Bulletinboard::new(content),
             counters: BoardCounters::default(),
@@ -394,11 +399,15 @@ impl BoardRunner {
     pub fn tick(&mut self, shared: &Shared, now: u64) -> Option<StateChange> {
         match self.board.advance(now) {
             Ok(Some(change)) => {
+                self.pending_tick = None;
                 shared.record(|s| s.tick(now));
                 self.after(shared, &change, now);
                 change.changed().then_some(change)
             }
-            Ok(None) => None,
+            Ok(None) => {
+                self.pending_tick = Some(now);
+                None
+            }
             Err(e) => {
                 self.cascade(shared, &e, now);
                 None
@@ -476,6 +485,12 @@ impl BoardRunner {
         }
         self.last_time[msg.agent as usize] = msg.time;
         self.counters.accepted += 1;
+        // An event that arrives after a heartbeat but is stamped before it
+        // (real time: it was on its way) changes the state at the board's
+        // clock, not at its stamp: the recording says where the clock was.
+        if let Some(t) = self.pending_tick.take().filter(|&t| msg.time < t) {
+            shared.record(|s| s.tick(t));
+        }
         let rec = record_of(msg, Verdict::Accepted);
         shared.record(|s| s.event(&rec));
         // The agent's FSM sees its own event before the Bulletinboard's rest.
