@@ -13,6 +13,9 @@ python3 -m pip install --quiet --disable-pip-version-check -r examples/python/re
 echo "== cargo test --workspace --all-features"
 cargo test --workspace --all-features
 
+echo "== the fuzz targets, 5 s each, from their committed corpora (scripts/fuzz.sh; cargo-fuzz on stable)"
+bash scripts/fuzz.sh 5
+
 echo "== the VS Code extension's grammar on every .situ file (vscode-tmgrammar-test, from npm)"
 bash editors/vscode/test/run.sh
 
