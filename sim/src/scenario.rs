@@ -350,11 +350,21 @@ pub fn parse(text: &str) -> Result<Scenario, ScenarioError> {
     build(file)
 }
 
+/// The extent of a scenario's world: coordinates (m) and angles (degrees)
+/// within ±100 km of the origin. A road sampled metre by metre across a
+/// larger world would ask for more memory than a mission can justify.
+pub const MAX_COORDINATE: f64 = 100_000.0;
+
 fn finite(place: &str, v: f64) -> Result<f64, ScenarioError> {
-    if v.is_finite() {
-        Ok(v)
-    } else {
+    if !v.is_finite() {
         Err(ScenarioError::Invalid { place: place.into(), message: format!("{v} is not a finite number") })
+    } else if v.abs() > MAX_COORDINATE {
+        Err(ScenarioError::Invalid {
+            place: place.into(),
+            message: format!("{v} is out of the world: coordinates and angles lie within ±{MAX_COORDINATE}"),
+        })
+    } else {
+        Ok(v)
     }
 }
 
@@ -713,6 +723,19 @@ y = -1.75
         let bad = text.replace("speed = 1.2", "speed = -1.0");
         let e = parse(&bad).expect_err("negative speed");
         assert_eq!(e.to_string(), "obstacles[0] (\"walker\").motion.speed: must be a positive number, not -1");
+    }
+
+    #[test]
+    fn a_coordinate_out_of_the_world_is_refused_not_sampled() {
+        // Found by the `scenario` fuzz target: a node at 7e26 m made the
+        // cross-country check sample the track metre by metre (capacity overflow).
+        let text = include_str!("../tests/fuzz/scenario-huge-coordinate.toml");
+        let e = parse(text).unwrap_err().to_string();
+        assert!(e.contains("out of the world"), "{e}");
+        let fixed = text.replace("704444444444444444444444441.0", "704.0");
+        if let Err(e) = parse(&fixed) {
+            assert!(!e.to_string().contains("out of the world"), "{e}");
+        }
     }
 
     #[cfg(unix)]
