@@ -586,6 +586,10 @@ fn duration(nanos: u64) -> String {
 
 /// A float that reads back as the same value, with a `.` or an exponent.
 fn float(value: f64) -> String {
+    if !value.is_finite() {
+        // `NaN`, `inf`, `-inf`: the literals of the language.
+        return format!("{value}");
+    }
     let text = format!("{value:?}");
     if text.contains(['.', 'e', 'E']) {
         text
@@ -974,6 +978,8 @@ mod tests {
         for v in [0.1, 1e300, -2.5e-300, 123456789.123] {
             assert_eq!(float(v).parse::<f64>().unwrap(), v);
         }
+        assert_eq!((float(f64::NAN).as_str(), float(f64::INFINITY).as_str()), ("NaN", "inf"));
+        assert_eq!(float(f64::NEG_INFINITY), "-inf");
     }
 
     #[test]

@@ -650,6 +650,11 @@ impl Builder<'_> {
             Rule::float => LiteralValue::Float(self.float(inner)?),
             Rule::int => LiteralValue::Int(self.int(inner)?),
             Rule::boolean => LiteralValue::Bool(inner.as_str() == "true"),
+            Rule::non_finite => LiteralValue::Float(match inner.as_str() {
+                "NaN" => f64::NAN,
+                "-inf" => f64::NEG_INFINITY,
+                _ => f64::INFINITY,
+            }),
             _ => LiteralValue::Symbol(inner.as_str().to_string()),
         };
         Some(Literal { value, span })
@@ -881,5 +886,27 @@ mod tests {
         assert_eq!(parse_scaled("200", 1_000_000), Some(200_000_000));
         assert_eq!(parse_scaled("0.0000000001", 1_000_000_000), None);
         assert_eq!(parse_scaled("99999999999999999999", 1), None);
+    }
+
+    /// The arguments of the first `on` of the first test of `src`.
+    fn arguments(src: &str) -> Vec<LiteralValue> {
+        let parsed = parse(src, crate::diag::FileId(0));
+        assert!(parsed.errors.is_empty(), "{:?}", parsed.errors);
+        let Some(crate::ast::Item::Test(t)) = parsed.file.items.first() else { panic!("a test") };
+        let Some(TestClause::On { events, .. }) = t.clauses.first() else { panic!("an on clause") };
+        events[0].arguments.iter().map(|a| a.value.value.clone()).collect()
+    }
+
+    #[test]
+    fn non_finite_floats_are_literals() {
+        let values = arguments("test \"t\" { on E(a: NaN, b: inf, c: -inf, d: nan, e: infinity, f: info) }");
+        assert!(matches!(values[0], LiteralValue::Float(f) if f.is_nan()));
+        assert_eq!(values[1], LiteralValue::Float(f64::INFINITY));
+        assert_eq!(values[2], LiteralValue::Float(f64::NEG_INFINITY));
+        for (v, name) in values[3..].iter().zip(["nan", "infinity", "info"]) {
+            assert_eq!(*v, LiteralValue::Symbol(name.into()), "other spellings are names");
+        }
+        // An overflowing number is still an error, not infinity.
+        assert!(!parse("test \"t\" { on E(a: 1e999) }", crate::diag::FileId(0)).errors.is_empty());
     }
 }

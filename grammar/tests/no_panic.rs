@@ -77,7 +77,7 @@ const VOCABULARY: &[&str] = &[
     "always", "never", "next", "eventually", "events", "true", "false", "runs", "running", "sleeping", "waiting", "f64",
     "i64", "bool", "{", "}", "(", ")", "[", "]", "#[allow(W0301)]", "#[", "->", "=>", "==", "!=", "<", "<=", ">", ">=",
     "..", "..=", ",", ":", "_", "?d", "x3", "A", "RS", "LADAR", "LAOBS", "distance", "fuse()", "fuse", "0", "-3", "30.0",
-    "1e-7", "-0.5", "200ms", "1.5s", "2min", "3us", "5ns", "20Hz", "2.5Hz", "\"desc\"", "\"a \\\" b\"", "\"open",
+    "1e-7", "-0.5", "NaN", "inf", "-inf", "200ms", "1.5s", "2min", "3us", "5ns", "20Hz", "2.5Hz", "\"desc\"", "\"a \\\" b\"", "\"open",
     "// comment", "//", "// note\n", " // note\n", "\n// note\n", "\n", "\n\n", " ", "\t", "é", "\u{0}",
 ];
 

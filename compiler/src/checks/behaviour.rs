@@ -2,6 +2,7 @@
 //! the runtime applies, and what the static checks can know of it when an
 //! FSM makes it depend on the agent's history.
 
+use super::transitions::Transitions;
 use crate::model::*;
 use situ_grammar::ast::Mode;
 use std::borrow::Cow;
@@ -62,13 +63,46 @@ pub fn can_fire(t: &FsmTransition) -> bool {
 /// Which states of the FSM its transitions can lead to from the initial
 /// state (indexed like [`Fsm::states`]).
 pub fn reachable_fsm_states(fsm: &Fsm) -> Vec<bool> {
+    reachable_fsm_states_with(fsm, can_fire)
+}
+
+/// The system states that a state change can lead into (indexed like
+/// [`Model::states`]): those the rules can reach from the initial state, but
+/// the initial state itself only when a rule leads back to it from a
+/// reachable state (the start is not a change).
+pub fn entered_states(model: &Model, tr: &Transitions) -> Vec<bool> {
+    let mut entered = vec![false; model.states.len()];
+    let Some(initial) = model.initial else { return entered };
+    let reachable = tr.shortest_paths(model, initial);
+    for e in tr.edges.iter().filter(|e| reachable[e.from.index()].is_some()) {
+        entered[e.to.index()] = true;
+    }
+    entered
+}
+
+/// Whether an FSM transition can ever fire, given the system states a state
+/// change can lead into ([`entered_states`]).
+pub fn can_fire_in(t: &FsmTransition, entered: &[bool]) -> bool {
+    match &t.trigger {
+        FsmTrigger::State(set) => set.states.iter().any(|s| entered.get(s.index()).copied().unwrap_or(false)),
+        FsmTrigger::Event(_) => true,
+    }
+}
+
+/// As [`reachable_fsm_states`], with only the transitions that can fire
+/// given the system states a state change can lead into.
+pub fn reachable_fsm_states_in(fsm: &Fsm, entered: &[bool]) -> Vec<bool> {
+    reachable_fsm_states_with(fsm, |t| can_fire_in(t, entered))
+}
+
+fn reachable_fsm_states_with(fsm: &Fsm, fires: impl Fn(&FsmTransition) -> bool) -> Vec<bool> {
     let mut seen = vec![false; fsm.states.len()];
     let mut stack = vec![fsm.initial];
     while let Some(s) = stack.pop() {
         if std::mem::replace(&mut seen[s], true) {
             continue;
         }
-        stack.extend(fsm.transitions.iter().filter(|t| t.from == s && can_fire(t)).map(|t| t.to));
+        stack.extend(fsm.transitions.iter().filter(|t| t.from == s && fires(t)).map(|t| t.to));
     }
     seen
 }

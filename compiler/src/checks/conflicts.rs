@@ -1,13 +1,24 @@
 //! E0302 / W0319: two rules of the same salience with different targets whose
 //! conditions can hold at the same time. Which one fires then depends on
 //! specificity, recency or the order in the file: rarely what was meant.
+//!
+//! The witness is a memory in which the two rules are the ones that decide:
+//! no rule of higher salience is activated there too (it would fire first
+//! and mask them). When every memory of the two rules activates a rule of
+//! higher salience, they never compete, and there is no finding.
 
+use super::escape::{avoiding, independent_dropped, Outcome};
+use super::situation::Situation;
 use super::transitions::Transitions;
 use crate::codes;
 use crate::model::{Model, Rule};
 use serde_json::json;
 use situ_grammar::diag::Diagnostic;
 use std::collections::BTreeMap;
+
+/// The search budget per pair for a memory that no rule of higher salience
+/// masks (branches of the falsification search, as for W0303).
+const BUDGET: usize = 20_000;
 
 pub fn check(model: &Model, tr: &Transitions) -> Vec<Diagnostic> {
     // Only rules of equal salience can conflict: group them first.
@@ -45,7 +56,42 @@ fn pair(model: &Model, tr: &Transitions, a: usize, b: usize) -> Option<Diagnosti
     if both.states.is_empty() {
         return None;
     }
-    let witness = both.witness(model).ok()?;
+    // The rules of higher salience that can be activated with both: a
+    // memory where one of them is activated does not show the conflict.
+    let higher: Vec<usize> = (0..model.rules.len())
+        .filter(|&h| {
+            model.rules[h].salience > ra.salience && tr.situations[h].as_ref().is_ok_and(|s| both.compatible(s))
+        })
+        .collect();
+    let higher_rules: Vec<&Rule> = higher.iter().map(|&h| &model.rules[h]).collect();
+    let mut masking: Vec<&Rule> = Vec::new();
+    let witness = if independent_dropped(model, &both, &higher_rules).is_empty() {
+        both.witness(model).ok()?
+    } else {
+        let mut budget = BUDGET;
+        match avoiding(model, &both, &higher_rules, &mut budget) {
+            Outcome::Found(w) => w,
+            // Every memory where both are activated activates a rule of
+            // higher salience: they never decide.
+            Outcome::None => return None,
+            // Undecided (budget, or comparisons between variables): a
+            // candidate memory, reported as "may", with the rules that may
+            // mask it.
+            Outcome::Unknown => {
+                let mut w = both.witness(model).ok()?;
+                w.widened = true;
+                masking = higher
+                    .iter()
+                    .filter(|&&h| {
+                        let meets = |hs: &Situation| both.meet(model, hs).and_then(|m| m.witness(model)).is_ok();
+                        tr.situations[h].as_ref().is_ok_and(meets)
+                    })
+                    .map(|&h| &model.rules[h])
+                    .collect();
+                w
+            }
+        }
+    };
     let (code, message) = if witness.widened {
         (codes::MAY_CONFLICT, format!("rules `{}` and `{}` may conflict", ra.name, rb.name))
     } else {
@@ -58,7 +104,21 @@ fn pair(model: &Model, tr: &Transitions, a: usize, b: usize) -> Option<Diagnosti
         Diagnostic::error(code, message, rb.origin.file, rb.origin.span, format!("leads to {}", target(rb)))
     };
     d = d.with_label(ra.origin.file, ra.origin.span, format!("leads to {}", target(ra)));
-    let help = if witness.widened {
+    for h in &masking {
+        d = d.with_label(
+            h.origin.file,
+            h.origin.span,
+            format!("salience {}, leads to {}: may fire first", h.salience, target(h)),
+        );
+    }
+    let masked_by: Vec<&str> = masking.iter().map(|h| h.name.as_str()).collect();
+    let help = if !masking.is_empty() {
+        format!(
+            "they can hold together in {}, but {} of higher salience may be activated there too, and no memory without them was found within the search budget; give one a higher salience if it should win",
+            witness.describe(),
+            masked_by.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(" or ")
+        )
+    } else if witness.widened {
         format!(
             "they can hold together in {} (comparisons between variables were not decided exactly); give one a higher salience if it should win",
             witness.describe()
@@ -70,10 +130,14 @@ fn pair(model: &Model, tr: &Transitions, a: usize, b: usize) -> Option<Diagnosti
             ra.salience
         )
     };
-    Some(d.with_help(help).with_witness(json!({
+    let mut data = json!({
         "rules": [ra.name, rb.name],
         "targets": [target(ra), target(rb)],
         "memory": witness.json,
         "exact": !witness.widened,
-    })))
+    });
+    if !masked_by.is_empty() {
+        data["may_be_masked_by"] = json!(masked_by);
+    }
+    Some(d.with_help(help).with_witness(data))
 }

@@ -100,13 +100,16 @@ impl Domain {
                     return Domain::Real { intervals: vec![], nan: false };
                 }
                 let (ninf, inf) = (f64::NEG_INFINITY, f64::INFINITY);
+                // Nothing is below -inf or above inf (`next_down(-inf)` is -inf).
+                let below = |hi: f64| if v == ninf { None } else { Interval::new(ninf, hi.next_down()) };
+                let above = |lo: f64| if v == inf { None } else { Interval::new(lo.next_up(), inf) };
                 let intervals = match op {
-                    CmpOp::Lt => vec![Interval::new(ninf, v.next_down())],
+                    CmpOp::Lt => vec![below(v)],
                     CmpOp::Le => vec![Interval::new(ninf, v)],
-                    CmpOp::Gt => vec![Interval::new(v.next_up(), inf)],
+                    CmpOp::Gt => vec![above(v)],
                     CmpOp::Ge => vec![Interval::new(v, inf)],
                     CmpOp::Eq => vec![Interval::new(v, v)],
-                    CmpOp::Ne => vec![Interval::new(ninf, v.next_down()), Interval::new(v.next_up(), inf)],
+                    CmpOp::Ne => vec![below(v), above(v)],
                 };
                 Domain::Real { intervals: intervals.into_iter().flatten().collect(), nan: false }
             }
@@ -270,7 +273,12 @@ impl Domain {
         use serde_json::json;
         match (self, ty) {
             (Domain::Real { intervals, nan }, _) => match intervals.first() {
-                Some(i) => Some(json!(i.sample())),
+                Some(i) => Some(match i.sample() {
+                    // JSON has no infinities: as the wire protocol writes them.
+                    f if f == f64::INFINITY => json!("inf"),
+                    f if f == f64::NEG_INFINITY => json!("-inf"),
+                    f => json!(f),
+                }),
                 None if *nan => Some(json!("NaN")),
                 None => None,
             },

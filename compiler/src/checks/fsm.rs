@@ -2,18 +2,21 @@
 //! transitions from one FSM state that compete for the same input (the
 //! first in source order fires, so the other never does on that input).
 
-use super::behaviour::{can_fire, reachable_fsm_states};
+use super::behaviour::{can_fire, can_fire_in, entered_states, reachable_fsm_states_in};
 use super::transitions::Transitions;
 use crate::codes;
 use crate::model::{Agent, Behaviour, Fsm, FsmTransition, FsmTrigger, Model};
 use serde_json::{json, Value};
 use situ_grammar::diag::Diagnostic;
 
-pub fn check(model: &Model, _tr: &Transitions) -> Vec<Diagnostic> {
+pub fn check(model: &Model, tr: &Transitions) -> Vec<Diagnostic> {
     let mut out = Vec::new();
+    // A state trigger fires on a change into one of its states: only the
+    // states the rules can lead into count.
+    let entered = entered_states(model, tr);
     for agent in &model.agents {
         if let Behaviour::Fsm(fsm) = &agent.behaviour {
-            out.extend(unreachable(model, agent, fsm));
+            out.extend(unreachable(model, agent, fsm, &entered));
             out.extend((0..fsm.transitions.len()).filter_map(|k| competing(model, agent, fsm, k)));
         }
     }
@@ -33,8 +36,8 @@ fn describe(model: &Model, fsm: &Fsm, t: &FsmTransition) -> String {
 }
 
 /// W0313.
-fn unreachable(model: &Model, agent: &Agent, fsm: &Fsm) -> Vec<Diagnostic> {
-    let reachable = reachable_fsm_states(fsm);
+fn unreachable(model: &Model, agent: &Agent, fsm: &Fsm, entered: &[bool]) -> Vec<Diagnostic> {
+    let reachable = reachable_fsm_states_in(fsm, entered);
     let names = |keep: bool| -> Vec<&str> {
         fsm.states.iter().zip(&reachable).filter(|(_, &r)| r == keep).map(|(s, _)| s.name.as_str()).collect()
     };
@@ -50,10 +53,18 @@ fn unreachable(model: &Model, agent: &Agent, fsm: &Fsm) -> Vec<Diagnostic> {
         );
         let mut why = Vec::new();
         for t in fsm.transitions.iter().filter(|t| t.to == i && t.from != i) {
-            let reason = if can_fire(t) {
-                format!("it starts in `{}`, itself unreachable", fsm.states[t.from].name)
-            } else {
-                "it never fires: its state test allows no state".to_string()
+            let reason = match &t.trigger {
+                FsmTrigger::State(_) if !can_fire(t) => "it never fires: its state test allows no state".to_string(),
+                FsmTrigger::State(set) if !can_fire_in(t, entered) => {
+                    let names: Vec<&str> = set.states.iter().map(|&s| model.state(s).name.as_str()).collect();
+                    let back =
+                        if model.initial.is_some_and(|i| set.states.contains(&i)) { " after the start" } else { "" };
+                    format!(
+                        "it never fires: no rule leads the system into {}{back}",
+                        names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(" or ")
+                    )
+                }
+                _ => format!("it starts in `{}`, itself unreachable", fsm.states[t.from].name),
             };
             d = d.with_label(t.origin.file, t.origin.span, format!("leads here, but {reason}"));
             why.push(json!({ "transition": describe(model, fsm, t), "why": reason }));

@@ -74,7 +74,9 @@ fn state_cycles(
             found(path);
         } else if to > start
             && dist[to.index()] != usize::MAX
-            && path.len() + dist[to.index()] < MAX_CYCLE
+            // `path.len()` steps lead to `to` and `dist` more close the
+            // cycle: at most MAX_CYCLE in all.
+            && path.len() + dist[to.index()] <= MAX_CYCLE
             && !path.contains(&to)
         {
             path.push(to);

@@ -183,3 +183,52 @@ fn a_variable_in_a_negation_widens() {
     let w = Situation::of_rule(&c.model, &c.model.rules[0]).unwrap().witness(&c.model).unwrap();
     assert!(w.widened, "an inequality with a variable is not decided exactly");
 }
+
+/// A ring of `n` states, each left on another agent's event.
+fn ring(n: usize) -> String {
+    let mut s = String::from("states { IT initial");
+    for i in 1..=n {
+        s.push_str(&format!(" P{i}"));
+    }
+    s.push_str(" }\nagent Supervisor interface { event SVRDY }\n");
+    for i in 1..=n {
+        s.push_str(&format!("agent A{i} sensor {{ event E{i} }}\n"));
+    }
+    s.push_str("rule ready { when state == IT and SVRDY then P1 }\n");
+    for i in 1..=n {
+        s.push_str(&format!("rule p{i} {{ when state == P{i} and E{i} then P{} }}\n", i % n + 1));
+    }
+    s
+}
+
+#[test]
+fn oscillations_of_up_to_six_rules_are_found() {
+    for n in 2..=7 {
+        let c = check_source("ring.situ", &ring(n));
+        let found = c.diagnostics.iter().filter(|d| d.code == crate::codes::OSCILLATION).count();
+        assert_eq!(found, usize::from(n <= 6), "a ring of {n} rules: {:?}", c.diagnostics);
+    }
+}
+
+#[test]
+fn infinities_are_values_at_the_ends() {
+    let (inf, ninf) = (f64::INFINITY, f64::NEG_INFINITY);
+    assert!(real(CmpOp::Gt, inf).is_empty(), "nothing is above inf");
+    assert!(real(CmpOp::Lt, ninf).is_empty(), "nothing is below -inf");
+    assert!(real(CmpOp::Ne, inf).intersect(&real(CmpOp::Eq, inf)).is_empty());
+    assert!(real(CmpOp::Ne, inf).intersect(&real(CmpOp::Gt, f64::MAX)).is_empty(), "above MAX is inf only");
+    assert!(!real(CmpOp::Lt, inf).intersect(&real(CmpOp::Eq, ninf)).is_empty(), "-inf < inf");
+    assert_eq!(real(CmpOp::Ge, inf).sample(&Type::F64), Some(serde_json::json!("inf")));
+    assert_eq!(real(CmpOp::Le, ninf).sample(&Type::F64), Some(serde_json::json!("-inf")));
+}
+
+#[test]
+fn non_finite_literals_are_payloads_not_rule_tests() {
+    let c = rules(
+        "rule r { when state == IT and LAOBS(distance < inf, side == left) then RS }
+         test \"t\" { given state IT on LAOBS(distance: NaN, side: left), LAOBS(distance: -inf, side: left) expect state RS }",
+    );
+    assert!(c.diagnostics.iter().all(|d| d.code != "E0201" && d.code != "E0203"), "{:?}", c.diagnostics);
+    let c = check_source("t.situ", &format!("{STACK}rule r {{ when state == IT and LAOBS(distance != NaN) then RS }}"));
+    assert!(c.diagnostics.iter().any(|d| d.code == "E0203"), "{:?}", c.diagnostics);
+}

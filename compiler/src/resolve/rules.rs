@@ -203,7 +203,27 @@ fn operand(
     scope: &[Variable],
 ) -> Option<Operand> {
     match op {
-        ast::Operand::Literal(lit) => types::literal(cx, file, lit, ty, field).map(Operand::Value),
+        ast::Operand::Literal(lit) => {
+            let value = types::literal(cx, file, lit, ty, field)?;
+            if matches!(value, Value::F64(f) if f.is_nan()) {
+                // NaN satisfies no comparison (not even `!=`): the test
+                // would never hold.
+                cx.diags.push(
+                    Diagnostic::error(
+                        codes::BAD_OPERATOR,
+                        format!("a comparison of field `{field}` with `NaN` never holds"),
+                        file,
+                        lit.span,
+                        "NaN is neither equal to, different from nor ordered with any value",
+                    )
+                    .with_help(format!(
+                        "`NaN` is for test and script payloads; to react to a NaN `{field}`, require the event and exclude both `{field} < 0.0` and `{field} >= 0.0` with `not`"
+                    )),
+                );
+                return None;
+            }
+            Some(Operand::Value(value))
+        }
         ast::Operand::Variable(var) => {
             let Some(id) = scope.iter().position(|v| v.name == var.name) else {
                 cx.diags.push(

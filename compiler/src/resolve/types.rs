@@ -30,6 +30,7 @@ pub(super) fn field_type(cx: &mut Cx, file: FileId, ty: &ast::FieldType) -> Type
 /// What kind of value a literal is, for messages.
 fn describe(lit: &ast::LiteralValue) -> String {
     match lit {
+        ast::LiteralValue::Float(f) if !f.is_finite() => format!("the float `{f}`"),
         ast::LiteralValue::Float(_) => "a float".into(),
         ast::LiteralValue::Int(_) => "an integer".into(),
         ast::LiteralValue::Bool(_) => "a boolean".into(),
@@ -40,6 +41,18 @@ fn describe(lit: &ast::LiteralValue) -> String {
 /// Checks a literal against the type of `field`; the typed value if it fits.
 pub(super) fn literal(cx: &mut Cx, file: FileId, lit: &ast::Literal, ty: &Type, field: &str) -> Option<Value> {
     use ast::LiteralValue as L;
+    // `NaN` and `inf` are float literals, but still name a symbol of that
+    // name where the field is an enumeration.
+    let non_finite_name = match &lit.value {
+        L::Float(f) if f.is_nan() => Some("NaN"),
+        L::Float(f) if *f == f64::INFINITY => Some("inf"),
+        _ => None,
+    };
+    if let (Some(name), Type::Symbols(symbols)) = (non_finite_name, ty) {
+        if let Some(i) = symbols.iter().position(|x| x == name) {
+            return Some(Value::Symbol(i as u32));
+        }
+    }
     let value = match (&lit.value, ty) {
         (L::Float(f), Type::F64) => Some(Value::F64(*f)),
         (L::Int(i), Type::F64) => Some(Value::F64(*i as f64)),
@@ -74,6 +87,7 @@ pub(super) fn literal(cx: &mut Cx, file: FileId, lit: &ast::Literal, ty: &Type, 
             format!("expected {}", ty.describe()),
         );
         d = match (&lit.value, ty) {
+            (L::Float(f), Type::I64) if !f.is_finite() => d.with_help("an i64 field holds whole numbers only"),
             (L::Float(f), Type::I64) if f.fract() == 0.0 => {
                 let int = (*f as i64).to_string();
                 d.with_help(format!("write the integer `{int}`")).with_fix(

@@ -180,7 +180,7 @@ fn describe(r: Rule) -> Option<&'static str> {
         Rule::variable => "a variable (`?name`)",
         Rule::string => "a string",
         Rule::int | Rule::uint => "an integer",
-        Rule::float => "a number",
+        Rule::float | Rule::non_finite => "a number",
         Rule::duration => "a duration (`200ms`)",
         Rule::frequency => "a frequency (`20Hz`)",
         Rule::literal | Rule::operand => "a value",
