@@ -8,7 +8,10 @@
 //!    fixed histogram; the clock's own cost is measured and reported beside.
 //!
 //! Missions end in final states: the engine is then reset before the next
-//! event (`--no-reset` turns this off). Nothing grows with the stream: the
+//! event ([`Engine::reset_if_final`], §10.12 of the language reference;
+//! `--no-reset` turns this off). Every event goes through the engine's
+//! acceptance rule ([`Engine::admit`]), at the clock its line gives
+//! (`@CLOCK`) if any. Nothing grows with the stream: the
 //! buffer, the histogram and the engine are of fixed size, so the peak
 //! resident memory of 10,000,000 events is that of 1,000.
 
@@ -58,6 +61,9 @@ pub struct Report {
     pub firings: u64,
     pub missions: u64,
     pub cascade_errors: u64,
+    /// Events the acceptance rule refused (`Engine::admit`): a payload that
+    /// does not fit, out of order, from the future. They change nothing.
+    pub refused: u64,
 }
 
 #[derive(Debug, Clone, Copy, Serialize)]
@@ -121,9 +127,11 @@ impl Histogram {
     }
 }
 
-/// The events of one chunk: ids, times, and payloads in one arena.
+/// The events of one chunk: ids, times, and payloads in one arena, and the
+/// clocks they arrived at (when the stream says).
 struct Chunk {
     events: Vec<(u32, u64, u32, u32)>,
+    clocks: Vec<Option<u64>>,
     values: Vec<Value>,
 }
 
@@ -132,11 +140,20 @@ impl Chunk {
         let (_, _, s, e) = self.events[i];
         &self.values[s as usize..e as usize]
     }
+
+    /// Posts event `i` through the engine's acceptance rule
+    /// ([`Engine::admit`]), at its clock when the stream gives one.
+    fn step(&self, engine: &mut Engine, i: usize) -> Result<crate::rete::Step, PostError> {
+        let (event, time, _, _) = self.events[i];
+        engine.set_clock(self.clocks[i]);
+        engine.step(event, time, self.payload(i))
+    }
 }
 
 /// Fills `chunk` with up to `n` events; returns how many.
 fn fill(source: &mut ChunkSource, chunk: &mut Chunk, n: usize) -> usize {
     chunk.events.clear();
+    chunk.clocks.clear();
     chunk.values.clear();
     for _ in 0..n {
         let start = chunk.values.len() as u32;
@@ -146,17 +163,18 @@ fn fill(source: &mut ChunkSource, chunk: &mut Chunk, n: usize) -> usize {
                     None
                 } else {
                     *left -= 1;
-                    gen.next_into(&mut chunk.values)
+                    gen.next_into(&mut chunk.values).map(|(event, time)| (event, time, None))
                 }
             }
             ChunkSource::File { events, at } => events.get(*at).map(|e| {
                 *at += 1;
                 chunk.values.extend_from_slice(&e.payload);
-                (e.event, e.time)
+                (e.event, e.time, e.clock)
             }),
         };
-        let Some((event, time)) = next else { break };
+        let Some((event, time, clock)) = next else { break };
         chunk.events.push((event, time, start, chunk.values.len() as u32));
+        chunk.clocks.push(clock);
     }
     chunk.events.len()
 }
@@ -181,13 +199,17 @@ impl<'a> ChunkSource<'a> {
 /// Runs the benchmark.
 pub fn run(content: Arc<Content>, mut opts: Options) -> Report {
     let mut engine = Engine::new(content.clone());
-    let is_final: Vec<bool> = content.states.iter().map(|s| s.is_final).collect();
-    let mut chunk = Chunk { events: Vec::with_capacity(CHUNK), values: Vec::with_capacity(CHUNK * 4) };
+    let mut chunk = Chunk {
+        events: Vec::with_capacity(CHUNK),
+        clocks: Vec::with_capacity(CHUNK),
+        values: Vec::with_capacity(CHUNK * 4),
+    };
 
     // Pass 1: throughput (and the optional stream and states files).
     let mut source = ChunkSource::new(&content, &opts.source, opts.reset_on_final);
     let mut elapsed = 0.0f64;
     let (mut total, mut changes, mut firings, mut missions, mut cascades) = (0u64, 0u64, 0u64, 0u64, 0u64);
+    let mut refused = 0u64;
     let mut at_rest = engine.state();
     let mut by_state = vec![0u64; content.states.len()];
     let mut lines: Vec<(u64, u32)> = Vec::new();
@@ -200,12 +222,11 @@ pub fn run(content: Arc<Content>, mut opts: Options) -> Report {
         lines.clear();
         let start = Instant::now();
         for i in 0..n {
-            let (event, time, _, _) = chunk.events[i];
             by_state[at_rest as usize] += 1;
-            match engine.step(event, time, chunk.payload(i)) {
+            match chunk.step(&mut engine, i) {
                 Ok(step) => firings += step.firings as u64,
                 Err(PostError::Cascade { .. }) => cascades += 1,
-                Err(_) => {}
+                Err(_) => refused += 1,
             }
             let state = engine.state();
             if state != at_rest {
@@ -213,8 +234,7 @@ pub fn run(content: Arc<Content>, mut opts: Options) -> Report {
                 lines.push((total + i as u64, state));
                 at_rest = state;
             }
-            if opts.reset_on_final && is_final[state as usize] {
-                engine.reset();
+            if opts.reset_on_final && engine.reset_if_final() {
                 missions += 1;
                 at_rest = engine.state();
             }
@@ -248,13 +268,11 @@ pub fn run(content: Arc<Content>, mut opts: Options) -> Report {
             break;
         }
         for i in 0..n {
-            let (event, time, _, _) = chunk.events[i];
-            let payload = chunk.payload(i);
             let start = Instant::now();
-            let _ = engine.step(event, time, payload);
+            let _ = chunk.step(&mut engine, i);
             hist.add(start.elapsed().as_nanos() as u64);
-            if opts.reset_on_final && is_final[engine.state() as usize] {
-                engine.reset();
+            if opts.reset_on_final {
+                engine.reset_if_final();
             }
         }
     }
@@ -285,6 +303,7 @@ pub fn run(content: Arc<Content>, mut opts: Options) -> Report {
         firings,
         missions,
         cascade_errors: cascades,
+        refused,
     }
 }
 

@@ -12,6 +12,8 @@
 //!   atomically, carrying the working memory over.
 //!
 //! [`rete::Engine`]: crate::rete::Engine
+//! [`Engine::admit`]: crate::rete::Engine::admit
+//! [`Engine::set_clock`]: crate::rete::Engine::set_clock
 
 use crate::rete::{Engine, PostError, StateChange};
 use situ_compiler::bundle::{self, Content, Value};
@@ -108,6 +110,17 @@ impl Bulletinboard {
         self.counters
     }
 
+    /// The Bulletinboard's clock the next events arrive at ([`Engine::set_clock`]).
+    pub fn set_clock(&mut self, clock: u64) {
+        self.engine.set_clock(Some(clock));
+    }
+
+    /// How far ahead of the clock it arrives at an event may be stamped
+    /// ([`Engine::admit`]).
+    pub fn set_max_skew(&mut self, ns: u64) {
+        self.engine.set_max_skew(ns);
+    }
+
     /// Keeps the latest `n` changes in [`history`](Self::history).
     pub fn set_history_capacity(&mut self, n: usize) {
         self.capacity = n;
@@ -133,6 +146,20 @@ impl Bulletinboard {
                 Err(e)
             }
         }
+    }
+
+    /// As [`post`](Self::post), for an event that arrived when the
+    /// Bulletinboard's clock read `clock`: one stamped more than the skew
+    /// bound ahead of it is refused ([`Engine::admit`]).
+    pub fn post_at(
+        &mut self,
+        clock: u64,
+        event: u32,
+        time: u64,
+        payload: &[Value],
+    ) -> Result<Option<StateChange>, PostError> {
+        self.engine.set_clock(Some(clock));
+        self.post(event, time, payload)
     }
 
     /// Posts an event by name, its payload in field order.
@@ -207,6 +234,8 @@ impl Bulletinboard {
         let state = new.state_id(state_name).ok_or_else(|| SwapError::StateMissing { state: state_name.clone() })?;
         let mut engine = Engine::new(new.clone());
         engine.set_cascade_limit(self.engine.cascade_limit());
+        engine.set_max_skew(self.engine.max_skew());
+        engine.set_clock(self.engine.clock());
         engine.advance_clock(self.engine.now());
         engine.force_state(state);
         let mut carried = Vec::new();
@@ -218,6 +247,9 @@ impl Bulletinboard {
                 }
                 continue;
             };
+            // The agent's clock goes on: its events stamped before its
+            // latest accepted one stay out of order under the new rules.
+            engine.advance_agent_time(new_agent, self.engine.agent_time(i as u32));
             if self.engine.is_stale(i as u32) {
                 engine.force_stale(new_agent);
                 carried.push(agent.name.clone());

@@ -8,9 +8,9 @@
 //! - [`bulletinboard`]: the Bulletinboard of Zhang & Zhu (2005) around it:
 //!   posting events, the state history, subscriptions, explanations, hot swap;
 //! - [`stream`]: seeded random event streams and their text form, for
-//!   benchmarks and differential tests;
-//! - [`verify`]: `situ test`: scenario tests, and properties checked by
-//!   random search with shrinking and by exhaustive exploration.
+//!   benchmarks and differential tests.
+//!
+//! `situ test` (scenario tests and properties) is the `situ-verify` crate.
 
 pub mod agent;
 pub mod bench;
@@ -28,4 +28,3 @@ pub mod script;
 pub mod stack;
 pub mod stream;
 pub mod summary;
-pub mod verify;

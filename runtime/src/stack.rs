@@ -17,7 +17,7 @@ use crate::bus::{Bus, DataMsg, EventMsg, StatusMsg};
 use crate::organise::Organisation;
 use crate::record::{DataRecord, EventRecord, Fate, Level, ModeRecord, Sink, Verdict};
 use crate::rete::{PostError, StateChange};
-use situ_compiler::bundle::{AlphaNode, Check, Content, Mode, Operand, Value};
+use situ_compiler::bundle::{Content, Mode, Value};
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex, RwLock};
 
@@ -287,26 +287,19 @@ pub struct BoardCounters {
 }
 
 /// How far ahead of the Bulletinboard's clock an event may be stamped, by
-/// default (ns): hosts kept in time by NTP on a local network agree within
-/// a few milliseconds, and 50 ms is a sixth of a typical `stale after`
-/// (300 ms), so that the events it lets through age the other facts by
-/// little.
-pub const DEFAULT_MAX_SKEW: u64 = 50_000_000;
+/// default (ns): the engine's acceptance rule ([`Engine::admit`]) holds it.
+///
+/// [`Engine::admit`]: crate::rete::Engine::admit
+pub use crate::rete::DEFAULT_MAX_SKEW;
 
 /// The events monitor of the Bulletinboard.
 pub struct BoardRunner {
     pub board: Bulletinboard,
     pub counters: BoardCounters,
-    /// Per agent, the time of its latest accepted event.
-    last_time: Vec<u64>,
     /// A heartbeat that moved the clock without a change and is not yet in
     /// the recording: written before the next accepted event stamped
     /// earlier than it, so that a replay's clock is where the board's was.
     pending_tick: Option<u64>,
-    /// How far ahead of the clock an event may be stamped (ns).
-    max_skew: u64,
-    /// Per event, per field: compared with something by a rule.
-    compared: Vec<Vec<bool>>,
     events: Vec<EventMsg>,
     /// The `BUSOVF` event, if the rules declare it.
     overflow_event: Option<u32>,
@@ -317,33 +310,12 @@ pub struct BoardRunner {
 
 impl BoardRunner {
     pub fn new(content: Arc<Content>) -> BoardRunner {
-        let mut compared: Vec<Vec<bool>> = content.events.iter().map(|e| vec![false; e.fields.len()]).collect();
-        for node in &content.network.alpha {
-            if let AlphaNode::Event { event, tests, .. } = node {
-                for t in tests {
-                    compared[*event as usize][t.field as usize] = true;
-                    if let Check::Compare { rhs: Operand::Own { field }, .. } = t.check {
-                        compared[*event as usize][field as usize] = true;
-                    }
-                }
-            }
-        }
-        for b in &content.network.beta {
-            if let AlphaNode::Event { event, .. } = &content.network.alpha[b.alpha as usize] {
-                for t in &b.tests {
-                    compared[*event as usize][t.field as usize] = true;
-                }
-            }
-        }
         let overflow_event = content.event_id("BUSOVF");
         BoardRunner {
-            last_time: vec![0; content.agents.len()],
-            max_skew: DEFAULT_MAX_SKEW,
             pending_tick: None,
             modes: vec![None; content.agents.len()],
             board: Bulletinboard::new(content),
             counters: BoardCounters::default(),
-            compared,
             events: Vec::new(),
             overflow_event,
             status_seq: 0,
@@ -353,7 +325,7 @@ impl BoardRunner {
     /// How far ahead of the Bulletinboard's clock (the `now` of
     /// [`pump`](Self::pump)) an event may be stamped; further is refused.
     pub fn set_max_skew(&mut self, ns: u64) {
-        self.max_skew = ns;
+        self.board.set_max_skew(ns);
     }
 
     /// Broadcasts the initial status and records the initial modes.
@@ -429,52 +401,28 @@ impl BoardRunner {
     }
 
     /// Why an event is refused, if it is; `now` is the Bulletinboard's clock.
-    fn check(&self, c: &Content, msg: &EventMsg, now: u64) -> Option<String> {
+    /// Beyond the bus's own check (an agent reports only its own events),
+    /// the engine's acceptance rule decides ([`Engine::admit`]: the payload's
+    /// fields, out of order, from the future), so that a running stack takes
+    /// exactly the events that `situ bench` and `situ test` take.
+    ///
+    /// [`Engine::admit`]: crate::rete::Engine::admit
+    fn check(&mut self, c: &Content, msg: &EventMsg, now: u64) -> Option<PostError> {
         let Some(def) = c.events.get(msg.event as usize) else {
-            return Some(format!("unknown event id {}", msg.event));
+            return Some(PostError::UnknownEvent { event: msg.event });
         };
         if def.agent != msg.agent {
-            let who = c.agents.get(msg.agent as usize).map_or("?", |a| a.name.as_str());
-            return Some(format!(
-                "`{}` is an event of `{}`, not of `{who}`",
-                def.name, c.agents[def.agent as usize].name
-            ));
+            return Some(PostError::AnotherAgent { event: msg.event, agent: msg.agent });
         }
-        if let Err(e) = self.board.engine().validate(msg.event, &msg.payload) {
-            return Some(e.describe(c));
-        }
-        for (i, v) in msg.payload.iter().enumerate() {
-            if let Value::F64(x) = v {
-                if !x.is_finite() && self.compared[msg.event as usize][i] {
-                    return Some(format!(
-                        "`{}.{}` is {x}, and the rules compare it: a sensor fault",
-                        def.name, def.fields[i].name
-                    ));
-                }
-            }
-        }
-        // Time at the boundary: an event from the future would move the
-        // clock and age every other fact (one stamped at 2^63 ns would end
-        // the mission); one behind its agent's previous event is out of order.
-        if msg.time > now.saturating_add(self.max_skew) {
-            return Some(format!(
-                "from the future: at {} ns, {} ns ahead of the Bulletinboard's clock (at most {} ns)",
-                msg.time,
-                msg.time - now,
-                self.max_skew
-            ));
-        }
-        let last = self.last_time[msg.agent as usize];
-        if msg.time < last {
-            return Some(format!("out of order: at {} ns, after an event at {last} ns", msg.time));
-        }
-        None
+        self.board.set_clock(now);
+        self.board.engine().admit(msg.event, msg.time, &msg.payload).err()
     }
 
     fn take(&mut self, shared: &Shared, msg: &EventMsg, now: u64) -> Option<StateChange> {
         let c = shared.content.clone();
-        if let Some(reason) = self.check(&c, msg, now) {
-            let key = reason_key(&reason);
+        if let Some(error) = self.check(&c, msg, now) {
+            let key = reason_key(&error).to_string();
+            let reason = error.describe(&c);
             *self.counters.refused.entry(key).or_default() += 1;
             let rec = record_of(msg, Verdict::Refused(reason.clone()));
             shared.record(|s| {
@@ -483,7 +431,6 @@ impl BoardRunner {
             });
             return None;
         }
-        self.last_time[msg.agent as usize] = msg.time;
         self.counters.accepted += 1;
         // An event that arrives after a heartbeat but is stamped before it
         // (real time: it was on its way) changes the state at the board's
@@ -498,7 +445,7 @@ impl BoardRunner {
         if moved.is_some() {
             self.record_modes(shared, msg.time);
         }
-        match self.board.post(msg.event, msg.time, &msg.payload) {
+        match self.board.post_at(now, msg.event, msg.time, &msg.payload) {
             Ok(Some(change)) => {
                 self.after(shared, &change, msg.time);
                 change.changed().then_some(change)
@@ -584,18 +531,12 @@ fn record_of(msg: &EventMsg, verdict: Verdict) -> EventRecord {
 }
 
 /// A short key for a refusal reason, for counting.
-fn reason_key(reason: &str) -> String {
-    if reason.starts_with("unknown event") {
-        "unknown event".into()
-    } else if reason.contains("is an event of") {
-        "another agent's event".into()
-    } else if reason.contains("sensor fault") {
-        "not a number".into()
-    } else if reason.starts_with("out of order") {
-        "out of order".into()
-    } else if reason.starts_with("from the future") {
-        "from the future".into()
-    } else {
-        "payload".into()
+fn reason_key(error: &PostError) -> &'static str {
+    match error {
+        PostError::UnknownEvent { .. } => "unknown event",
+        PostError::AnotherAgent { .. } => "another agent's event",
+        PostError::OutOfOrder { .. } => "out of order",
+        PostError::FromTheFuture { .. } => "from the future",
+        PostError::Arity { .. } | PostError::Type { .. } | PostError::Cascade { .. } => "payload",
     }
 }

@@ -42,6 +42,11 @@ pub struct Event {
     /// Nanoseconds.
     pub time: u64,
     pub payload: Vec<Value>,
+    /// The Bulletinboard's clock when the event arrived (`@CLOCK` at the end
+    /// of its line), when the stream says it; otherwise the event arrived at
+    /// its stamp. An event stamped more than the skew bound ahead of its
+    /// clock is refused (`Engine::admit`).
+    pub clock: Option<u64>,
 }
 
 /// A seeded stream of events over a bundle's alphabet.
@@ -192,7 +197,7 @@ impl Generator {
     pub fn next_event(&mut self) -> Option<Event> {
         let mut payload = Vec::new();
         let (event, time) = self.next_into(&mut payload)?;
-        Some(Event { event, time, payload })
+        Some(Event { event, time, payload, clock: None })
     }
 
     /// The next event, its payload appended to `payload` (no allocation
@@ -225,9 +230,8 @@ impl Generator {
         let gap = (-(1.0 - u).ln() * self.mean_gap).clamp(1.0, 1e12) as u64;
         self.now += gap;
         let _ = self.guide.engine.post(event, self.now, &payload[start..]);
-        let state = self.guide.engine.state() as usize;
-        if self.guide.reset_on_final && self.content.states[state].is_final {
-            self.guide.engine.reset();
+        if self.guide.reset_on_final {
+            self.guide.engine.reset_if_final();
         }
         Some((event, self.now))
     }
@@ -316,12 +320,23 @@ pub fn header(source: &str, seed: u64) -> String {
     format!("# situ events v1 {source} seed={seed}\n")
 }
 
+/// Appends one event as a line of the text form, with the clock it arrived
+/// at (`@CLOCK`) when given.
+pub fn write_event(c: &Content, out: &mut String, e: &Event) {
+    write_line(c, out, e.event, e.time, &e.payload);
+    if let Some(clock) = e.clock {
+        out.pop();
+        let _ = writeln!(out, " @{clock}");
+    }
+}
+
 /// Appends one event as a line of the text form.
 pub fn write_line(c: &Content, out: &mut String, event: u32, time: u64, payload: &[Value]) {
     let e = &c.events[event as usize];
     let _ = write!(out, "{time} {}", e.name);
     for (f, v) in e.fields.iter().zip(payload) {
         let _ = match (v, &f.ty) {
+            (Value::F64(x), _) if !x.is_finite() => write!(out, " {x}"),
             (Value::F64(x), _) => write!(out, " {x:.3}"),
             (Value::I64(i), _) => write!(out, " {i}"),
             (Value::Bool(b), _) => write!(out, " {b}"),
@@ -376,10 +391,15 @@ pub fn parse(c: &Content, text: &str) -> Result<Vec<Event>, StreamError> {
             };
             payload.push(v);
         }
+        let mut clock = None;
+        if let Some(at) = words.clone().next().and_then(|w| w.strip_prefix('@')) {
+            words.next();
+            clock = Some(at.parse().map_err(|_| err(format!("`@{at}` is not a clock in nanoseconds")))?);
+        }
         if let Some(extra) = words.next() {
             return Err(err(format!("unexpected `{extra}` after the payload of `{name}`")));
         }
-        out.push(Event { event, time, payload });
+        out.push(Event { event, time, payload, clock });
     }
     Ok(out)
 }
@@ -428,6 +448,23 @@ mod tests {
     }
 
     #[test]
+    fn a_line_may_say_when_its_event_arrived_and_carry_non_finite_values() {
+        let c = outdoor();
+        let text = "10 LAOBS NaN inf @5\n20 LAOBS -inf 0.500\n9223372036854775807 LAOBN @30\n";
+        let events = parse(&c, text).unwrap();
+        assert_eq!(events[0].clock, Some(5));
+        assert!(matches!(events[0].payload[0], Value::F64(x) if x.is_nan()));
+        assert_eq!(events[0].payload[1], Value::F64(f64::INFINITY));
+        assert_eq!((events[1].clock, events[1].payload[0]), (None, Value::F64(f64::NEG_INFINITY)));
+        assert_eq!((events[2].time, events[2].clock), (i64::MAX as u64, Some(30)));
+        let mut again = String::new();
+        for e in &events {
+            write_event(&c, &mut again, e);
+        }
+        assert_eq!(again, text);
+    }
+
+    #[test]
     fn bad_lines_say_where_and_why() {
         let c = outdoor();
         let cases = [
@@ -437,6 +474,8 @@ mod tests {
             ("10 LAOBS 1.0 high", "`high` is not a f64"),
             ("10 LAOBN 3", "unexpected `3`"),
             ("10 PLF maybe", "`maybe` is not a {no_path, blocked, timeout}"),
+            ("10 LAOBN @soon", "`@soon` is not a clock"),
+            ("10 LAOBN @5 6", "unexpected `6`"),
         ];
         for (line, want) in cases {
             let e = parse(&c, &format!("# header\n\n{line}\n")).unwrap_err();

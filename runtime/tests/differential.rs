@@ -44,15 +44,19 @@ fn agree(
     let mut engine = Engine::new(content.clone());
     let mut naive = Naive::new(&checked.model);
     for (i, (event, time, payload)) in events.iter().enumerate() {
-        let got: Result<Vec<usize>, Vec<usize>> = match engine.post(*event, *time, payload) {
-            Ok(None) => Ok(vec![]),
-            Ok(Some(change)) => Ok(change.firings.iter().map(|f| f.rule as usize).collect()),
-            Err(PostError::Cascade { firings, .. }) => Err(firings.iter().map(|f| f.rule as usize).collect()),
+        // `None`: refused (out of order, §10.4).
+        let got: Option<Result<Vec<usize>, Vec<usize>>> = match engine.post(*event, *time, payload) {
+            Ok(None) => Some(Ok(vec![])),
+            Ok(Some(change)) => Some(Ok(change.firings.iter().map(|f| f.rule as usize).collect())),
+            Err(PostError::Cascade { firings, .. }) => Some(Err(firings.iter().map(|f| f.rule as usize).collect())),
+            Err(PostError::OutOfOrder { .. }) => None,
             Err(other) => return Err(format!("event {i} refused: {other:?}")),
         };
         let want = naive.post(*event as usize, *time, payload);
-        let name =
-            |rules: &Vec<usize>| -> Vec<String> { rules.iter().map(|&r| content.rules[r].name.clone()).collect() };
+        let name = |fired: &Result<Vec<usize>, Vec<usize>>| -> Result<Vec<String>, Vec<String>> {
+            let names = |rules: &Vec<usize>| rules.iter().map(|&r| content.rules[r].name.clone()).collect();
+            fired.as_ref().map(names).map_err(names)
+        };
         if got.as_ref().map(name) != want.as_ref().map(name) || engine.state() != naive.state.0 {
             return Err(format!(
                 "event {i} ({} at {time}): rete fired {:?} and is in {}, naive fired {:?} and is in {}",
@@ -63,7 +67,7 @@ fn agree(
                 content.states[naive.state.index()].name,
             ));
         }
-        if got.is_err() {
+        if matches!(got, Some(Err(_))) {
             return Ok(()); // a cascade error ends the run, for both
         }
         if reset_on_final && content.states[engine.state() as usize].is_final {

@@ -9,7 +9,16 @@
 //! only the alpha nodes of the event concerned and the beta nodes below
 //! them, in topological order, never the whole network.
 //!
-//! [`Engine::post`] processes one event (§10.4):
+//! [`Engine::admit`] is the one acceptance rule of situ (§10.4): the
+//! engine, `situ bench`, `situ test` and the running stack's Bulletinboard
+//! all take or refuse an event by it. An event is refused, and changes
+//! nothing, when its payload does not fit its event's fields, when it is
+//! stamped before its agent's latest accepted event (out of order), or, when
+//! the clock it arrives at is known ([`Engine::set_clock`]), when it is
+//! stamped more than the skew bound ahead of that clock (from the future). NaN and the infinities are values
+//! like any other (§10.3 says what they match).
+//!
+//! [`Engine::post`] processes one accepted event (§10.4):
 //! 1. now = max(now, t); facts older than their agent's `stale after`
 //!    expire and windows close; the network is brought to rest;
 //! 2. the new fact replaces the agent's previous one; rest again.
@@ -30,6 +39,13 @@ pub use eval::{compare, in_range, passes};
 
 /// The default bound of a cascade (§10.4).
 pub const CASCADE_LIMIT: usize = 64;
+
+/// How far ahead of the Bulletinboard's clock an event may be stamped, by
+/// default (ns): hosts kept in time by NTP on a local network agree within
+/// a few milliseconds, and 50 ms is a sixth of a typical `stale after`
+/// (300 ms), so that the events it lets through age the other facts by
+/// little (§10.7).
+pub const DEFAULT_MAX_SKEW: u64 = 50_000_000;
 
 /// An agent's latest fact.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -165,6 +181,13 @@ pub enum PostError {
     Arity { event: u32, expected: usize, found: usize },
     /// A value does not fit its field's type.
     Type { event: u32, field: u32, expected: FieldType },
+    /// Reported on the bus by another agent than the event's (the engine
+    /// takes the agent from the event; the Bulletinboard's bus checks it).
+    AnotherAgent { event: u32, agent: u32 },
+    /// Stamped before the same agent's latest accepted event.
+    OutOfOrder { event: u32, time: u64, last: u64 },
+    /// Stamped more than the skew bound ahead of the clock it arrived at.
+    FromTheFuture { event: u32, time: u64, clock: u64, max_skew: u64 },
     /// The network did not come to rest within the bound: the firings so
     /// far, which name the rules. The state is the last one reached.
     Cascade { limit: usize, firings: Vec<Firing> },
@@ -187,6 +210,18 @@ impl PostError {
                     expected.describe()
                 )
             }
+            PostError::AnotherAgent { event, agent } => {
+                let e = &c.events[*event as usize];
+                let who = c.agents.get(*agent as usize).map_or("?", |a| a.name.as_str());
+                format!("`{}` is an event of `{}`, not of `{who}`", e.name, c.agents[e.agent as usize].name)
+            }
+            PostError::OutOfOrder { time, last, .. } => {
+                format!("out of order: at {time} ns, after an event of the same agent at {last} ns")
+            }
+            PostError::FromTheFuture { time, clock, max_skew, .. } => format!(
+                "from the future: at {time} ns, {} ns ahead of the Bulletinboard's clock (at most {max_skew} ns)",
+                time - clock
+            ),
             PostError::Cascade { limit, firings } => {
                 let mut names: Vec<&str> = firings.iter().map(|f| c.rules[f.rule as usize].name.as_str()).collect();
                 names.dedup();
@@ -211,6 +246,13 @@ pub struct Engine {
     stale: Vec<bool>,
     now: u64,
     seq: u64,
+    /// Per agent, the stamp of its latest accepted event (kept by a reset:
+    /// an agent's clock does not go back with a new mission).
+    last: Vec<u64>,
+    max_skew: u64,
+    /// The Bulletinboard's clock the next events arrive at (`None`: at
+    /// their stamps).
+    clock: Option<u64>,
     // Timers: per agent the time its fact expires and the next window that
     // closes (u64::MAX: none); the earliest of all, possibly too early.
     stale_at: Vec<u64>,
@@ -242,6 +284,9 @@ impl Engine {
             stale: vec![false; na],
             now: 0,
             seq: 0,
+            last: vec![0; na],
+            max_skew: DEFAULT_MAX_SKEW,
+            clock: None,
             stale_at: vec![u64::MAX; na],
             window_at: vec![u64::MAX; na],
             next_deadline: u64::MAX,
@@ -322,6 +367,9 @@ impl Engine {
         self.stale.clone_from(&other.stale);
         self.now = other.now;
         self.seq = other.seq;
+        self.last.clone_from(&other.last);
+        self.max_skew = other.max_skew;
+        self.clock = other.clock;
         self.stale_at.clone_from(&other.stale_at);
         self.window_at.clone_from(&other.window_at);
         self.next_deadline = other.next_deadline;
@@ -345,7 +393,9 @@ impl Engine {
         &self.active
     }
 
-    /// Back to the initial state with no facts; now is kept. Incremental:
+    /// Back to the initial state with no facts; now, and each agent's
+    /// latest accepted time, are kept (§10.12: a mission ends in a final
+    /// state, the clocks go on). Incremental:
     /// only the nodes of the facts there were, and of the state, change.
     pub fn reset(&mut self) {
         for a in 0..self.slots.len() {
@@ -366,7 +416,87 @@ impl Engine {
         self.propagate();
     }
 
-    /// Checks an event against the bundle's schema.
+    /// How far ahead of the clock it arrives at an event may be stamped
+    /// (ns; default [`DEFAULT_MAX_SKEW`]).
+    pub fn max_skew(&self) -> u64 {
+        self.max_skew
+    }
+
+    pub fn set_max_skew(&mut self, ns: u64) {
+        self.max_skew = ns;
+    }
+
+    /// The stamp of the agent's latest accepted event (0 before its first):
+    /// an event of the agent stamped earlier is refused.
+    pub fn agent_time(&self, agent: u32) -> u64 {
+        self.last.get(agent as usize).copied().unwrap_or(0)
+    }
+
+    /// Moves the agent's clock forward to `time` (a carried-over clock, at
+    /// hot swap): its events stamped earlier are refused from then on.
+    pub fn advance_agent_time(&mut self, agent: u32, time: u64) {
+        if let Some(t) = self.last.get_mut(agent as usize) {
+            *t = (*t).max(time);
+        }
+    }
+
+    /// The Bulletinboard's clock when the next events arrive (`None`: each
+    /// arrives at its stamp, as in a stream without clocks, a test or a
+    /// search). The running stack sets it to its clock (the wall clock, or
+    /// simulated time) before it takes the events of a drain; a stream line
+    /// `@CLOCK` sets it for its event. Against it [`admit`](Self::admit)
+    /// refuses events from the future.
+    pub fn set_clock(&mut self, clock: Option<u64>) {
+        self.clock = clock;
+    }
+
+    pub fn clock(&self) -> Option<u64> {
+        self.clock
+    }
+
+    /// **The acceptance rule** (language reference §10.4), the one place
+    /// where situ decides whether an event is taken: the engine's
+    /// [`step`](Self::step) and [`post`](Self::post), hence `situ bench`,
+    /// `situ test` and the running stack's Bulletinboard, all go through it.
+    /// An event is refused when
+    /// - its payload does not fit its event's fields ([`validate`](Self::validate));
+    /// - it is stamped before its agent's latest accepted event (out of
+    ///   order; the same time is accepted);
+    /// - it is stamped more than [`max_skew`](Self::max_skew) ahead of the
+    ///   [`clock`](Self::set_clock) it arrived at (from the future). Without
+    ///   a clock an event arrives at its stamp, and none is from the future.
+    ///
+    /// NaN and the infinities are accepted: §10.3 says what they match.
+    /// A refused event changes nothing, not even now.
+    pub fn admit(&self, event: u32, time: u64, payload: &[Value]) -> Result<(), PostError> {
+        self.validate(event, payload)?;
+        let agent = self.net.event_agent[event as usize] as usize;
+        let last = self.last[agent];
+        if time < last {
+            return Err(PostError::OutOfOrder { event, time, last });
+        }
+        if let Some(clock) = self.clock {
+            if time > clock.saturating_add(self.max_skew) {
+                return Err(PostError::FromTheFuture { event, time, clock, max_skew: self.max_skew });
+            }
+        }
+        Ok(())
+    }
+
+    /// The end of a mission (§10.12): if the state at rest is `final`, back
+    /// to the initial state with no facts ([`reset`](Self::reset)) and
+    /// true. `situ bench` and its stream generator call it after each event
+    /// (after both rests), unless told not to.
+    pub fn reset_if_final(&mut self) -> bool {
+        let fin = self.content.states.get(self.state as usize).is_some_and(|s| s.is_final);
+        if fin {
+            self.reset();
+        }
+        fin
+    }
+
+    /// Checks an event against the bundle's schema (a part of
+    /// [`admit`](Self::admit), which also checks its time).
     pub fn validate(&self, event: u32, payload: &[Value]) -> Result<(), PostError> {
         let Some(&(s, e)) = self.net.event_kinds.get(event as usize) else {
             return Err(PostError::UnknownEvent { event });
@@ -400,7 +530,12 @@ impl Engine {
     /// allocation once the engine has warmed up. [`last_change`](Self::last_change)
     /// gives the details of the latest step.
     pub fn step(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Step, PostError> {
-        self.validate(event, payload)?;
+        self.admit(event, time, payload)?;
+        self.accepted(event, time, payload)
+    }
+
+    /// Processes an event that [`admit`](Self::admit) accepted.
+    fn accepted(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Step, PostError> {
         self.begin();
         if time > self.now {
             self.now = time;
@@ -549,6 +684,7 @@ impl Engine {
         self.seq += 1;
         let run = if old.event == event { old.run + 1 } else { 1 };
         self.slots[a] = Slot { event, time, run, seq: self.seq };
+        self.last[a] = self.last[a].max(time);
         let at = self.net.payload_at[a] as usize;
         self.payload[at..at + payload.len()].copy_from_slice(payload);
         if self.stale[a] {

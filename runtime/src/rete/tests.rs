@@ -44,6 +44,10 @@ impl T {
         &self.e.content().states[self.e.state() as usize].name
     }
 
+    fn clone_engine(&self) -> T {
+        T { e: self.e.clone() }
+    }
+
     fn go(&mut self, state: &str) {
         let s = self.e.content().state_id(state).unwrap();
         self.e.force_state(s);
@@ -312,4 +316,145 @@ fn the_clock_alone_expires_silent_agents() {
     assert_eq!(t.state(), "EM");
     assert!(t.e.advance(100 * MS).unwrap().is_none(), "the clock never goes back");
     assert_eq!(t.e.now(), 301 * MS);
+}
+
+// ─── The acceptance rule and the behaviours §10 writes down ───────────────
+
+fn rule_name(t: &T, change: &StateChange, i: usize) -> String {
+    t.e.content().rules[change.firings[i].rule as usize].name.clone()
+}
+
+#[test]
+fn an_event_behind_its_agents_latest_is_refused_and_changes_nothing() {
+    // A late LAOBN would have completed the x3 (the run was LAOBN, LAOBN).
+    let mut t = T::new("rule clear { when state == RO and LAOBN x3 then RS }");
+    t.go("RO");
+    t.post("LAOBN", 10, &[]);
+    t.post("LAOBN", 20, &[]);
+    t.post("STOBN", 30, &[]);
+    let laobn = t.id("LAOBN");
+    let err = t.e.post(laobn, 15 * MS, &[]).unwrap_err();
+    assert_eq!(err, PostError::OutOfOrder { event: laobn, time: 15 * MS, last: 20 * MS });
+    assert!(err.describe(t.e.content()).starts_with("out of order: at 15000000 ns"));
+    assert_eq!(t.state(), "RO");
+    assert_eq!(t.e.fact(0).unwrap().run, 2, "the fact of 20 ms is kept");
+    assert_eq!(t.e.now(), 30 * MS);
+    // The same time as the agent's latest is not behind it.
+    t.post("LAOBN", 20, &[]);
+    assert_eq!(t.state(), "RS");
+    // Another agent's event stamped before now is taken (§10.4).
+    t.post("FURS", 25, &[]);
+    assert_eq!(t.e.fact(3).unwrap().time, 25 * MS);
+    assert_eq!(t.e.agent_time(0), 20 * MS);
+}
+
+#[test]
+fn an_event_from_the_future_is_refused_against_the_clock_it_arrived_at() {
+    let mut t = T::new("rule silent { when state == RS and stale LADAR then EM }");
+    t.go("RS");
+    t.post("LAOBN", 1_000, &[]);
+    let stobn = t.id("STOBN");
+    let ahead = 1_000 * MS + DEFAULT_MAX_SKEW + 1;
+    t.e.set_clock(Some(1_000 * MS));
+    let err = t.e.step(stobn, ahead, &[]).unwrap_err();
+    assert!(matches!(err, PostError::FromTheFuture { clock, .. } if clock == 1_000 * MS), "{err:?}");
+    assert_eq!(t.e.now(), 1_000 * MS, "a refused event never moves now");
+    assert!(t.e.fact(1).is_none());
+    // At the bound it is taken; so is an event at 2^63 − 1 ns that arrived
+    // then: without a clock, an event arrives at its stamp.
+    t.e.step(stobn, ahead - 1, &[]).unwrap();
+    assert_eq!(t.state(), "RS");
+    t.e.set_max_skew(0);
+    t.e.set_clock(Some(2_000 * MS));
+    assert!(t.e.step(stobn, 2_000 * MS + 1, &[]).is_err());
+    t.e.set_clock(None);
+    t.e.step(stobn, i64::MAX as u64, &[]).unwrap();
+    assert_eq!((t.e.now(), t.state()), (i64::MAX as u64, "EM"));
+}
+
+#[test]
+fn nan_and_the_infinities_are_values_that_match_as_section_10_3_says() {
+    let mut t = T::new(
+        "rule near { when state == RS and LAOBS(distance < 30.0) then RO }
+         rule far { when state == RS and LAOBS(distance >= 1000.0) then EM }",
+    );
+    t.go("RS");
+    assert!(t.post("LAOBS", 10, &[F64(f64::NAN), F64(0.5)]).is_none(), "NaN satisfies no comparison");
+    assert!(t.e.fact(0).is_some(), "but it is the agent's latest fact");
+    let mut other = t.clone_engine();
+    t.post("LAOBS", 20, &[F64(f64::NEG_INFINITY), F64(0.5)]);
+    assert_eq!(t.state(), "RO");
+    other.post("LAOBS", 20, &[F64(f64::INFINITY), F64(0.5)]);
+    assert_eq!(other.state(), "EM");
+}
+
+#[test]
+fn a_rule_of_stale_and_not_tests_alone_has_no_recency_and_comes_last() {
+    // Same salience and specificity (2 tests each); declared first, and
+    // LADAR expired after STOBN was posted: `by_fact` still wins.
+    let rules = "rule first { when state == IT and FURS then RS }
+         rule by_stale { when state == RS and stale LADAR then EM }
+         rule by_not { when state == RS and not STOBS then EM }
+         rule by_fact { when state == RS and STOBN then SP }";
+    let mut t = T::new(rules);
+    t.post("LAOBN", 0, &[]);
+    t.post("STOBN", 10, &[]);
+    let change = t.post("FURS", 400, &[]).unwrap();
+    assert_eq!(rule_name(&t, &change, 1), "by_fact");
+    assert_eq!(t.state(), "SP");
+    // Without a matched fact between them, declaration order decides.
+    let mut t = T::new(&rules.replace("and STOBN then SP", "and STOBN and LAOBS then SP"));
+    t.post("LAOBN", 0, &[]);
+    t.post("STOBN", 10, &[]);
+    let change = t.post("FURS", 400, &[]).unwrap();
+    assert_eq!(rule_name(&t, &change, 1), "by_stale");
+    assert_eq!(t.state(), "EM");
+}
+
+#[test]
+fn a_run_continues_across_a_gap_of_exactly_stale_after_and_not_one_ns_more() {
+    let mut t = T::new("rule clear { when state == RS and LAOBN x2 then RO }");
+    t.go("RS");
+    let laobn = t.id("LAOBN");
+    t.e.post(laobn, 0, &[]).unwrap();
+    t.e.post(laobn, 300 * MS, &[]).unwrap();
+    assert_eq!(t.e.fact(0).unwrap().run, 2, "now − t = D: not expired, the run goes on");
+    assert_eq!(t.state(), "RO");
+    t.go("RS");
+    t.e.post(laobn, 600 * MS + 1, &[]).unwrap();
+    assert_eq!(t.e.fact(0).unwrap().run, 1, "D + 1 ns: expired, a new run");
+    assert_eq!(t.state(), "RS");
+    // What counts is now, which another agent's event may have moved.
+    let stobn = t.id("STOBN");
+    t.e.post(stobn, 900 * MS + 2, &[]).unwrap();
+    t.e.post(laobn, 900 * MS + 2, &[]).unwrap();
+    assert_eq!(t.e.fact(0).unwrap().run, 1);
+}
+
+#[test]
+fn a_final_state_resets_after_both_rests_and_an_event_that_reached_it_first_is_lost() {
+    let mut t = T::new(
+        "rule go { when state == IT and STOBN then RS }
+         rule silent { when state == RS and stale LADAR then SP }
+         rule back { when state == IT and FURS then RO }",
+    );
+    t.post("LAOBN", 0, &[]);
+    t.post("STOBN", 10, &[]);
+    assert_eq!(t.state(), "RS");
+    assert!(!t.e.reset_if_final(), "RS is not final");
+    // FURS at 400 ms: LADAR expires and `silent` fires in the first rest;
+    // FURS is inserted in SP, where no rule reads it.
+    let change = t.post("FURS", 400, &[]).unwrap();
+    assert_eq!((rule_name(&t, &change, 0).as_str(), t.state()), ("silent", "SP"));
+    assert!(t.e.fact(3).is_some());
+    assert!(t.e.reset_if_final());
+    assert_eq!(t.state(), "IT");
+    assert!((0..4).all(|a| t.e.fact(a).is_none() && !t.e.is_stale(a)), "facts cleared, no agent stale");
+    assert_eq!(t.e.now(), 400 * MS, "now is kept");
+    assert_eq!(t.e.agent_time(3), 400 * MS, "so are the agents' clocks");
+    // FURS was lost: `back` (IT and FURS) does not fire on it.
+    assert!(t.e.settle().unwrap().is_none());
+    assert_eq!(t.state(), "IT");
+    let furs = t.id("FURS");
+    assert!(matches!(t.e.post(furs, 399 * MS, &[]), Err(PostError::OutOfOrder { .. })));
 }

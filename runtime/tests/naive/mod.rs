@@ -23,6 +23,8 @@ pub struct Naive<'m> {
     facts: Vec<Option<Fact>>,
     now: u64,
     seq: u64,
+    /// Per agent, the stamp of its latest accepted event.
+    last: Vec<u64>,
 }
 
 /// The rules fired while processing one event, in order; `Err` when the
@@ -37,6 +39,7 @@ impl<'m> Naive<'m> {
             facts: vec![None; model.agents.len()],
             now: 0,
             seq: 0,
+            last: vec![0; model.agents.len()],
         }
     }
 
@@ -45,11 +48,22 @@ impl<'m> Naive<'m> {
         self.facts.fill(None);
     }
 
-    pub fn post(&mut self, event: usize, time: u64, payload: &[Value]) -> Fired {
+    /// Processes one event (§10.4); `None` when it is refused: stamped
+    /// before its agent's latest accepted event (no arrival clock here, so
+    /// nothing is from the future).
+    pub fn post(&mut self, event: usize, time: u64, payload: &[Value]) -> Option<Fired> {
+        let agent = self.model.events[event].agent.index();
+        if time < self.last[agent] {
+            return None;
+        }
+        self.last[agent] = time;
+        Some(self.process(event, agent, time, payload))
+    }
+
+    fn process(&mut self, event: usize, agent: usize, time: u64, payload: &[Value]) -> Fired {
         self.now = self.now.max(time);
         let mut fired = Vec::new();
         self.rest(&mut fired)?;
-        let agent = self.model.events[event].agent.index();
         let run = match &self.facts[agent] {
             Some(f) if self.live(agent, f) && f.event == event => f.run + 1,
             _ => 1,
