@@ -295,7 +295,7 @@ fn graph_draws_states_rete_and_svg() {
     let o = situ(&["graph", "rules/outdoor.situ", "--view", "states"]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     assert!(stdout(&o).starts_with("digraph states"), "{}", stdout(&o));
-    assert!(stdout(&o).contains("\"RS\" -> \"RO\""), "{}", stdout(&o));
+    assert!(stdout(&o).contains("\"RO\" -> \"RS\""), "{}", stdout(&o));
     let o = situ(&["graph", "rules/outdoor.situ", "--view", "rete"]);
     assert!(stdout(&o).contains("road_obstacle_ladar"), "{}", stdout(&o));
     let o = situ(&["graph", "rules/outdoor.situ", "--view", "wiring", "--state", "RS", "--format", "svg"]);

@@ -1,11 +1,25 @@
 //! `situ graph FILE --view wiring|rete|states [--state S] [--format dot|svg]`:
-//! pictures. DOT is printed as is; SVG is laid out by the `layout-rs` crate
-//! (no Graphviz needed; for Graphviz's own layout, pipe the DOT into `dot -Tsvg`).
+//! pictures. The compiler writes DOT (`situ_compiler::graph`); DOT is printed
+//! as is, SVG is laid out here ([`layout`]): by Graphviz's `dot` when it is
+//! on the PATH, else by the pure-Rust `layout-rs` crate.
+//!
+//! Findings are drawn, not refused: the diagnostics of a source go to
+//! standard error, and the states view of a file with errors draws what
+//! resolved (exit 1, the picture written all the same). The wiring and Rete
+//! views come from a compiled program and need a file without errors.
 
-use super::{OK, USAGE};
+pub mod layout;
+
+use super::{FAILED, OK, USAGE};
+use situ_compiler::bundle::{self, Content};
 use situ_compiler::checks::transitions::Transitions;
 use situ_compiler::graph;
+use situ_compiler::loader::FsLoader;
+use situ_compiler::render;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+pub use layout::svg;
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
 pub enum View {
@@ -23,44 +37,83 @@ pub enum Format {
     Svg,
 }
 
+/// What a picture is drawn from: the checked source (when given one) and
+/// the compiled program (when it has no errors).
+struct Input {
+    checked: Option<situ_compiler::Checked>,
+    content: Option<Arc<Content>>,
+}
+
+fn load(file: &Path) -> Result<Input, u8> {
+    if !super::program::is_source(file) {
+        let p = super::program::load(file, false)?;
+        return Ok(Input { checked: p.checked, content: Some(p.content) });
+    }
+    super::program::refuse_source_under_trust(file)?;
+    let checked = situ_compiler::check(file, &FsLoader).map_err(|e| {
+        eprintln!("error: {e}");
+        USAGE
+    })?;
+    // The findings on standard error: standard output is the picture.
+    let style = render::Style { colour: false, ..super::style() };
+    eprint!("{}", render::human_all(&checked, style));
+    let content = (checked.errors() == 0).then(|| Arc::new(bundle::build(&checked)));
+    Ok(Input { checked: Some(checked), content })
+}
+
 pub fn run(file: &Path, view: View, state: Option<&str>, format: Format, out: Option<&PathBuf>) -> u8 {
-    let program = match super::program::load(file, false) {
-        Ok(p) => p,
+    let input = match load(file) {
+        Ok(i) => i,
         Err(code) => return code,
     };
-    let c = &program.content;
-    let state = match state {
-        None => None,
-        Some(name) => match c.state_id(name) {
-            Some(s) => Some(s),
+    let name = file.display().to_string();
+    let errors = input.checked.as_ref().map_or(0, |c| c.errors());
+    let content = match (&input.content, view) {
+        (_, View::States) => None,
+        (Some(c), _) => Some(c.clone()),
+        (None, _) => {
+            eprintln!(
+                "error: `{name}` has {errors} error(s): the wiring and Rete views are drawn from a program without errors \
+                 (the states view draws what resolved; `situ check` explains each)"
+            );
+            return FAILED;
+        }
+    };
+    let state = match (state, &content) {
+        (Some(s), Some(c)) => match c.state_id(s) {
+            Some(id) => Some(id),
             None => {
                 let names: Vec<&str> = c.states.iter().map(|s| s.name.as_str()).collect();
-                eprintln!("error: no state `{name}`; the states are: {}", names.join(", "));
+                eprintln!("error: no state `{s}`; the states are: {}", names.join(", "));
                 return USAGE;
             }
         },
+        _ => None,
     };
-    let dot = match view {
-        View::Wiring => graph::wiring(c, state),
-        View::Rete => graph::rete(c),
-        View::States => match &program.checked {
-            Some(checked) => graph::states(&checked.model, &Transitions::build(&checked.model)),
+    let dot = match (view, &content) {
+        (View::States, _) => match &input.checked {
+            Some(ch) => graph::states(&ch.model, &Transitions::build(&ch.model), &name, &ch.diagnostics),
             None => {
                 eprintln!("error: the states view comes from the static checks: give the `.situ` source, not a bundle");
                 return USAGE;
             }
         },
+        (View::Wiring, Some(c)) => graph::wiring(c, state),
+        (View::Rete, Some(c)) => graph::rete(c, &name),
+        (_, None) => unreachable!("refused above"),
     };
     let text = match format {
         Format::Dot => dot,
         Format::Svg => {
-            if matches!(view, View::Wiring) && state.is_none() {
-                eprintln!(
-                    "error: an SVG shows one state's wiring: add `--state S` (or use `--format dot` for all states)"
-                );
-                return USAGE;
+            let engine = layout::engine();
+            if let layout::Engine::Builtin(why) = &engine {
+                eprintln!("note: {why}: laid out by the built-in layout (install Graphviz for the better one)");
             }
-            match svg(&dot) {
+            let laid = match (view, &content, state) {
+                (View::Wiring, Some(c), None) => small_multiples(&engine, c, &name),
+                _ => layout::svgs(&engine, &[dot.as_str()]).map(|mut v| v.remove(0)),
+            };
+            match laid {
                 Ok(svg) => svg,
                 Err(e) => {
                     eprintln!("error: cannot lay out the graph: {e}");
@@ -69,13 +122,14 @@ pub fn run(file: &Path, view: View, state: Option<&str>, format: Format, out: Op
             }
         }
     };
+    let code = if errors > 0 { FAILED } else { OK };
     match out {
         None => {
             print!("{text}");
-            OK
+            code
         }
         Some(path) => match super::write_atomically(path, text.as_bytes()) {
-            Ok(()) => OK,
+            Ok(()) => code,
             Err(e) => {
                 eprintln!("error: cannot write `{}`: {e}", path.display());
                 USAGE
@@ -84,16 +138,12 @@ pub fn run(file: &Path, view: View, state: Option<&str>, format: Format, out: Op
     }
 }
 
-/// DOT to SVG with layout-rs.
-pub fn svg(dot: &str) -> Result<String, String> {
-    use layout::backends::svg::SVGWriter;
-    use layout::gv::{DotParser, GraphBuilder};
-    let mut parser = DotParser::new(dot);
-    let tree = parser.process()?;
-    let mut builder = GraphBuilder::new();
-    builder.visit_graph(&tree);
-    let mut graph = builder.get();
-    let mut writer = SVGWriter::new();
-    graph.do_it(false, false, false, &mut writer);
-    Ok(writer.finalize())
+/// The wiring of every state in SVG: one small picture per state in a grid,
+/// the legend last, laid out by one run of the engine.
+fn small_multiples(engine: &layout::Engine, c: &Content, name: &str) -> Result<String, String> {
+    let mut dots: Vec<String> = (0..c.states.len() as u32).map(|s| graph::wiring_cell(c, s)).collect();
+    dots.push(graph::wiring_legend());
+    let refs: Vec<&str> = dots.iter().map(String::as_str).collect();
+    let cells = layout::svgs(engine, &refs)?;
+    Ok(layout::compose(&format!("Wiring of every state of {name}"), &cells))
 }
