@@ -10,6 +10,7 @@ cd "$(dirname "$0")/.."
 echo "== installing the Python packages the tests use (examples/python/requirements.txt)"
 python3 -m pip install --quiet --disable-pip-version-check -r examples/python/requirements.txt
 
+bash scripts/install-graphviz.sh # situ graph lays pictures out with Graphviz; tests/graph_cmd.rs needs it
 echo "== cargo test --workspace --all-features"
 cargo test --workspace --all-features
 
@@ -31,3 +32,6 @@ EVENTS=200000 bash bench/vs-clips.sh
 
 echo "== spin and situ agree on the properties (Promela export)"
 bash verify/spin-check.sh
+
+echo "== ABC and situ agree on the properties (AIGER export of the circuit; pdr and int)"
+SITU=target/debug/situ bash verify/abc-check.sh

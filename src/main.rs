@@ -223,6 +223,9 @@ enum Command {
         /// The most abstract states the exhaustive exploration makes.
         #[arg(long, default_value_t = 20_000)]
         max_states: usize,
+        /// Seconds IC3 may spend on one property before its verdict stays bounded.
+        #[arg(long, default_value_t = 60.0)]
+        prove_timeout: f64,
         /// Print the size and time of the exploration and the random search.
         #[arg(long)]
         stats: bool,
@@ -235,8 +238,16 @@ enum Command {
     /// Export the abstraction and the properties of a rule file to another tool.
     Export {
         /// A Promela model for spin (one property per `-DPROP=k`).
-        #[arg(long, required = true)]
+        #[arg(long, required_unless_present = "aiger", conflicts_with = "aiger")]
         promela: bool,
+        /// A binary AIGER 1.9 circuit for hardware model checkers such as ABC:
+        /// the abstraction for runs of any length, one bad-state output per
+        /// property (unbounded `eventually` has none).
+        #[arg(long)]
+        aiger: bool,
+        /// Only this property (by name), as the circuit's single bad-state output.
+        #[arg(long, requires = "aiger")]
+        property: Option<String>,
         file: PathBuf,
         /// Write here instead of standard output.
         #[arg(short, long)]
@@ -308,22 +319,36 @@ fn main() -> ExitCode {
                 Err(code) => code,
             }
         }
-        Command::Test { files, filter, format, engine, seed, cases, length, depth, max_states, stats } => {
-            cmd::test::run(cmd::test::Args {
-                files,
-                filter,
-                format,
-                engine,
-                seed,
-                cases,
-                length,
-                depth,
-                max_states,
-                stats,
-            })
-        }
+        Command::Test {
+            files,
+            filter,
+            format,
+            engine,
+            seed,
+            cases,
+            length,
+            depth,
+            max_states,
+            prove_timeout,
+            stats,
+        } => cmd::test::run(cmd::test::Args {
+            files,
+            filter,
+            format,
+            engine,
+            seed,
+            cases,
+            length,
+            depth,
+            max_states,
+            prove_timeout,
+            stats,
+        }),
         Command::Gen { what } => cmd::gen::run(what),
-        Command::Export { promela: _, file, output, depth, max_states } => {
+        Command::Export { promela: _, aiger: true, property, file, output, .. } => {
+            cmd::export::aiger(&file, output.as_ref(), property.as_deref())
+        }
+        Command::Export { file, output, depth, max_states, .. } => {
             cmd::export::run(&file, output.as_ref(), depth, max_states)
         }
         Command::Run {

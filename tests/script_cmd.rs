@@ -163,6 +163,11 @@ fn every_clean_rules_file_of_the_repository_runs_on_random_events() {
         if code(&check) != 0 || !stdout(&check).contains("no findings") {
             continue;
         }
+        // Clean for the checks, yet known to oscillate when run (beyond the
+        // static checks' bound, said in the file).
+        if std::fs::read_to_string(f).is_ok_and(|t| t.contains("// at run time: an oscillation")) {
+            continue;
+        }
         let o = common::situ(&["run", &name, "--random", "1", "--until", "5"]);
         assert_eq!(code(&o), 0, "{name}:\n{}", text(&o));
         assert!(stdout(&o).contains("path: "), "{name}:\n{}", text(&o));

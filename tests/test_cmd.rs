@@ -35,6 +35,11 @@ fn the_papers_stacks_pass_their_tests_and_properties() {
         let last = out.lines().last().unwrap_or_default();
         assert!(last.ends_with(" passed, 0 failed"), "{last}");
         assert!(!out.contains("FAILED"), "{out}");
+        // Every property is proved for runs of any length, not searched.
+        let properties = out.matches("\nproperty \"").count();
+        let proved = out.matches("symbolic: proved for runs of any length").count();
+        assert!(properties >= 7, "{out}");
+        assert_eq!(proved, properties, "{out}");
     }
 }
 
@@ -71,6 +76,66 @@ fn a_counterexample_replays_as_a_test() {
     let replay = write(dir.path(), "replay.situ", format!("{BUGGY}\n{block}"));
     let o = situ(&["test", &replay, "--filter", "counterexample"]);
     assert_eq!(code(&o), 0, "{}\n{block}", stdout(&o));
+    assert_eq!(stdout(&o).lines().last(), Some("1 passed, 0 failed"));
+}
+
+/// A property that only a NaN payload breaks (issue 18: the counterexample
+/// printed `R(d: NaN)`, which did not parse).
+const NAN_ONLY: &str = r#"states { Idle initial Odd Alarm final }
+agent Rng sensor { event R { d: f64 } }
+agent Btn interface { event GO }
+rule nan_seen { when state == Idle and R and not R(d < 0.0) and not R(d >= 0.0) then Odd }
+rule alarm { when state == Odd and GO then Alarm }
+property "no alarm" { never state == Alarm }
+"#;
+
+/// A property that only NaN, then -inf, then inf break, in that order.
+const NON_FINITE: &str = r#"states { Idle initial Odd Low Alarm final }
+agent Rng sensor { event R { d: f64 } }
+rule nan_seen { when state == Idle and R and not R(d < 0.0) and not R(d >= 0.0) then Odd }
+rule lowest { when state == Odd and R(d <= -inf) then Low }
+rule highest { when state == Low and R(d >= inf) then Alarm }
+property "no alarm" { never state == Alarm }
+"#;
+
+/// Runs `situ test` on `rules`, expects a failure whose counterexample block
+/// contains each of `values`, pastes the block back and expects it to pass.
+fn counterexample_replays(rules: &str, values: &[&str]) {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "odd.situ", rules);
+    let o = situ(&["test", &file, "--engine", "exhaustive"]);
+    let out = stdout(&o);
+    assert_eq!(code(&o), 1, "{out}");
+    let start = out.find("    test \"counterexample").expect("a test block");
+    let block: String =
+        out[start..].lines().take_while(|l| l.starts_with("    ")).map(|l| format!("{}\n", &l[4..])).collect();
+    for value in values {
+        assert!(block.contains(value), "{value} in:\n{block}");
+    }
+    let replay = write(dir.path(), "replay.situ", format!("{rules}\n{block}"));
+    let o = situ(&["test", &replay, "--filter", "counterexample"]);
+    assert_eq!(code(&o), 0, "{}\n{block}", stdout(&o));
+    assert_eq!(stdout(&o).lines().last(), Some("1 passed, 0 failed"));
+}
+
+#[test]
+fn a_counterexample_with_nan_replays_as_a_test() {
+    counterexample_replays(NAN_ONLY, &["R(d: NaN)"]);
+}
+
+#[test]
+fn a_counterexample_with_nan_and_infinities_replays_as_a_test() {
+    counterexample_replays(NON_FINITE, &["R(d: NaN)", "R(d: -inf)", "R(d: inf)"]);
+}
+
+#[test]
+fn nan_and_infinities_replay_in_a_test_block() {
+    let dir = tempfile::tempdir().unwrap();
+    // As `situ test` prints a counterexample.
+    let block = "test \"counterexample: no alarm\" {\n    on R(d: NaN) at 0ms,\n       R(d: -inf) at 0ms,\n       R(d: inf) at 1ms\n    expect state Alarm\n}\n";
+    let file = write(dir.path(), "odd.situ", format!("{NON_FINITE}\n{block}"));
+    let o = situ(&["test", &file, "--filter", "counterexample"]);
+    assert_eq!(code(&o), 0, "{}", stdout(&o));
     assert_eq!(stdout(&o).lines().last(), Some("1 passed, 0 failed"));
 }
 

@@ -16,10 +16,12 @@
 use situ_compiler::bundle;
 use situ_compiler::loader::FsLoader;
 use situ_compiler::spec::{self, Consequent, PropertySpec};
-use situ_runtime::verify::abstraction::Alphabet;
-use situ_runtime::verify::explore::{Graph, Limits};
-use situ_runtime::verify::random::{self, Search};
-use situ_runtime::verify::Verdict;
+use situ_verify::abstraction::Alphabet;
+use situ_verify::explore::{Graph, Limits};
+use situ_verify::model::Model;
+use situ_verify::prove;
+use situ_verify::random::{self, Search};
+use situ_verify::Verdict;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
@@ -70,6 +72,7 @@ fn planted_bugs_are_found_and_correct_properties_proved() {
         let props: Vec<&PropertySpec> = spec.properties.iter().collect();
         let graph = Graph::build(&content, &props, Limits { depth: 12, max_states: 100_000 });
         let alphabet = Arc::new(Alphabet::new(&content, &props));
+        let model = Model::build(&content, &alphabet, &props);
         for (i, p) in props.iter().enumerate() {
             let name = format!("{}: property \"{}\"", path.display(), p.name);
             let Some(&want) = expected.get(&p.place.line) else {
@@ -87,6 +90,16 @@ fn planted_bugs_are_found_and_correct_properties_proved() {
                 let r = random::search(&content, &alphabet, p, Search { seed: 11, cases: 300, length: 30 });
                 if r.failed() {
                     failures.push(format!("{name}: proved, yet the random checker found {}", r.summary()));
+                }
+            }
+            // IC3 on the circuit agrees: what fails has a counterexample that
+            // replays on the engine, what holds is proved for runs of any length.
+            if !liveness(p) {
+                let model = model.as_ref().unwrap_or_else(|e| panic!("{name}: no circuit: {e:?}"));
+                match (want, prove::prove(&content, &alphabet, model, i, p, None)) {
+                    (Expect::Fails(_), Some(Verdict::Failed(_)))
+                    | (Expect::Proved | Expect::Exhausted, Some(Verdict::Inductive { sampled: None, .. })) => {}
+                    (_, other) => failures.push(format!("{name}: expected {want:?}, IC3 found {other:?}")),
                 }
             }
             if let (Expect::Fails(n), false) = (want, liveness(p)) {

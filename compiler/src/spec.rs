@@ -1,6 +1,6 @@
 //! Tests and properties in the runtime's terms (`situ test`): bundle ids,
 //! bundle values and field tests, and a source place for every expectation,
-//! so that the runtime's checkers (`situ_runtime::verify`) never look at the
+//! so that the runtime's checkers (`situ_verify`) never look at the
 //! model or the AST. Ids are the bundle's: the model's indices, unchanged.
 //!
 //! [`lower`] also computes the timing of a test's events (language reference

@@ -9,11 +9,13 @@ use situ_compiler::bundle::{self, Content};
 use situ_compiler::loader::FsLoader;
 use situ_compiler::render;
 use situ_compiler::spec::{self, PropertySpec, TestSpec};
-use situ_runtime::verify::abstraction::Alphabet;
-use situ_runtime::verify::explore::{Graph, Limits};
-use situ_runtime::verify::monitor::Monitor;
-use situ_runtime::verify::random::{self, Search};
-use situ_runtime::verify::{scenario, show_event, Counterexample, Verdict};
+use situ_verify::abstraction::Alphabet;
+use situ_verify::explore::{Graph, Limits};
+use situ_verify::model::Model;
+use situ_verify::monitor::Monitor;
+use situ_verify::prove;
+use situ_verify::random::{self, Search};
+use situ_verify::{scenario, show_event, Counterexample, Verdict};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
@@ -45,18 +47,25 @@ pub struct Args {
     pub length: usize,
     pub depth: usize,
     pub max_states: usize,
+    /// Seconds of IC3 per property.
+    pub prove_timeout: f64,
     pub stats: bool,
 }
 
 /// What one property came to.
 struct PropertyResult {
     exhaustive: Option<Verdict>,
+    /// IC3 on the circuit of the abstraction (runs of any length).
+    symbolic: Option<Verdict>,
+    /// Why IC3 gave no verdict, when it gave none.
+    symbolic_note: Option<String>,
     random: Option<Verdict>,
 }
 
 impl PropertyResult {
     fn failed(&self) -> bool {
-        self.exhaustive.as_ref().is_some_and(Verdict::failed) || self.random.as_ref().is_some_and(Verdict::failed)
+        let bad = |v: &Option<Verdict>| v.as_ref().is_some_and(|v| v.failed() || matches!(v, Verdict::Disagree { .. }));
+        bad(&self.exhaustive) || bad(&self.symbolic) || bad(&self.random)
     }
 
     /// The counterexample to show: the exhaustive one (shortest) first.
@@ -74,7 +83,10 @@ impl PropertyResult {
                 "exhaustive, shortest"
             }
         };
-        of(&self.exhaustive).map(|c| (how(c), c)).or_else(|| of(&self.random).map(|c| ("random, shrunk", c)))
+        of(&self.exhaustive)
+            .map(|c| (how(c), c))
+            .or_else(|| of(&self.symbolic).map(|c| ("IC3, replayed on the engine", c)))
+            .or_else(|| of(&self.random).map(|c| ("random, shrunk", c)))
     }
 }
 
@@ -146,10 +158,14 @@ pub fn run(args: Args) -> u8 {
         if !props.is_empty() {
             let results = check_properties(&args, &content, &props, human);
             for (p, r) in props.iter().zip(&results) {
-                let lines: Vec<String> = [("exhaustive", &r.exhaustive), ("random", &r.random)]
-                    .iter()
-                    .filter_map(|(name, v)| v.as_ref().map(|v| format!("{name}: {}", v.summary())))
-                    .collect();
+                let mut lines: Vec<String> =
+                    [("exhaustive", &r.exhaustive), ("symbolic", &r.symbolic), ("random", &r.random)]
+                        .iter()
+                        .filter_map(|(name, v)| v.as_ref().map(|v| format!("{name}: {}", v.summary())))
+                        .collect();
+                if let Some(note) = &r.symbolic_note {
+                    lines.insert(lines.len().min(1), format!("symbolic: {note}"));
+                }
                 let lines = match (&r.random, args.engine) {
                     (None, Engine::Both | Engine::Random) => {
                         let mut l = lines;
@@ -221,11 +237,50 @@ fn check_properties(args: &Args, content: &Arc<Content>, props: &[&PropertySpec]
         g
     });
     let alphabet = Arc::new(Alphabet::new(content, props));
+    let budget = std::time::Duration::from_secs_f64(args.prove_timeout.clamp(0.0, 86_400.0));
+    // The circuit of the abstraction, for proofs over runs of any length.
+    let model = (args.engine != Engine::Random).then(|| {
+        let start = Instant::now();
+        let m = Model::build(content, &alphabet, props);
+        if args.stats && human {
+            match &m {
+                Ok(m) => println!(
+                    "circuit: {} latches, {} inputs, {} and-gates, {:.3} s",
+                    m.aig.latches().len(),
+                    m.aig.inputs().len(),
+                    m.aig.len() - 1 - m.aig.latches().len() - m.aig.inputs().len(),
+                    start.elapsed().as_secs_f64()
+                ),
+                Err(why) => println!("circuit: not built ({})", why.0),
+            }
+        }
+        m
+    });
     props
         .iter()
         .enumerate()
         .map(|(i, p)| {
             let exhaustive = graph.as_ref().map(|g| g.check(i, p));
+            let settled = exhaustive.as_ref().is_some_and(|v| v.failed() || matches!(v, Verdict::Proved { .. }));
+            let liveness = Monitor::new(p).is_liveness();
+            let (symbolic, symbolic_note) = match &model {
+                Some(Ok(_)) if liveness => {
+                    (None, Some("not run (an unbounded `eventually` is a liveness property: searched only)".into()))
+                }
+                Some(Ok(m)) if !settled => {
+                    let start = Instant::now();
+                    let v = prove::prove(content, &alphabet, m, i, p, Some(budget));
+                    if args.stats && human {
+                        println!("ic3 \"{}\": {:.3} s", p.name, start.elapsed().as_secs_f64());
+                    }
+                    let note = v.is_none().then(|| {
+                        format!("gave up after {} s (`--prove-timeout`): the other verdicts stand", args.prove_timeout)
+                    });
+                    (v, note)
+                }
+                Some(Err(why)) if !settled => (None, Some(format!("not run (no circuit: {})", why.0))),
+                _ => (None, None),
+            };
             // Unbounded `eventually` is decided on infinite runs: not by random runs.
             let m = Monitor::new(p);
             let decided = !m.is_liveness() || m.never;
@@ -245,7 +300,7 @@ fn check_properties(args: &Args, content: &Arc<Content>, props: &[&PropertySpec]
                 }
                 v
             });
-            PropertyResult { exhaustive, random }
+            PropertyResult { exhaustive, symbolic, symbolic_note, random }
         })
         .collect()
 }
@@ -254,7 +309,9 @@ fn property_json(content: &Content, path: &std::path::Path, p: &PropertySpec, r:
     let verdict = |v: &Option<Verdict>| {
         v.as_ref().map(|v| {
             let kind = match v {
-                Verdict::Proved { .. } => "proved",
+                Verdict::Proved { .. } | Verdict::Inductive { sampled: None, .. } => "proved",
+                Verdict::Inductive { .. } => "exhausted",
+                Verdict::Disagree { .. } => "disagree",
                 Verdict::Exhausted { .. } => "exhausted",
                 Verdict::Bounded { .. } => "bounded",
                 Verdict::NotFound { .. } => "not_found",
@@ -276,7 +333,7 @@ fn property_json(content: &Content, path: &std::path::Path, p: &PropertySpec, r:
                "test": c.as_test(content, &p.name)})
     });
     json!({"kind": "property", "file": path.display().to_string(), "name": p.name, "place": p.place.to_string(),
-           "passed": !r.failed(), "exhaustive": verdict(&r.exhaustive), "random": verdict(&r.random),
+           "passed": !r.failed(), "exhaustive": verdict(&r.exhaustive), "symbolic": verdict(&r.symbolic), "random": verdict(&r.random),
            "counterexample": cex})
 }
 

@@ -280,6 +280,21 @@ impl Alphabet {
         self.samples.is_empty()
     }
 
+    /// Per agent: the run length beyond which runs are alike (at least 1).
+    pub fn run_cap(&self, agent: u32) -> u64 {
+        self.run_cap[agent as usize].max(1)
+    }
+
+    /// Per agent: the age beyond which ages are alike (0: age never matters).
+    pub fn age_cap(&self, agent: u32) -> u64 {
+        self.age_cap[agent as usize]
+    }
+
+    /// The agents whose order of reports the abstract state keeps.
+    pub fn recency(&self) -> &[u32] {
+        &self.recency
+    }
+
     /// The class of a value of a field: an index into its representatives.
     pub fn class_of(&self, event: u32, field: usize, v: Value) -> Option<usize> {
         let fc = self.fields.get(event as usize)?.get(field)?;
@@ -378,7 +393,10 @@ fn recency_agents(c: &Content) -> Vec<u32> {
             }
             let (sa, ea) = &info[i];
             let (sb, eb) = &info[j];
-            let overlap = sa.iter().any(|s| sb.contains(s) && *s != a.target && *s != b.target);
+            // A rule without a state test may fire in every state.
+            let in_a = |s: u32| sa.is_empty() || sa.contains(&s);
+            let in_b = |s: u32| sb.is_empty() || sb.contains(&s);
+            let overlap = (0..c.states.len() as u32).any(|s| in_a(s) && in_b(s) && s != a.target && s != b.target);
             let exclusive = ea.iter().any(|(agent, e)| eb.get(agent).is_some_and(|f| f != e));
             if overlap && !exclusive {
                 agents.extend(a.matches.iter().chain(&b.matches).copied());
@@ -391,7 +409,7 @@ fn recency_agents(c: &Content) -> Vec<u32> {
 /// The constants of a check, as numbers (symbols and bools by index).
 fn constants(ch: &Check) -> Vec<f64> {
     let num = |o: &Operand| match o {
-        Operand::Value(Value::F64(f)) if f.is_finite() => Some(*f),
+        Operand::Value(Value::F64(f)) if !f.is_nan() => Some(*f),
         Operand::Value(Value::I64(i)) => Some(*i as f64),
         _ => None,
     };
@@ -402,7 +420,7 @@ fn constants(ch: &Check) -> Vec<f64> {
 }
 
 fn check_value(ch: &Check, v: Value) -> bool {
-    crate::rete::passes(&Test { field: 0, check: ch.clone() }, &[v])
+    situ_runtime::rete::passes(&Test { field: 0, check: ch.clone() }, &[v])
 }
 
 fn same(a: Value, b: Value) -> bool {
@@ -450,6 +468,8 @@ fn candidates(ty: &FieldType, consts: &[f64], two: bool) -> Vec<Value> {
                     out.push(hi.ceil() + 2.0);
                 }
             }
+            // The infinities compared with are values of their own.
+            out.extend(consts.iter().copied().filter(|c| c.is_infinite()));
             out.push(f64::NAN);
             out.into_iter().map(Value::F64).collect()
         }

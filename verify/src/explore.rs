@@ -24,9 +24,9 @@
 use super::abstraction::Alphabet;
 use super::monitor::{Monitor, MonitorState};
 use super::{Counterexample, RunStep, System, Verdict};
-use crate::rete::PostError;
 use situ_compiler::bundle::Content;
 use situ_compiler::spec::PropertySpec;
+use situ_runtime::rete::PostError;
 use std::collections::{HashMap, VecDeque};
 use std::sync::Arc;
 

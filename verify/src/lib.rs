@@ -17,16 +17,20 @@
 //! every change of the state at rest after it).
 
 pub mod abstraction;
+pub mod aig;
 pub mod explore;
+pub mod ic3;
+pub mod model;
 pub mod monitor;
 pub mod promela;
+pub mod prove;
 pub mod random;
 pub mod scenario;
 
-use crate::organise::Organisation;
-use crate::rete::{format_time, passes, show_value, Engine, PostError, Step};
 use situ_compiler::bundle::{Content, Value};
 use situ_compiler::spec::{Pred, PropertySpec};
+use situ_runtime::organise::Organisation;
+use situ_runtime::rete::{format_time, passes, show_value, Engine, PostError, Step};
 use std::sync::Arc;
 
 /// The engine and the organisation, stepped together.
@@ -50,7 +54,7 @@ impl System {
     /// the network comes to rest, then the FSMs see the new state at rest.
     /// A refused event changes nothing.
     pub fn post(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Step, PostError> {
-        self.engine.validate(event, payload)?;
+        self.engine.admit(event, time, payload)?;
         let agent = self.content().events[event as usize].agent;
         self.org.on_event(agent, event);
         let step = self.engine.step(event, time, payload);
@@ -243,6 +247,20 @@ pub enum Verdict {
         states: usize,
         note: String,
     },
+    /// No state of the abstraction that breaks it is reachable, in runs of
+    /// any length and with any gaps: IC3 closed an inductive invariant of
+    /// `clauses` clauses at frame `frames`. With `sampled`, the abstraction
+    /// samples payloads (said there), so it is not a proof for every run.
+    Inductive {
+        frames: usize,
+        clauses: usize,
+        sampled: Option<String>,
+    },
+    /// The circuit's counterexample of `events` events does not break the
+    /// property on the real engine: the two disagree (an error of situ).
+    Disagree {
+        events: usize,
+    },
     /// No counterexample in `runs` random runs of up to `length` events.
     NotFound {
         runs: u64,
@@ -270,6 +288,15 @@ impl Verdict {
             Verdict::NotFound { runs, length, steps } => {
                 format!("no counterexample in {runs} random runs of up to {length} events ({steps} steps)")
             }
+            Verdict::Inductive { frames, clauses, sampled: None } => {
+                format!("proved for runs of any length (IC3: an inductive invariant of {clauses} clauses at frame {frames})")
+            }
+            Verdict::Inductive { frames, clauses, sampled: Some(note) } => format!(
+                "no counterexample in runs of any length of the abstraction (IC3: {clauses} clauses at frame {frames}; {note})"
+            ),
+            Verdict::Disagree { events } => format!(
+                "the symbolic model's counterexample of {events} events does not replay on the engine: an error of situ, please report it"
+            ),
             Verdict::Failed(c) => format!("counterexample of {} events", c.steps.len()),
         }
     }

@@ -1,7 +1,7 @@
 //! Random search for counterexamples, with shrinking (proptest).
 //!
 //! A run is drawn by [`RunStrategy`]: the seeded generator of
-//! [`stream`](crate::stream) — events guided by the rules that can fire in
+//! [`stream`](situ_runtime::stream) — events guided by the rules that can fire in
 //! the current state half of the time, agents in proportion to their rates
 //! otherwise, payloads near the rules' thresholds, exponential gaps — run
 //! without resets for `length` events, from a seed that proptest draws (one
@@ -16,13 +16,13 @@
 use super::abstraction::Alphabet;
 use super::monitor::{Monitor, MonitorState};
 use super::{Counterexample, RunStep, System, Verdict};
-use crate::rete::PostError;
-use crate::stream::Generator;
 use proptest::prelude::Rng;
 use proptest::strategy::{NewTree, Strategy, ValueTree};
 use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestError, TestRng, TestRunner};
 use situ_compiler::bundle::{Content, Value};
 use situ_compiler::spec::PropertySpec;
+use situ_runtime::rete::PostError;
+use situ_runtime::stream::Generator;
 use std::cell::Cell;
 use std::sync::Arc;
 

@@ -5,9 +5,9 @@
 //! and reports every failed expectation.
 
 use super::{show_event, System};
-use crate::rete::format_time;
 use situ_compiler::bundle::Content;
 use situ_compiler::spec::{Expected, Place, TestSpec, TestStep};
+use situ_runtime::rete::format_time;
 use std::sync::Arc;
 
 /// A failed expectation, or an event the engine could not process.
