@@ -13,20 +13,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-install_abc() {
-    command -v berkeley-abc >/dev/null && return 0
-    local sudo=""
-    if [ "$(id -u)" != 0 ]; then sudo="sudo"; fi
-    echo "== installing ABC (apt-get install berkeley-abc)"
-    $sudo apt-get install -y berkeley-abc >/dev/null 2>&1 \
-        || { $sudo apt-get update >/dev/null 2>&1 && $sudo apt-get install -y berkeley-abc >/dev/null 2>&1; } \
-        || true
-    if ! command -v berkeley-abc >/dev/null; then
-        echo "error: ABC (Debian package \`berkeley-abc\`) is needed and could not be installed" >&2
-        exit 1
-    fi
-}
-install_abc
+bash scripts/apt-install.sh berkeley-abc=berkeley-abc
 
 if [ -z "${SITU:-}" ]; then
     cargo build --quiet

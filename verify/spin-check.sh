@@ -12,20 +12,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-install_spin() {
-    command -v spin >/dev/null && command -v gcc >/dev/null && return 0
-    local sudo=""
-    if [ "$(id -u)" != 0 ]; then sudo="sudo"; fi
-    echo "== installing spin and gcc (apt-get)"
-    $sudo apt-get install -y spin gcc >/dev/null 2>&1 \
-        || { $sudo apt-get update >/dev/null 2>&1 && $sudo apt-get install -y spin gcc >/dev/null 2>&1; } \
-        || true
-    if ! command -v spin >/dev/null || ! command -v gcc >/dev/null; then
-        echo "error: spin (Debian package \`spin\`) and gcc are needed and could not be installed" >&2
-        exit 1
-    fi
-}
-install_spin
+bash scripts/apt-install.sh spin=spin gcc=gcc
 
 if [ -z "${SITU:-}" ]; then
     cargo build -q -p situ

@@ -9,7 +9,8 @@
 
 use super::{FAILED, OK, USAGE};
 use situ_compiler::bundle;
-use situ_compiler::spec::{self, PropertySpec};
+use situ_compiler::bundle::Content;
+use situ_compiler::spec::{self, PropertySpec, Spec};
 use situ_verify::abstraction::Alphabet;
 use situ_verify::explore::{Graph, Limits};
 use situ_verify::model::Model;
@@ -18,12 +19,10 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 pub fn run(file: &Path, output: Option<&PathBuf>, depth: usize, max_states: usize) -> u8 {
-    let checked = match super::program::check(file, false) {
-        Ok(c) => c,
+    let (content, spec) = match load(file) {
+        Ok(x) => x,
         Err(code) => return code,
     };
-    let content = Arc::new(bundle::build(&checked));
-    let spec = spec::lower(&checked);
     let props: Vec<&PropertySpec> = spec.properties.iter().collect();
     let graph = Graph::build(&content, &props, Limits { depth, max_states });
     let text = promela::export(&content, &graph, &props);
@@ -54,13 +53,17 @@ pub fn run(file: &Path, output: Option<&PathBuf>, depth: usize, max_states: usiz
     }
 }
 
+/// The program and its properties, from a source file with no errors.
+fn load(file: &Path) -> Result<(Arc<Content>, Spec), u8> {
+    let checked = super::program::check(file, false)?;
+    Ok((Arc::new(bundle::build(&checked)), spec::lower(&checked)))
+}
+
 pub fn aiger(file: &Path, output: Option<&PathBuf>, only: Option<&str>) -> u8 {
-    let checked = match super::program::check(file, false) {
-        Ok(c) => c,
+    let (content, spec) = match load(file) {
+        Ok(x) => x,
         Err(code) => return code,
     };
-    let content = Arc::new(bundle::build(&checked));
-    let spec = spec::lower(&checked);
     let props: Vec<&PropertySpec> = spec.properties.iter().collect();
     if let Some(name) = only {
         if !props.iter().any(|p| p.name == name) {

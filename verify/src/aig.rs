@@ -154,9 +154,9 @@ impl Aig {
         val
     }
 
-    /// The circuit in the binary AIGER 1.9 format, `bad` as its bad-state
-    /// properties (named in the symbol table).
-    pub fn to_aig(&self, bad: &[(String, Lit)]) -> Vec<u8> {
+    /// AIGER's numbering of our variables (inputs, then latches, then
+    /// gates; ours are mixed), and the gates in order.
+    fn numbering(&self) -> (Vec<u32>, Vec<u32>) {
         let mut map = vec![0u32; self.nodes.len()];
         let mut k = 1u32;
         for &v in self.inputs.iter().chain(&self.latches) {
@@ -169,6 +169,14 @@ impl Aig {
             map[v as usize] = k;
             k += 1;
         }
+        (map, gates)
+    }
+
+    /// The circuit in the binary AIGER 1.9 format, `bad` as its bad-state
+    /// properties (named in the symbol table).
+    pub fn to_aig(&self, bad: &[(String, Lit)]) -> Vec<u8> {
+        let (map, gates) = self.numbering();
+        let k = map.iter().max().copied().unwrap_or(0) + 1;
         let m = |l: Lit| 2 * map[(l >> 1) as usize] + (l & 1);
         let mut out =
             format!("aig {} {} {} 0 {} {}\n", k - 1, self.inputs.len(), self.latches.len(), gates.len(), bad.len())
@@ -209,19 +217,8 @@ impl Aig {
     /// The circuit in the AIGER 1.9 ASCII format, `bad` as its bad-state
     /// properties (one per line, named in the symbol table).
     pub fn to_aag(&self, bad: &[(String, Lit)]) -> String {
-        // AIGER numbers inputs, then latches, then gates; ours are mixed.
-        let mut map = vec![0u32; self.nodes.len()];
-        let mut k = 1u32;
-        for &v in self.inputs.iter().chain(&self.latches) {
-            map[v as usize] = k;
-            k += 1;
-        }
-        let gates: Vec<u32> =
-            (0..self.nodes.len() as u32).filter(|&v| matches!(self.nodes[v as usize], Node::And(..))).collect();
-        for &v in &gates {
-            map[v as usize] = k;
-            k += 1;
-        }
+        let (map, gates) = self.numbering();
+        let k = map.iter().max().copied().unwrap_or(0) + 1;
         let m = |l: Lit| 2 * map[(l >> 1) as usize] + (l & 1);
         let mut out = String::new();
         let _ =

@@ -38,7 +38,7 @@ use super::aig::{lit_value, not, Aig, Lit, Word, FALSE, TRUE};
 use super::monitor::{Kind, Monitor};
 use situ_compiler::bundle::{AlphaNode, Behaviour, BetaKind, Check, Content, Mode, Operand, Test, Trigger, Value};
 use situ_compiler::spec::{Pred, PropertySpec};
-use situ_runtime::rete::{compare, in_range};
+use situ_runtime::rete::passes_with;
 
 /// The most rounds of a rest the circuit unrolls (more states: not modelled).
 const MAX_STATES: usize = 32;
@@ -855,19 +855,7 @@ fn operands(ch: &Check) -> Vec<&Operand> {
 /// A test on a fact's field, its operands read from the fact itself or
 /// from other agents' facts (as the engine's join does).
 fn check<'a>(t: &Test, own: &[Value], fact: &dyn Fn(u32) -> Option<&'a [Value]>) -> bool {
-    let get = |o: &Operand| match o {
-        Operand::Value(v) => Some(*v),
-        Operand::Own { field } => own.get(*field as usize).copied(),
-        Operand::Fact { agent, field } => fact(*agent).and_then(|p| p.get(*field as usize).copied()),
-    };
-    let Some(&x) = own.get(t.field as usize) else { return false };
-    match &t.check {
-        Check::Compare { op, rhs } => get(rhs).is_some_and(|y| compare(*op, x, y)),
-        Check::Range { lo, hi, inclusive } => match (get(lo), get(hi)) {
-            (Some(lo), Some(hi)) => in_range(x, lo, hi, *inclusive),
-            _ => false,
-        },
-    }
+    passes_with(t, own, |agent, field| fact(agent).and_then(|p| p.get(field as usize).copied()))
 }
 
 /// The order of the latest reports of some agents: for each pair (a, b),

@@ -13,10 +13,11 @@
 use super::abstraction::Alphabet;
 use super::ic3::{self, Outcome};
 use super::model::Model;
-use super::monitor::{Monitor, MonitorState};
-use super::{Counterexample, RunStep, System, Verdict};
+use super::random;
+use super::{Counterexample, RunStep, Verdict};
 use situ_compiler::bundle::Content;
 use situ_compiler::spec::PropertySpec;
+use std::cell::Cell;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -53,33 +54,10 @@ pub fn prove(
                     RunStep { event: letter.event, payload: letter.payload.clone(), gap }
                 })
                 .collect();
-            Some(match fails_at(content, property, &run) {
-                Some((point, reason)) => Verdict::Failed(Counterexample::replay(content, &run[..point], point, reason)),
-                None => Verdict::Disagree { events: run.len() },
+            Some(match random::check_run(content, property, &run, &Cell::new(0)) {
+                Err((point, reason)) => Verdict::Failed(Counterexample::replay(content, &run[..point], point, reason)),
+                Ok(()) => Verdict::Disagree { events: run.len() },
             })
         }
     }
-}
-
-/// Where the property fails on the real engine along `run`, and why.
-pub fn fails_at(content: &Arc<Content>, property: &PropertySpec, run: &[RunStep]) -> Option<(usize, String)> {
-    let monitor = Monitor::new(property);
-    let mut st = MonitorState::default();
-    let mut sys = System::new(content.clone());
-    let (p, q) = sys.point(property);
-    if let Some(why) = monitor.step(&mut st, p, q, 0) {
-        return Some((0, why));
-    }
-    let mut time = 0u64;
-    for (i, s) in run.iter().enumerate() {
-        time = time.saturating_add(s.gap);
-        if let Err(e) = sys.post(s.event, time, &s.payload) {
-            return Some((i + 1, e.describe(content)));
-        }
-        let (p, q) = sys.point(property);
-        if let Some(why) = monitor.step(&mut st, p, q, s.gap) {
-            return Some((i + 1, why));
-        }
-    }
-    None
 }

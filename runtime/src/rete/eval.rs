@@ -28,10 +28,16 @@ pub fn in_range(x: Value, lo: Value, hi: Value, inclusive: bool) -> bool {
 /// Whether a payload passes a test on its own fields (a test on another
 /// fact's field passes nothing: it needs the other fact).
 pub fn passes(t: &Test, payload: &[Value]) -> bool {
+    passes_with(t, payload, |_, _| None)
+}
+
+/// Whether a payload passes a test, the other facts' fields read by
+/// `fact(agent, field)` (`None`: no such fact, and the test fails).
+pub fn passes_with(t: &Test, payload: &[Value], fact: impl Fn(u32, u32) -> Option<Value>) -> bool {
     let get = |o: &Operand| match o {
         Operand::Value(v) => Some(*v),
         Operand::Own { field } => payload.get(*field as usize).copied(),
-        Operand::Fact { .. } => None,
+        Operand::Fact { agent, field } => fact(*agent, *field),
     };
     let Some(&x) = payload.get(t.field as usize) else { return false };
     match &t.check {

@@ -35,7 +35,7 @@ use net::{AlphaKind, Kind, Net, OperandRt, TestKind, TestRt, NONE};
 use situ_compiler::bundle::{Content, FieldType, Value};
 use std::sync::Arc;
 
-pub use eval::{compare, in_range, passes};
+pub use eval::{compare, in_range, passes, passes_with};
 
 /// The default bound of a cascade (§10.4).
 pub const CASCADE_LIMIT: usize = 64;
