@@ -118,6 +118,11 @@ enum Command {
         /// Dafflon et al.'s comparison of the controllers (rules/ugv.situ): hard-switch,merge.
         #[arg(long, value_delimiter = ',')]
         compare: Option<Vec<String>>,
+        /// Serve the run live over Foxglove's WebSocket protocol at this address (the
+        /// recording's channels and messages; waits for a client, then runs in real time).
+        #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8765",
+              conflicts_with = "compare")]
+        foxglove: Option<String>,
         /// Any rules file: play this `script` block (its name) or the first script of this
         /// `.situ` file, every agent a stand-in that follows its table or FSM.
         #[arg(long, conflicts_with_all = ["compare", "scenario", "random"])]
@@ -196,6 +201,17 @@ enum Command {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
+    /// Serve the Supervisor's console on 127.0.0.1 until Ctrl-C: the state graph, the wiring of a state, the rules, and for a recording a timeline; exit 2 on a damaged recording, other rules, or a port in use.
+    View {
+        /// A `.situ` source, a bundle, or an MCAP recording of `situ run --record`.
+        file: PathBuf,
+        /// The rules of a recording (a `.situ` source or a bundle); default: the bundle attached to it. Refused (exit 2) when the recording was made on other rules.
+        #[arg(long, value_name = "FILE")]
+        rules: Option<PathBuf>,
+        /// The port to listen on (default: a free one); the URL is the first line on standard output.
+        #[arg(long)]
+        port: Option<u16>,
+    },
     /// Run the tests and check the properties of rule files; exit 0 all hold, 1 a failure, 2 usage or I/O.
     Test {
         #[arg(required = true)]
@@ -224,7 +240,7 @@ enum Command {
         #[arg(long, default_value_t = 20_000)]
         max_states: usize,
         /// Seconds IC3 may spend on one property before its verdict stays bounded.
-        #[arg(long, default_value_t = 60.0)]
+        #[arg(long, default_value_t = 20.0)]
         prove_timeout: f64,
         /// Print the size and time of the exploration and the random search.
         #[arg(long)]
@@ -359,6 +375,7 @@ fn main() -> ExitCode {
             seed,
             until,
             compare,
+            foxglove,
             script,
             random,
             stack,
@@ -373,10 +390,13 @@ fn main() -> ExitCode {
                 return ExitCode::from(code);
             }
             let local = stack == cmd::distributed::Stack::Sim && transport == cmd::distributed::Transport::Inproc;
-            if local && (script.is_some() || random.is_some()) {
+            if foxglove.is_some() && (!local || script.is_some() || random.is_some()) {
+                eprintln!("error: --foxglove serves the runs of the reference stacks (rules/outdoor.situ, rules/ugv.situ) only, for now");
+                cmd::USAGE
+            } else if local && (script.is_some() || random.is_some()) {
                 cmd::scripted::run(cmd::scripted::Args { file, script, random, until, out, record })
             } else if local {
-                cmd::run::run(cmd::run::Args { file, scenario, record, out, seed, until, compare })
+                cmd::run::run(cmd::run::Args { file, scenario, record, out, seed, until, compare, foxglove })
             } else {
                 cmd::distributed::run(cmd::distributed::Args {
                     file,
@@ -403,6 +423,7 @@ fn main() -> ExitCode {
         Command::Graph { file, view, state, format, output } => {
             cmd::graph::run(&file, view, state.as_deref(), format, output.as_ref())
         }
+        Command::View { file, rules, port } => cmd::view::run(&file, rules.as_deref(), port),
     };
     ExitCode::from(code)
 }

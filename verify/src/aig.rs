@@ -261,6 +261,11 @@ pub struct Word {
     pub bits: Vec<Lit>,
 }
 
+/// How many bits hold the numbers `0..=max`.
+pub fn bits_upto(max: u64) -> usize {
+    (u64::BITS - max.leading_zeros()) as usize
+}
+
 /// How many bits hold the numbers `0..n`.
 pub fn width(n: usize) -> usize {
     let mut w = 0;
@@ -277,6 +282,16 @@ impl Word {
 
     pub fn inputs(aig: &mut Aig, name: &str, n: usize) -> Word {
         Word { bits: (0..width(n)).map(|i| aig.input(&format!("{name}[{i}]"))).collect() }
+    }
+
+    /// Latches for the numbers `0..=max`.
+    pub fn latches_upto(aig: &mut Aig, name: &str, max: u64) -> Word {
+        Word { bits: (0..bits_upto(max)).map(|i| aig.latch(&format!("{name}[{i}]"))).collect() }
+    }
+
+    /// Inputs for the numbers `0..=max`.
+    pub fn inputs_upto(aig: &mut Aig, name: &str, max: u64) -> Word {
+        Word { bits: (0..bits_upto(max)).map(|i| aig.input(&format!("{name}[{i}]"))).collect() }
     }
 
     pub fn constant(k: usize, w: usize) -> Word {

@@ -42,6 +42,8 @@ use situ_runtime::rete::passes_with;
 
 /// The most rounds of a rest the circuit unrolls (more states: not modelled).
 const MAX_STATES: usize = 32;
+/// The most (same-class rule pair × state) checks the rests may unroll.
+const MAX_PAIR_ROUNDS: usize = 4_000_000;
 /// The most letter combinations one join may enumerate.
 const MAX_COMBINATIONS: usize = 200_000;
 
@@ -133,7 +135,7 @@ impl Model {
             .max()
             .unwrap_or(0)
             .max(1);
-        let gap_in = Word::inputs(aig, "gap", max_cap as usize + 1);
+        let gap_in = Word::inputs_upto(aig, "gap", max_cap);
         let state = Word::latches(aig, "state", n_states);
         let state_code: Vec<usize> = (0..n_states).map(|s| code(s, c.initial as usize)).collect();
         let mut fsm = Vec::new();
@@ -161,14 +163,14 @@ impl Model {
                 kind: Word::latches(aig, &format!("kind{a}"), 3),
                 letter: Word::latches(aig, &format!("letter{a}"), letters.len()),
                 run: Word::latches(aig, &format!("run{a}"), run_cap as usize),
-                age: Word::latches(aig, &format!("age{a}"), cap as usize + 1),
+                age: Word::latches_upto(aig, &format!("age{a}"), cap),
                 letters,
                 run_cap,
                 age_cap: cap,
                 stale_after,
             });
         }
-        let last_gap = Word::latches(aig, "last_gap", max_cap as usize + 1);
+        let last_gap = Word::latches_upto(aig, "last_gap", max_cap);
         // The order of the latest reports of the agents it matters for:
         // one latch per pair, whether the first reported after the second.
         let order = Recency::latches(aig, alphabet.recency());
@@ -307,7 +309,7 @@ impl Model {
     /// The inputs that choose `letter` after a gap of `gap` ns (capped).
     pub fn inputs(&self, letter: usize, gap: u64) -> Vec<bool> {
         let w = self.gap_in.bits.len();
-        let gap = gap.min((1u64 << w) - 1);
+        let gap = if w >= 64 { gap } else { gap.min((1u64 << w) - 1) };
         let mut v = Vec::new();
         v.extend((0..self.letter_in.bits.len()).map(|i| letter >> i & 1 == 1));
         v.extend((0..w).map(|i| gap >> i & 1 == 1));
@@ -491,18 +493,33 @@ impl Builder<'_> {
         // reports where salience and specificity tie (§10.4).
         let class = |r: usize| (c.rules[r].salience, c.rules[r].specificity);
         let rules = c.rules.len();
-        let beats: Vec<Vec<Lit>> = (0..rules)
-            .map(|x| {
-                (0..rules)
-                    .map(|y| match class(x).cmp(&class(y)) {
-                        _ if x == y => FALSE,
-                        std::cmp::Ordering::Greater => TRUE,
-                        std::cmp::Ordering::Less => FALSE,
-                        std::cmp::Ordering::Equal => {
+        // The rules by class, highest first; within a class, which beats which.
+        let mut classes: Vec<(i64, u32)> = (0..rules).map(class).collect();
+        classes.sort_unstable_by(|a, b| b.cmp(a));
+        classes.dedup();
+        let members: Vec<Vec<usize>> =
+            classes.iter().map(|k| (0..rules).filter(|&r| class(r) == *k).collect()).collect();
+        let pairs: usize = members.iter().map(|m| m.len() * m.len()).sum();
+        if pairs.saturating_mul(n) > MAX_PAIR_ROUNDS {
+            return Err(Unsupported(format!(
+                "{rules} rules in {} salience and specificity classes over {n} states: too large a circuit",
+                classes.len()
+            )));
+        }
+        let beats: Vec<Vec<Lit>> = members
+            .iter()
+            .map(|m| {
+                let mut b = Vec::with_capacity(m.len() * m.len());
+                for &x in m {
+                    for &y in m {
+                        b.push(if x == y {
+                            FALSE
+                        } else {
                             order.beats(&mut self.aig, &c.rules[x].matches, &c.rules[y].matches, x < y)
-                        }
-                    })
-                    .collect()
+                        });
+                    }
+                }
+                b
             })
             .collect();
         let mut s = state.clone();
@@ -524,12 +541,23 @@ impl Builder<'_> {
                 })
                 .collect();
             let mut cases = Vec::new();
-            for r in 0..c.rules.len() {
-                let beaten: Vec<Lit> =
-                    (0..c.rules.len()).filter(|&x| x != r).map(|x| self.aig.and(acts[x], beats[x][r])).collect();
-                let beaten = self.aig.or_all(beaten);
-                let fires = self.aig.and(acts[r], not(beaten));
-                cases.push((fires, codes[c.rules[r].target as usize]));
+            // Whether a rule of a higher class is activated.
+            let mut higher = FALSE;
+            for (k, m) in members.iter().enumerate() {
+                for (i, &r) in m.iter().enumerate() {
+                    let same: Vec<Lit> = m
+                        .iter()
+                        .enumerate()
+                        .filter(|&(_, &x)| x != r)
+                        .map(|(j, &x)| self.aig.and(acts[x], beats[k][j * m.len() + i]))
+                        .collect();
+                    let same = self.aig.or_all(same);
+                    let beaten = self.aig.or(higher, same);
+                    let fires = self.aig.and(acts[r], not(beaten));
+                    cases.push((fires, codes[c.rules[r].target as usize]));
+                }
+                let here = self.aig.or_all(m.iter().map(|&r| acts[r]));
+                higher = self.aig.or(higher, here);
             }
             let any = self.aig.or_all(acts.iter().copied());
             let moved = Word::select(&mut self.aig, s.bits.len(), &cases);
@@ -775,7 +803,7 @@ impl Builder<'_> {
                 let ev = Word::latches(aig, &format!("p{k}.events"), ev_max + 1);
                 // The elapsed time, capped just past the bound.
                 let ns_cap = nanos.map_or(0, |d| d.saturating_add(1));
-                let ns = Word::latches(aig, &format!("p{k}.nanos"), ns_cap as usize + 1);
+                let ns = Word::latches_upto(aig, &format!("p{k}.nanos"), ns_cap);
                 let ev_sel = ev.decode(aig, ev_max + 1);
                 // Advanced counters.
                 let ev_cases: Vec<(Lit, usize)> =
