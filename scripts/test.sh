@@ -11,6 +11,7 @@ echo "== installing the Python packages the tests use (examples/python/requireme
 python3 -m pip install --quiet --disable-pip-version-check -r examples/python/requirements.txt
 
 bash scripts/install-graphviz.sh # situ graph lays pictures out with Graphviz; tests/graph_cmd.rs needs it
+bash scripts/install-chromium.sh # tests/view_cmd.rs drives situ view's page in headless Chromium
 echo "== cargo test --workspace --all-features"
 cargo test --workspace --all-features
 

@@ -18,6 +18,7 @@ pub mod replay;
 pub mod run;
 pub mod scripted;
 pub mod test;
+pub mod view;
 pub mod watch;
 
 use std::io::IsTerminal;

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Checks that a recording made by `situ run` reads with the `mcap` package
 # from PyPI (and `zstandard`, for the zstd chunks), with the schemas
-# Foxglove's panels need. Fails loudly when the packages cannot be installed.
+# Foxglove's panels need, every message valid against its channel's JSON
+# schema (`jsonschema`). Fails loudly when the packages cannot be installed.
 #
 #   bash tests/python/check.sh [SITU_BINARY]     (default: target/release/situ, else target/debug/situ)
 set -euo pipefail
@@ -20,8 +21,8 @@ venv="${TMPDIR:-/tmp}/situ-mcap-venv"
 if [[ ! -x "$venv/bin/python" ]]; then
   "$python" -m venv "$venv" || { echo "check.sh: FAILED to create a Python venv" >&2; exit 1; }
 fi
-if ! "$venv/bin/python" -m pip install --quiet --disable-pip-version-check mcap zstandard; then
-  echo "check.sh: FAILED to install the mcap and zstandard packages from PyPI" >&2
+if ! "$venv/bin/python" -m pip install --quiet --disable-pip-version-check mcap zstandard jsonschema; then
+  echo "check.sh: FAILED to install the mcap, zstandard and jsonschema packages from PyPI" >&2
   exit 1
 fi
 work="$(mktemp -d)"

@@ -6,7 +6,11 @@ per topic and checks the schemas Foxglove's panels need:
 - `foxglove.Log` on /events and /diagnostics,
 - `foxglove.PoseInFrame` on /pose, `foxglove.SceneUpdate` on /obstacles,
 - a /state channel whose messages have a `state` field (Foxglove's State
-  Transitions panel draws it), and the attached bundle.
+  Transitions panel draws it), and the attached bundle;
+- every message valid against its channel's JSON schema (the `jsonschema`
+  package), and the Foxglove schemas in full: every object in them lists
+  its properties and the required ones (a stub `{"type": "object"}` fails,
+  and so does a field of the wrong name, a required one being missing).
 
 Usage: read_mcap.py RECORDING.mcap [--stand-ins]   (exit 0 when everything holds)
 
@@ -16,7 +20,23 @@ With --stand-ins (a scripted run of any rules file: no vehicle), /pose and
 import json
 import sys
 
+import jsonschema
 from mcap.reader import make_reader
+
+
+def stubs(node, where="#"):
+    """The places in a Foxglove schema where an object does not say its
+    properties and the required ones."""
+    found = []
+    if isinstance(node, dict):
+        if node.get("type") == "object" and (not node.get("properties") or "required" not in node):
+            found.append(where)
+        for k, v in node.items():
+            found += stubs(v, f"{where}/{k}")
+    elif isinstance(node, list):
+        for i, v in enumerate(node):
+            found += stubs(v, f"{where}/{i}")
+    return found
 
 
 def main(path, stand_ins=False):
@@ -25,11 +45,29 @@ def main(path, stand_ins=False):
     states = []
     first_pose = None
     first_scene = None
+    validators = {}
+    invalid = {}
+    stubbed = {}
     with open(path, "rb") as f:
         reader = make_reader(f)
         for schema, channel, message in reader.iter_messages():
             counts[channel.topic] = counts.get(channel.topic, 0) + 1
             schemas[channel.topic] = (schema.name, schema.encoding, channel.message_encoding)
+            if schema.id not in validators:
+                doc = json.loads(schema.data)
+                cls = jsonschema.validators.validator_for(doc)
+                cls.check_schema(doc)
+                validators[schema.id] = cls(doc)
+                if schema.name.startswith("foxglove."):
+                    # The timestamps' `time` and `duration` objects list
+                    # no required fields in Foxglove's own schemas.
+                    found = [w for w in stubs(doc) if not w.endswith(("/timestamp", "/lifetime"))]
+                    if found:
+                        stubbed[channel.topic] = found
+            errors = list(validators[schema.id].iter_errors(json.loads(message.data)))
+            if errors and channel.topic not in invalid:
+                e = errors[0]
+                invalid[channel.topic] = f"{e.message} at {'/'.join(map(str, e.absolute_path)) or 'the top'}"
             if channel.topic in ("/state", "/pose", "/obstacles"):
                 body = json.loads(message.data)
                 if channel.topic == "/state":
@@ -73,12 +111,16 @@ def main(path, stand_ins=False):
     if first_scene is not None:
         check(isinstance(first_scene.get("entities"), list) and first_scene["entities"], "/obstacles has no entities")
     check("bundle.json" in attachments, "the bundle is not attached")
+    for topic, why in sorted(invalid.items()):
+        check(False, f"{topic}: a message does not validate against its schema: {why}")
+    for topic, where in sorted(stubbed.items()):
+        check(False, f"{topic}: the schema {schemas[topic][0]} is a stub at {', '.join(where[:5])}")
     print("states:", " -> ".join(states))
     if failures:
         for f in failures:
             print("FAIL:", f, file=sys.stderr)
         return 1
-    print("ok: readable by the mcap package, Foxglove schemas in place")
+    print(f"ok: readable by the mcap package, Foxglove schemas in place, {sum(counts.values())} messages valid")
     return 0
 
 

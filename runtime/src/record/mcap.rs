@@ -16,6 +16,10 @@
 //! adds the vehicle's pose (`/pose`, `foxglove.PoseInFrame`) and the
 //! obstacles (`/obstacles`, `foxglove.SceneUpdate`).
 //!
+//! Every channel and message can go elsewhere too, as it is written: a
+//! [`Tap`] (`situ run --foxglove` serves them live over Foxglove's WebSocket
+//! protocol), with or without a file ([`McapRecorder::live`]).
+//!
 //! The bundle that ran is attached (`bundle.json`), so that a replay needs
 //! nothing else. Chunks are closed and the file flushed at least once a
 //! second (of wall time, or of the messages' time for simulated runs) while
@@ -65,7 +69,21 @@ pub const FLUSH_EVERY: Duration = Duration::from_secs(1);
 /// recording keeps in memory between flushes stays bounded).
 pub const FLUSH_AFTER_BYTES: usize = 16 << 20;
 
-const LOG_SCHEMA: &str = r#"{"title":"foxglove.Log","type":"object","properties":{"timestamp":{"type":"object","properties":{"sec":{"type":"integer","minimum":0},"nsec":{"type":"integer","minimum":0,"maximum":999999999}}},"level":{"type":"integer","description":"0 UNKNOWN, 1 DEBUG, 2 INFO, 3 WARNING, 4 ERROR, 5 FATAL"},"message":{"type":"string"},"name":{"type":"string"},"file":{"type":"string"},"line":{"type":"integer","minimum":0}}}"#;
+/// The JSON schema of `foxglove.Log`: Foxglove's own, as published
+/// (schemas/jsonschema/Log.json of github.com/foxglove/foxglove-sdk, MIT).
+const LOG_SCHEMA: &str = include_str!("mcap/schemas/Log.json");
+
+/// Another destination of a recording's channels and messages, told of each
+/// as it is written (the same schemas, the same JSON bytes, the same times).
+pub trait Tap: Send {
+    /// A channel: its id (as in the file), topic, schema name and JSON schema.
+    fn channel(&mut self, id: u16, topic: &str, schema_name: &str, schema: &str);
+    /// A message on channel `id`, at `time` (ns), its JSON bytes.
+    fn message(&mut self, id: u16, time: u64, bytes: &[u8]);
+}
+
+/// A channel of the recording: id, topic, schema name, JSON schema.
+type ChannelInfo = (u16, String, String, String);
 
 fn schema(title: &str, properties: Json) -> String {
     json!({ "title": title, "type": "object", "properties": properties }).to_string()
@@ -95,12 +113,66 @@ pub struct McapRecorder {
     counts: Counts,
     /// Channels added with [`McapRecorder::add_channel`]: id → topic.
     extra: BTreeMap<u16, String>,
+    /// Every channel so far (for taps added later).
+    all: Vec<ChannelInfo>,
+    taps: Vec<Box<dyn Tap>>,
+    finished: bool,
     last_flush: Instant,
     /// Flush by the messages' own time instead of the wall clock: the time
     /// of the last flush (simulated runs whose files must be the same bytes
     /// every time).
     by_message_time: Option<u64>,
     error: Option<io::Error>,
+}
+
+/// The recording's own channels, made with `channel` (topic, schema name,
+/// JSON schema → id).
+fn standard_channels(channel: &mut dyn FnMut(&str, &str, &str) -> io::Result<u16>) -> io::Result<Channels> {
+    let time = json!({ "type": "integer", "description": "nanoseconds" });
+    Ok(Channels {
+        state: channel(
+            topics::STATE,
+            "situ.State",
+            &schema(
+                "situ.State",
+                json!({ "state": {"type": "string"}, "from": {"type": "string"}, "time_ns": time,
+                            "rules": {"type": "array", "items": {"type": "string"}}, "explain": {"type": "string"} }),
+            ),
+        )?,
+        events_log: channel(topics::EVENTS_LOG, "foxglove.Log", LOG_SCHEMA)?,
+        diagnostics: channel(topics::DIAGNOSTICS, "foxglove.Log", LOG_SCHEMA)?,
+        events: channel(
+            topics::EVENTS,
+            "situ.Event",
+            &schema(
+                "situ.Event",
+                json!({ "time_ns": time, "agent": {"type": "string"}, "event": {"type": "string"},
+                            "payload": {"type": "object"}, "urgent": {"type": "boolean"},
+                            "accepted": {"type": "boolean"}, "reason": {"type": "string"} }),
+            ),
+        )?,
+        ticks: channel(topics::TICKS, "situ.Tick", &schema("situ.Tick", json!({ "time_ns": time })))?,
+        data: channel(
+            topics::DATA,
+            "situ.Data",
+            &schema(
+                "situ.Data",
+                json!({ "time_ns": time, "from": {"type": "string"}, "to": {"type": "string"},
+                            "urgent": {"type": "boolean"}, "size": {"type": "integer"},
+                            "fate": {"type": "string", "enum": ["delivered", "suppressed", "to_sleeping", "unrouted"]} }),
+            ),
+        )?,
+        modes: channel(
+            topics::MODES,
+            "situ.Mode",
+            &schema(
+                "situ.Mode",
+                json!({ "time_ns": time, "agent": {"type": "string"}, "state": {"type": "string"},
+                            "mode": {"type": "string", "enum": ["running", "waiting", "sleeping"]},
+                            "function": {"type": "string"} }),
+            ),
+        )?,
+    })
 }
 
 fn mcap_err(e: mcap::McapError) -> io::Error {
@@ -121,55 +193,14 @@ impl McapRecorder {
             .disable_seeking(true)
             .create(file)
             .map_err(mcap_err)?;
+        let mut all = Vec::new();
         let mut channel = |topic: &str, name: &str, schema_text: &str| -> io::Result<u16> {
             let schema = w.add_schema(name, "jsonschema", schema_text.as_bytes()).map_err(mcap_err)?;
-            w.add_channel(schema, topic, "json", &BTreeMap::new()).map_err(mcap_err)
+            let id = w.add_channel(schema, topic, "json", &BTreeMap::new()).map_err(mcap_err)?;
+            all.push((id, topic.to_string(), name.to_string(), schema_text.to_string()));
+            Ok(id)
         };
-        let time = json!({ "type": "integer", "description": "nanoseconds" });
-        let channels = Channels {
-            state: channel(
-                topics::STATE,
-                "situ.State",
-                &schema(
-                    "situ.State",
-                    json!({ "state": {"type": "string"}, "from": {"type": "string"}, "time_ns": time,
-                            "rules": {"type": "array", "items": {"type": "string"}}, "explain": {"type": "string"} }),
-                ),
-            )?,
-            events_log: channel(topics::EVENTS_LOG, "foxglove.Log", LOG_SCHEMA)?,
-            diagnostics: channel(topics::DIAGNOSTICS, "foxglove.Log", LOG_SCHEMA)?,
-            events: channel(
-                topics::EVENTS,
-                "situ.Event",
-                &schema(
-                    "situ.Event",
-                    json!({ "time_ns": time, "agent": {"type": "string"}, "event": {"type": "string"},
-                            "payload": {"type": "object"}, "urgent": {"type": "boolean"},
-                            "accepted": {"type": "boolean"}, "reason": {"type": "string"} }),
-                ),
-            )?,
-            ticks: channel(topics::TICKS, "situ.Tick", &schema("situ.Tick", json!({ "time_ns": time })))?,
-            data: channel(
-                topics::DATA,
-                "situ.Data",
-                &schema(
-                    "situ.Data",
-                    json!({ "time_ns": time, "from": {"type": "string"}, "to": {"type": "string"},
-                            "urgent": {"type": "boolean"}, "size": {"type": "integer"},
-                            "fate": {"type": "string", "enum": ["delivered", "suppressed", "to_sleeping", "unrouted"]} }),
-                ),
-            )?,
-            modes: channel(
-                topics::MODES,
-                "situ.Mode",
-                &schema(
-                    "situ.Mode",
-                    json!({ "time_ns": time, "agent": {"type": "string"}, "state": {"type": "string"},
-                            "mode": {"type": "string", "enum": ["running", "waiting", "sleeping"]},
-                            "function": {"type": "string"} }),
-                ),
-            )?,
-        };
+        let channels = standard_channels(&mut channel)?;
         w.attach(&mcap::Attachment {
             log_time: 0,
             create_time: 0,
@@ -188,10 +219,49 @@ impl McapRecorder {
             channels,
             counts: Counts::new(),
             extra: BTreeMap::new(),
+            all,
+            taps: Vec::new(),
+            finished: false,
             last_flush: Instant::now(),
             by_message_time: None,
             error: None,
         })
+    }
+
+    /// A recording with no file: the same channels and messages, for the
+    /// taps only ([`McapRecorder::tap`]).
+    pub fn live(content: Arc<Content>) -> McapRecorder {
+        let mut all = Vec::new();
+        let mut channel = |topic: &str, name: &str, schema_text: &str| -> io::Result<u16> {
+            let id = all.len() as u16 + 1;
+            all.push((id, topic.to_string(), name.to_string(), schema_text.to_string()));
+            Ok(id)
+        };
+        let channels = standard_channels(&mut channel).expect("no file, no error");
+        McapRecorder {
+            writer: None,
+            finishing: Arc::new(AtomicBool::new(false)),
+            since_flush: 0,
+            content,
+            channels,
+            counts: Counts::new(),
+            extra: BTreeMap::new(),
+            all,
+            taps: Vec::new(),
+            finished: false,
+            last_flush: Instant::now(),
+            by_message_time: None,
+            error: None,
+        }
+    }
+
+    /// Sends every channel and message to `tap` too: the channels so far at
+    /// once, the rest as they come.
+    pub fn tap(&mut self, mut tap: Box<dyn Tap>) {
+        for (id, topic, name, schema) in &self.all {
+            tap.channel(*id, topic, name, schema);
+        }
+        self.taps.push(tap);
     }
 
     /// Closes chunks every second of the messages' time rather than of the
@@ -210,10 +280,21 @@ impl McapRecorder {
     /// Foxglove schema name such as `foxglove.PoseInFrame` makes Foxglove's
     /// panels show it); returns its id for [`write_message`](Self::write_message).
     pub fn add_channel(&mut self, topic: &str, schema_name: &str, schema_text: &str) -> io::Result<u16> {
-        let w = self.writer.as_mut().ok_or_else(|| io::Error::other("the recording is finished"))?;
-        let schema = w.add_schema(schema_name, "jsonschema", schema_text.as_bytes()).map_err(mcap_err)?;
-        let id = w.add_channel(schema, topic, "json", &BTreeMap::new()).map_err(mcap_err)?;
+        if self.finished {
+            return Err(io::Error::other("the recording is finished"));
+        }
+        let id = match self.writer.as_mut() {
+            Some(w) => {
+                let schema = w.add_schema(schema_name, "jsonschema", schema_text.as_bytes()).map_err(mcap_err)?;
+                w.add_channel(schema, topic, "json", &BTreeMap::new()).map_err(mcap_err)?
+            }
+            None => self.all.len() as u16 + 1,
+        };
         self.extra.insert(id, topic.to_string());
+        self.all.push((id, topic.to_string(), schema_name.to_string(), schema_text.to_string()));
+        for tap in &mut self.taps {
+            tap.channel(id, topic, schema_name, schema_text);
+        }
         Ok(id)
     }
 
@@ -228,12 +309,19 @@ impl McapRecorder {
     }
 
     fn write(&mut self, channel: u16, topic: &str, time: u64, message: &Json) {
-        let Some(w) = self.writer.as_mut() else { return };
-        let header = MessageHeader { channel_id: channel, sequence: 0, log_time: time, publish_time: time };
-        let bytes = serde_json::to_vec(message).expect("JSON serializes");
-        if let Err(e) = w.write_to_known_channel(&header, &bytes) {
-            self.error.get_or_insert(mcap_err(e));
+        if self.finished {
             return;
+        }
+        let bytes = serde_json::to_vec(message).expect("JSON serializes");
+        for tap in &mut self.taps {
+            tap.message(channel, time, &bytes);
+        }
+        if let Some(w) = self.writer.as_mut() {
+            let header = MessageHeader { channel_id: channel, sequence: 0, log_time: time, publish_time: time };
+            if let Err(e) = w.write_to_known_channel(&header, &bytes) {
+                self.error.get_or_insert(mcap_err(e));
+                return;
+            }
         }
         match self.counts.get_mut(topic) {
             Some(n) => *n += 1,
@@ -386,6 +474,7 @@ impl Sink for McapRecorder {
     }
 
     fn finish(&mut self) -> io::Result<()> {
+        self.finished = true;
         if let Some(mut w) = self.writer.take() {
             // The summary, the footer and the magic, written over the last
             // provisional end (the writer flushes once they are written).

@@ -381,66 +381,20 @@ fn time_json(t: u64) -> Json {
     json!({ "sec": t / NS, "nsec": t % NS })
 }
 
-fn time_schema() -> Json {
-    json!({ "type": "object", "title": "time",
-            "properties": { "sec": {"type": "integer", "minimum": 0},
-                            "nsec": {"type": "integer", "minimum": 0, "maximum": 999_999_999} } })
-}
-
-fn vector3_schema(title: &str) -> Json {
-    json!({ "type": "object", "title": title,
-            "properties": { "x": {"type": "number"}, "y": {"type": "number"}, "z": {"type": "number"} } })
-}
-
-fn pose_schema() -> Json {
-    json!({ "type": "object", "title": "foxglove.Pose",
-            "properties": { "position": vector3_schema("foxglove.Vector3"),
-                            "orientation": { "type": "object", "title": "foxglove.Quaternion",
-                                "properties": { "x": {"type": "number"}, "y": {"type": "number"},
-                                                "z": {"type": "number"}, "w": {"type": "number"} } } } })
-}
-
-/// The JSON schema of `foxglove.PoseInFrame`.
+/// The JSON schema of `foxglove.PoseInFrame`: Foxglove's own, as published
+/// (schemas/jsonschema/PoseInFrame.json of github.com/foxglove/foxglove-sdk,
+/// MIT), so that Foxglove's panels read the messages and a recording
+/// validates against it.
 pub fn pose_in_frame_schema() -> String {
-    json!({ "title": "foxglove.PoseInFrame", "description": "A timestamped pose in a reference frame",
-            "type": "object",
-            "properties": { "timestamp": time_schema(), "frame_id": {"type": "string"}, "pose": pose_schema() } })
-    .to_string()
+    include_str!("schemas/PoseInFrame.json").trim_end().to_string()
 }
 
-/// The JSON schema of `foxglove.SceneUpdate` (the parts `situ run` writes
-/// are given in full; the other primitive lists are arrays of objects).
+/// The JSON schema of `foxglove.SceneUpdate`: Foxglove's own, as published
+/// (schemas/jsonschema/SceneUpdate.json of github.com/foxglove/foxglove-sdk,
+/// MIT), every sub-schema in full (SceneEntity, SceneEntityDeletion, the
+/// primitives, Pose, Vector3, Quaternion, Color, time, duration).
 pub fn scene_update_schema() -> String {
-    let color = json!({ "type": "object", "title": "foxglove.Color",
-        "properties": { "r": {"type": "number"}, "g": {"type": "number"}, "b": {"type": "number"}, "a": {"type": "number"} } });
-    let line = json!({ "type": "object", "title": "foxglove.LinePrimitive",
-        "properties": {
-            "type": {"type": "integer", "description": "0 LINE_STRIP, 1 LINE_LOOP, 2 LINE_LIST"},
-            "pose": pose_schema(), "thickness": {"type": "number"}, "scale_invisible": {"type": "boolean"},
-            "points": {"type": "array", "items": vector3_schema("foxglove.Point3")},
-            "color": color, "colors": {"type": "array", "items": color},
-            "indices": {"type": "array", "items": {"type": "integer", "minimum": 0}} } });
-    let others = json!({"type": "array", "items": {"type": "object"}});
-    let entity = json!({ "type": "object", "title": "foxglove.SceneEntity",
-        "properties": {
-            "timestamp": time_schema(), "frame_id": {"type": "string"}, "id": {"type": "string"},
-            "lifetime": { "type": "object", "title": "duration",
-                "properties": { "sec": {"type": "integer"}, "nsec": {"type": "integer", "minimum": 0, "maximum": 999_999_999} } },
-            "frame_locked": {"type": "boolean"},
-            "metadata": {"type": "array", "items": { "type": "object", "title": "foxglove.KeyValuePair",
-                "properties": { "key": {"type": "string"}, "value": {"type": "string"} } } },
-            "arrows": others, "cubes": others, "spheres": others, "cylinders": others,
-            "lines": {"type": "array", "items": line},
-            "triangles": others, "texts": others, "models": others } });
-    json!({ "title": "foxglove.SceneUpdate", "description": "An update to the entities displayed in a 3D scene",
-            "type": "object",
-            "properties": {
-                "deletions": {"type": "array", "items": { "type": "object", "title": "foxglove.SceneEntityDeletion",
-                    "properties": { "timestamp": time_schema(),
-                                    "type": {"type": "integer", "description": "0 MATCHING_ID, 1 ALL"},
-                                    "id": {"type": "string"} } } },
-                "entities": {"type": "array", "items": entity} } })
-    .to_string()
+    include_str!("schemas/SceneUpdate.json").trim_end().to_string()
 }
 
 /// The pose and obstacle channels of a recording.
@@ -488,7 +442,7 @@ impl Scene {
                     "lines": [{
                         "type": 1,
                         "pose": { "position": {"x": 0.0, "y": 0.0, "z": 0.0}, "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0} },
-                        "thickness": 0.15, "scale_invisible": false, "points": points,
+                        "thickness": 0.15, "scale_invariant": false, "points": points,
                         "color": color, "colors": [], "indices": [],
                     }],
                     "triangles": [], "texts": [], "models": [],

@@ -1,0 +1,221 @@
+//! `situ view` in a real browser: headless Chromium (Debian's `chromium`,
+//! `scripts/install-chromium.sh`; a missing `chromium` fails these tests)
+//! loads the page that `situ view` serves, runs its script, and dumps the
+//! DOM: the state graph's SVG with the current state highlighted, the
+//! agents' modes, the rules, no page error; for a recording, two times
+//! chosen in the address show two different states and modes. Screenshots
+//! are saved under `target/tmp/view/` for a person to open. Bad input (a
+//! damaged recording, one of other rules, a port in use) exits 2 before
+//! anything is served.
+
+mod common;
+use common::*;
+use std::io::{BufRead, BufReader};
+use std::net::TcpListener;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// A `situ view` being served; stopped when dropped.
+struct Served {
+    child: Child,
+    url: String,
+}
+
+impl Served {
+    fn start(args: &[&str]) -> Served {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_situ"))
+            .arg("view")
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .expect("situ view starts");
+        let mut line = String::new();
+        BufReader::new(child.stdout.take().unwrap()).read_line(&mut line).expect("the first line");
+        let url =
+            line.trim().strip_prefix("serving ").unwrap_or_else(|| panic!("not a URL line: {line:?}")).to_string();
+        assert!(url.starts_with("http://127.0.0.1:") && url.ends_with('/'), "{url}");
+        Served { child, url }
+    }
+}
+
+impl Drop for Served {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn require_chromium() {
+    let ok = Command::new("chromium").arg("--version").stdout(Stdio::null()).status().is_ok_and(|s| s.success());
+    assert!(ok, "Debian's `chromium` is missing: run scripts/install-chromium.sh");
+}
+
+/// Where the screenshots go.
+fn screens() -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("view");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Headless Chromium on `url` with `extra` arguments, to its end (60 s at
+/// most); its standard output.
+fn chromium(url: &str, extra: &[&str]) -> String {
+    let profile = tempfile::tempdir().unwrap();
+    let out = tempfile::NamedTempFile::new().unwrap();
+    let mut child = Command::new("chromium")
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--no-first-run",
+            "--virtual-time-budget=5000",
+        ])
+        .arg(format!("--user-data-dir={}", profile.path().display()))
+        .args(extra)
+        .arg(url)
+        .stdout(out.reopen().unwrap())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("chromium starts");
+    let deadline = Instant::now() + Duration::from_secs(60);
+    loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            assert!(status.success(), "chromium on {url} failed: {status}");
+            break;
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("chromium on {url} did not finish in 60 s");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    std::fs::read_to_string(out.path()).unwrap()
+}
+
+/// The page's DOM once its script ran.
+fn dom(url: &str) -> String {
+    let dom = chromium(url, &["--dump-dom"]);
+    assert!(dom.contains("data-ready=\"true\""), "the page's script did not finish on {url}:\n{dom}");
+    assert!(!dom.contains("<pre id=\"page-error\""), "the page reported an error on {url}:\n{dom}");
+    dom
+}
+
+fn screenshot(url: &str, name: &str) {
+    let path = screens().join(name);
+    let _ = std::fs::remove_file(&path);
+    chromium(url, &["--window-size=1400,900", &format!("--screenshot={}", path.display())]);
+    let size = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+    assert!(size > 10_000, "no screenshot at {} ({size} bytes)", path.display());
+    eprintln!("screenshot: {}", path.display());
+}
+
+/// The state the graph highlights as current (the one node of class
+/// `current`), and the one the header names.
+fn current(dom: &str) -> String {
+    let highlighted: Vec<&str> = dom
+        .split("<g ")
+        .skip(1)
+        .map(|g| &g[..g.find('>').unwrap()])
+        .filter(|tag| {
+            tag.split("class=\"").nth(1).is_some_and(|c| c[..c.find('"').unwrap()].split(' ').any(|w| w == "current"))
+        })
+        .filter_map(|tag| tag.split("data-state=\"").nth(1).map(|s| &s[..s.find('"').unwrap()]))
+        .collect();
+    assert_eq!(highlighted.len(), 1, "one highlighted state in the graph: {highlighted:?}");
+    let at = dom.find("id=\"current-state\">").expect("the current state named") + 19;
+    let named = &dom[at..at + dom[at..].find('<').unwrap()];
+    assert_eq!(highlighted[0], named, "the graph and the header disagree");
+    named.to_string()
+}
+
+/// An agent's mode in the wiring table.
+fn mode(dom: &str, agent: &str) -> String {
+    let at = dom.find(&format!("<tr data-agent=\"{agent}\">")).unwrap_or_else(|| panic!("no row of {agent}"));
+    let row = &dom[at..at + dom[at..].find("</tr>").unwrap()];
+    let m = row.find("data-mode=\"").expect("a mode") + 11;
+    row[m..m + row[m..].find('"').unwrap()].to_string()
+}
+
+#[test]
+fn the_rules_draw_in_a_browser() {
+    require_chromium();
+    let served = Served::start(&["rules/outdoor.situ"]);
+    let dom = dom(&served.url);
+    assert!(dom.contains("<svg") && dom.contains("data-state=\"RS\""), "the state graph's SVG");
+    assert_eq!(current(&dom), "IT");
+    // Every agent's mode and function in the initial state.
+    assert_eq!(dom.matches("<tr data-agent=").count(), 12);
+    assert_eq!(mode(&dom, "Localization"), "running");
+    assert_eq!(mode(&dom, "RFCCD"), "waiting");
+    assert!(dom.contains(">lines_far<"), "RFCCD's function");
+    // The rules with their source text.
+    assert!(dom.contains("data-rule=\"start_on_road\""));
+    assert!(dom.contains("rule start_on_road"), "a rule's source text");
+    // Another state's wiring, chosen in the address.
+    let other = self::dom(&format!("{}?state=RS", served.url));
+    assert!(other.contains("id=\"wiring-state\">RS<"), "the wiring of RS");
+    assert_eq!(mode(&other, "RFCCD"), "running");
+    screenshot(&served.url, "rules.png");
+}
+
+#[test]
+fn a_recording_scrubs_in_a_browser() {
+    require_chromium();
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("run.mcap");
+    let rec = rec.to_str().unwrap();
+    let run = situ(&["run", "rules/outdoor.situ", "--record", rec, "--until", "25"]);
+    assert!(Path::new(rec).is_file(), "no recording: {}", text(&run));
+    let served = Served::start(&[rec]);
+    let early = dom(&format!("{}?at=0.1", served.url));
+    let late = dom(&format!("{}#t=24", served.url));
+    assert_eq!(current(&early), "IT");
+    let later = current(&late);
+    assert_ne!(later, "IT", "24 s later the robot is elsewhere");
+    assert_ne!(mode(&early, "RFCCD"), mode(&late, "RFCCD"), "the modes move with the time");
+    assert!(late.contains("(recorded)"), "the recorded modes are shown");
+    // The firings with their explanations; the timeline.
+    assert!(late.contains("by initialized") && late.contains("rule `initialized`"), "a firing explained");
+    assert!(late.contains("id=\"scrub\""), "the timeline");
+    // Played from the start, the page reaches the end of the recording.
+    let played = dom(&format!("{}?play", served.url));
+    assert_eq!(current(&played), later, "played to its end");
+    assert!(played.contains("id=\"time-label\">25.000 s / 25.000 s<"), "at the end: {played}");
+    assert!(played.contains("class=\"firing now\"") && played.contains("▶ play"), "stopped at the end");
+    // The same with its rules given: they are the rules it was made on.
+    let again = Served::start(&[rec, "--rules", "rules/outdoor.situ"]);
+    assert_eq!(current(&dom(&format!("{}#t=24", again.url))), later);
+    screenshot(&format!("{}#t=24", served.url), "recording.png");
+}
+
+#[test]
+fn bad_input_exits_2_before_serving() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("run.mcap");
+    let rec_s = rec.to_str().unwrap();
+    situ(&["run", "rules/outdoor.situ", "--record", rec_s, "--until", "3"]);
+    let mut bytes = std::fs::read(&rec).unwrap();
+    let mid = bytes.len() / 2;
+    bytes[mid..mid + 64].fill(0xff);
+    let damaged = write(dir.path(), "damaged.mcap", &bytes);
+    let o = situ(&["view", &damaged]);
+    assert_eq!(code(&o), 2, "{}", text(&o));
+    assert!(stderr(&o).contains("not a readable recording"), "{}", text(&o));
+    assert!(stdout(&o).is_empty(), "nothing served: {}", text(&o));
+
+    let o = situ(&["view", rec_s, "--rules", "rules/ugv.situ"]);
+    assert_eq!(code(&o), 2, "{}", text(&o));
+    assert!(stderr(&o).contains("recorded on other rules"), "{}", text(&o));
+
+    let taken = TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = taken.local_addr().unwrap().port().to_string();
+    let o = situ(&["view", "rules/outdoor.situ", "--port", &port]);
+    assert_eq!(code(&o), 2, "{}", text(&o));
+    assert!(stderr(&o).contains(&format!("port {port} on 127.0.0.1 is in use")), "{}", text(&o));
+}
