@@ -28,14 +28,17 @@
 //! order; set the state; repeat. More than [`Engine::cascade_limit`] firings
 //! for one event is a [`PostError::Cascade`].
 
+mod admit;
 mod eval;
 mod net;
+mod report;
 
-use net::{AlphaKind, Kind, Net, OperandRt, TestKind, TestRt, NONE};
-use situ_compiler::bundle::{Content, FieldType, Value};
+use net::{AlphaKind, Net, OperandRt, TestKind, TestRt, NONE};
+use situ_compiler::bundle::{Content, Value};
 use std::sync::Arc;
 
 pub use eval::{compare, in_range, passes, passes_with};
+pub use report::{describe_fact, format_time, show_value, FactView, Firing, MatchedFact, PostError, StateChange};
 
 /// The default bound of a cascade (§10.4).
 pub const CASCADE_LIMIT: usize = 64;
@@ -59,180 +62,6 @@ struct Slot {
 }
 
 const EMPTY: Slot = Slot { event: NONE, time: 0, run: 0, seq: 0 };
-
-/// A fact as matched by a firing, for explanations.
-#[derive(Debug, Clone, PartialEq)]
-pub struct MatchedFact {
-    pub agent: u32,
-    pub event: u32,
-    pub payload: Vec<Value>,
-    pub time: u64,
-    pub run: u64,
-}
-
-/// An agent's live fact, borrowed from the working memory.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FactView<'a> {
-    pub event: u32,
-    pub payload: &'a [Value],
-    pub time: u64,
-    pub run: u64,
-    /// The posting sequence number: a later report has a larger one.
-    pub seq: u64,
-}
-
-/// One rule firing.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Firing {
-    pub rule: u32,
-    pub from: u32,
-    pub to: u32,
-    /// Now, when it fired.
-    pub time: u64,
-    /// The facts its positive patterns matched, in pattern order.
-    pub matched: Vec<MatchedFact>,
-    /// The agents its `stale A` tests found stale.
-    pub stale: Vec<u32>,
-}
-
-/// What one event (or a settling) did: the rules that fired, in order.
-#[derive(Debug, Clone, PartialEq)]
-pub struct StateChange {
-    /// The state at rest before, and after.
-    pub from: u32,
-    pub to: u32,
-    pub time: u64,
-    pub firings: Vec<Firing>,
-}
-
-impl StateChange {
-    /// Whether the state at rest changed (a cascade may come back).
-    pub fn changed(&self) -> bool {
-        self.from != self.to
-    }
-
-    /// The change in source terms: every firing with its rule, where it is
-    /// written, and the facts that made it hold.
-    pub fn explain(&self, c: &Content) -> String {
-        let mut out = format!(
-            "{} -> {} at {}",
-            c.states[self.from as usize].name,
-            c.states[self.to as usize].name,
-            format_time(self.time)
-        );
-        for f in &self.firings {
-            let rule = &c.rules[f.rule as usize];
-            out.push_str(&format!(
-                "\n  rule `{}` ({}, salience {}) fired in {}: ",
-                rule.name, rule.source, rule.salience, c.states[f.from as usize].name
-            ));
-            let mut why: Vec<String> = f.matched.iter().map(|m| describe_fact(c, m)).collect();
-            why.extend(f.stale.iter().map(|&a| format!("{} stale", c.agents[a as usize].name)));
-            if why.is_empty() {
-                out.push_str("its state guard holds");
-            } else {
-                out.push_str(&why.join(", "));
-            }
-            out.push_str(&format!(" -> {}", c.states[f.to as usize].name));
-        }
-        out
-    }
-}
-
-/// A fact as a person writes an event: `LAOBS(distance: 12.0, height: 0.5) x2 at 1.230s`.
-pub fn describe_fact(c: &Content, m: &MatchedFact) -> String {
-    let e = &c.events[m.event as usize];
-    let mut s = e.name.clone();
-    if !e.fields.is_empty() {
-        let args: Vec<String> =
-            e.fields.iter().zip(&m.payload).map(|(f, v)| format!("{}: {}", f.name, show_value(&f.ty, *v))).collect();
-        s.push_str(&format!("({})", args.join(", ")));
-    }
-    if m.run > 1 {
-        s.push_str(&format!(" x{}", m.run));
-    }
-    s.push_str(&format!(" at {}", format_time(m.time)));
-    s
-}
-
-/// A value as written in situ.
-pub fn show_value(ty: &FieldType, v: Value) -> String {
-    match (ty, v) {
-        (FieldType::Symbols(s), Value::Symbol(i)) => s.get(i as usize).cloned().unwrap_or_else(|| format!("#{i}")),
-        (_, Value::F64(f)) if f.is_finite() && f.fract() == 0.0 && f.abs() < 1e15 => format!("{f:.1}"),
-        (_, Value::F64(f)) => format!("{f}"),
-        (_, Value::I64(i)) => i.to_string(),
-        (_, Value::Bool(b)) => b.to_string(),
-        (_, Value::Symbol(i)) => format!("#{i}"),
-    }
-}
-
-/// Nanoseconds as seconds with millisecond precision: `1.230s`.
-pub fn format_time(ns: u64) -> String {
-    format!("{}.{:03}s", ns / 1_000_000_000, (ns / 1_000_000) % 1000)
-}
-
-/// Why an event was not taken, or what went wrong while it was processed.
-#[derive(Debug, Clone, PartialEq)]
-pub enum PostError {
-    /// No event has this id in the bundle.
-    UnknownEvent { event: u32 },
-    /// The payload has the wrong number of values.
-    Arity { event: u32, expected: usize, found: usize },
-    /// A value does not fit its field's type.
-    Type { event: u32, field: u32, expected: FieldType },
-    /// Reported on the bus by another agent than the event's (the engine
-    /// takes the agent from the event; the Bulletinboard's bus checks it).
-    AnotherAgent { event: u32, agent: u32 },
-    /// Stamped before the same agent's latest accepted event.
-    OutOfOrder { event: u32, time: u64, last: u64 },
-    /// Stamped more than the skew bound ahead of the clock it arrived at.
-    FromTheFuture { event: u32, time: u64, clock: u64, max_skew: u64 },
-    /// The network did not come to rest within the bound: the firings so
-    /// far, which name the rules. The state is the last one reached.
-    Cascade { limit: usize, firings: Vec<Firing> },
-}
-
-impl PostError {
-    pub fn describe(&self, c: &Content) -> String {
-        match self {
-            PostError::UnknownEvent { event } => format!("unknown event id {event}"),
-            PostError::Arity { event, expected, found } => format!(
-                "event `{}` has {expected} payload field(s), {found} given",
-                c.events.get(*event as usize).map_or("?", |e| &e.name)
-            ),
-            PostError::Type { event, field, expected } => {
-                let e = &c.events[*event as usize];
-                format!(
-                    "field `{}.{}` is {}, the value is not",
-                    e.name,
-                    e.fields[*field as usize].name,
-                    expected.describe()
-                )
-            }
-            PostError::AnotherAgent { event, agent } => {
-                let e = &c.events[*event as usize];
-                let who = c.agents.get(*agent as usize).map_or("?", |a| a.name.as_str());
-                format!("`{}` is an event of `{}`, not of `{who}`", e.name, c.agents[e.agent as usize].name)
-            }
-            PostError::OutOfOrder { time, last, .. } => {
-                format!("out of order: at {time} ns, after an event of the same agent at {last} ns")
-            }
-            PostError::FromTheFuture { time, clock, max_skew, .. } => format!(
-                "from the future: at {time} ns, {} ns ahead of the Bulletinboard's clock (at most {max_skew} ns)",
-                time - clock
-            ),
-            PostError::Cascade { limit, firings } => {
-                let mut names: Vec<&str> = firings.iter().map(|f| c.rules[f.rule as usize].name.as_str()).collect();
-                names.dedup();
-                format!(
-                    "the rules did not come to rest within {limit} firings: {} (an oscillation: make their conditions exclude each other)",
-                    names.join(", ")
-                )
-            }
-        }
-    }
-}
 
 /// The Rete network of a bundle with its working memory.
 #[derive(Debug, Clone)]
@@ -414,109 +243,6 @@ impl Engine {
         self.next_deadline = u64::MAX;
         self.set_state(self.content.initial);
         self.propagate();
-    }
-
-    /// How far ahead of the clock it arrives at an event may be stamped
-    /// (ns; default [`DEFAULT_MAX_SKEW`]).
-    pub fn max_skew(&self) -> u64 {
-        self.max_skew
-    }
-
-    pub fn set_max_skew(&mut self, ns: u64) {
-        self.max_skew = ns;
-    }
-
-    /// The stamp of the agent's latest accepted event (0 before its first):
-    /// an event of the agent stamped earlier is refused.
-    pub fn agent_time(&self, agent: u32) -> u64 {
-        self.last.get(agent as usize).copied().unwrap_or(0)
-    }
-
-    /// Moves the agent's clock forward to `time` (a carried-over clock, at
-    /// hot swap): its events stamped earlier are refused from then on.
-    pub fn advance_agent_time(&mut self, agent: u32, time: u64) {
-        if let Some(t) = self.last.get_mut(agent as usize) {
-            *t = (*t).max(time);
-        }
-    }
-
-    /// The Bulletinboard's clock when the next events arrive (`None`: each
-    /// arrives at its stamp, as in a stream without clocks, a test or a
-    /// search). The running stack sets it to its clock (the wall clock, or
-    /// simulated time) before it takes the events of a drain; a stream line
-    /// `@CLOCK` sets it for its event. Against it [`admit`](Self::admit)
-    /// refuses events from the future.
-    pub fn set_clock(&mut self, clock: Option<u64>) {
-        self.clock = clock;
-    }
-
-    pub fn clock(&self) -> Option<u64> {
-        self.clock
-    }
-
-    /// **The acceptance rule** (language reference §10.4), the one place
-    /// where situ decides whether an event is taken: the engine's
-    /// [`step`](Self::step) and [`post`](Self::post), hence `situ bench`,
-    /// `situ test` and the running stack's Bulletinboard, all go through it.
-    /// An event is refused when
-    /// - its payload does not fit its event's fields ([`validate`](Self::validate));
-    /// - it is stamped before its agent's latest accepted event (out of
-    ///   order; the same time is accepted);
-    /// - it is stamped more than [`max_skew`](Self::max_skew) ahead of the
-    ///   [`clock`](Self::set_clock) it arrived at (from the future). Without
-    ///   a clock an event arrives at its stamp, and none is from the future.
-    ///
-    /// NaN and the infinities are accepted: §10.3 says what they match.
-    /// A refused event changes nothing, not even now.
-    pub fn admit(&self, event: u32, time: u64, payload: &[Value]) -> Result<(), PostError> {
-        self.validate(event, payload)?;
-        let agent = self.net.event_agent[event as usize] as usize;
-        let last = self.last[agent];
-        if time < last {
-            return Err(PostError::OutOfOrder { event, time, last });
-        }
-        if let Some(clock) = self.clock {
-            if time > clock.saturating_add(self.max_skew) {
-                return Err(PostError::FromTheFuture { event, time, clock, max_skew: self.max_skew });
-            }
-        }
-        Ok(())
-    }
-
-    /// The end of a mission (§10.12): if the state at rest is `final`, back
-    /// to the initial state with no facts ([`reset`](Self::reset)) and
-    /// true. `situ bench` and its stream generator call it after each event
-    /// (after both rests), unless told not to.
-    pub fn reset_if_final(&mut self) -> bool {
-        let fin = self.content.states.get(self.state as usize).is_some_and(|s| s.is_final);
-        if fin {
-            self.reset();
-        }
-        fin
-    }
-
-    /// Checks an event against the bundle's schema (a part of
-    /// [`admit`](Self::admit), which also checks its time).
-    pub fn validate(&self, event: u32, payload: &[Value]) -> Result<(), PostError> {
-        let Some(&(s, e)) = self.net.event_kinds.get(event as usize) else {
-            return Err(PostError::UnknownEvent { event });
-        };
-        let kinds = &self.net.kinds[s as usize..e as usize];
-        if kinds.len() != payload.len() {
-            return Err(PostError::Arity { event, expected: kinds.len(), found: payload.len() });
-        }
-        for (i, (k, v)) in kinds.iter().zip(payload).enumerate() {
-            let fits = match (k, v) {
-                (Kind::F64, Value::F64(_)) | (Kind::I64, Value::I64(_)) | (Kind::Bool, Value::Bool(_)) => true,
-                (Kind::Symbol(n), Value::Symbol(x)) => x < n,
-                _ => false,
-            };
-            if !fits {
-                let expected = self.content.events[event as usize].fields[i].ty.clone();
-                return Err(PostError::Type { event, field: i as u32, expected });
-            }
-        }
-        Ok(())
     }
 
     /// Processes one event: expiry, rest, the new fact, rest. Returns the

@@ -1,0 +1,113 @@
+//! The acceptance rule (language reference §10.4, §10.7): whether the
+//! engine takes an event — its payload against the schema, its time
+//! against its agent's latest accepted event and against the clock it
+//! arrived at — and the clocks it keeps for that.
+
+use super::net::Kind;
+use super::{Engine, PostError};
+use situ_compiler::bundle::Value;
+
+impl Engine {
+    /// How far ahead of the clock it arrives at an event may be stamped
+    /// (ns; default [`DEFAULT_MAX_SKEW`]).
+    pub fn max_skew(&self) -> u64 {
+        self.max_skew
+    }
+
+    pub fn set_max_skew(&mut self, ns: u64) {
+        self.max_skew = ns;
+    }
+
+    /// The stamp of the agent's latest accepted event (0 before its first):
+    /// an event of the agent stamped earlier is refused.
+    pub fn agent_time(&self, agent: u32) -> u64 {
+        self.last.get(agent as usize).copied().unwrap_or(0)
+    }
+
+    /// Moves the agent's clock forward to `time` (a carried-over clock, at
+    /// hot swap): its events stamped earlier are refused from then on.
+    pub fn advance_agent_time(&mut self, agent: u32, time: u64) {
+        if let Some(t) = self.last.get_mut(agent as usize) {
+            *t = (*t).max(time);
+        }
+    }
+
+    /// The Bulletinboard's clock when the next events arrive (`None`: each
+    /// arrives at its stamp, as in a stream without clocks, a test or a
+    /// search). The running stack sets it to its clock (the wall clock, or
+    /// simulated time) before it takes the events of a drain; a stream line
+    /// `@CLOCK` sets it for its event. Against it [`admit`](Self::admit)
+    /// refuses events from the future.
+    pub fn set_clock(&mut self, clock: Option<u64>) {
+        self.clock = clock;
+    }
+
+    pub fn clock(&self) -> Option<u64> {
+        self.clock
+    }
+
+    /// **The acceptance rule** (language reference §10.4), the one place
+    /// where situ decides whether an event is taken: the engine's
+    /// [`step`](Self::step) and [`post`](Self::post), hence `situ bench`,
+    /// `situ test` and the running stack's Bulletinboard, all go through it.
+    /// An event is refused when
+    /// - its payload does not fit its event's fields ([`validate`](Self::validate));
+    /// - it is stamped before its agent's latest accepted event (out of
+    ///   order; the same time is accepted);
+    /// - it is stamped more than [`max_skew`](Self::max_skew) ahead of the
+    ///   [`clock`](Self::set_clock) it arrived at (from the future). Without
+    ///   a clock an event arrives at its stamp, and none is from the future.
+    ///
+    /// NaN and the infinities are accepted: §10.3 says what they match.
+    /// A refused event changes nothing, not even now.
+    pub fn admit(&self, event: u32, time: u64, payload: &[Value]) -> Result<(), PostError> {
+        self.validate(event, payload)?;
+        let agent = self.net.event_agent[event as usize] as usize;
+        let last = self.last[agent];
+        if time < last {
+            return Err(PostError::OutOfOrder { event, time, last });
+        }
+        if let Some(clock) = self.clock {
+            if time > clock.saturating_add(self.max_skew) {
+                return Err(PostError::FromTheFuture { event, time, clock, max_skew: self.max_skew });
+            }
+        }
+        Ok(())
+    }
+
+    /// The end of a mission (§10.12): if the state at rest is `final`, back
+    /// to the initial state with no facts ([`reset`](Self::reset)) and
+    /// true. `situ bench` and its stream generator call it after each event
+    /// (after both rests), unless told not to.
+    pub fn reset_if_final(&mut self) -> bool {
+        let fin = self.content.states.get(self.state as usize).is_some_and(|s| s.is_final);
+        if fin {
+            self.reset();
+        }
+        fin
+    }
+
+    /// Checks an event against the bundle's schema (a part of
+    /// [`admit`](Self::admit), which also checks its time).
+    pub fn validate(&self, event: u32, payload: &[Value]) -> Result<(), PostError> {
+        let Some(&(s, e)) = self.net.event_kinds.get(event as usize) else {
+            return Err(PostError::UnknownEvent { event });
+        };
+        let kinds = &self.net.kinds[s as usize..e as usize];
+        if kinds.len() != payload.len() {
+            return Err(PostError::Arity { event, expected: kinds.len(), found: payload.len() });
+        }
+        for (i, (k, v)) in kinds.iter().zip(payload).enumerate() {
+            let fits = match (k, v) {
+                (Kind::F64, Value::F64(_)) | (Kind::I64, Value::I64(_)) | (Kind::Bool, Value::Bool(_)) => true,
+                (Kind::Symbol(n), Value::Symbol(x)) => x < n,
+                _ => false,
+            };
+            if !fits {
+                let expected = self.content.events[event as usize].fields[i].ty.clone();
+                return Err(PostError::Type { event, field: i as u32, expected });
+            }
+        }
+        Ok(())
+    }
+}
