@@ -211,21 +211,7 @@ impl McapRecorder {
         .map_err(mcap_err)?;
         // A valid file from the start: the header and the bundle.
         w.flush().map_err(mcap_err)?;
-        Ok(McapRecorder {
-            writer: Some(w),
-            finishing,
-            since_flush: 0,
-            content,
-            channels,
-            counts: Counts::new(),
-            extra: BTreeMap::new(),
-            all,
-            taps: Vec::new(),
-            finished: false,
-            last_flush: Instant::now(),
-            by_message_time: None,
-            error: None,
-        })
+        Ok(McapRecorder::with(Some(w), finishing, content, channels, all))
     }
 
     /// A recording with no file: the same channels and messages, for the
@@ -238,9 +224,20 @@ impl McapRecorder {
             Ok(id)
         };
         let channels = standard_channels(&mut channel).expect("no file, no error");
+        McapRecorder::with(None, Arc::new(AtomicBool::new(false)), content, channels, all)
+    }
+
+    /// A recorder with nothing written yet but its channels.
+    fn with(
+        writer: Option<mcap::Writer<Staged>>,
+        finishing: Arc<AtomicBool>,
+        content: Arc<Content>,
+        channels: Channels,
+        all: Vec<ChannelInfo>,
+    ) -> McapRecorder {
         McapRecorder {
-            writer: None,
-            finishing: Arc::new(AtomicBool::new(false)),
+            writer,
+            finishing,
             since_flush: 0,
             content,
             channels,

@@ -80,24 +80,24 @@ impl Builder<'_> {
                 b
             })
             .collect();
+        // Per rule: the states it may fire in (its state tests, not its target).
+        let allowed: Vec<Vec<usize>> = conds
+            .iter()
+            .enumerate()
+            .map(|(r, (_, states))| {
+                (0..n)
+                    .filter(|&x| {
+                        x != c.rules[r].target as usize
+                            && states.iter().all(|(positive, ss)| ss.contains(&(x as u32)) == *positive)
+                    })
+                    .collect()
+            })
+            .collect();
+        let mem: Vec<Lit> = conds.iter().map(|(m, _)| *m).collect();
         let mut s = state.clone();
         for _round in 0..n {
             let sel = s.decode(&mut self.aig, n);
-            let acts: Vec<Lit> = (0..c.rules.len())
-                .map(|r| {
-                    let (mem_cond, states) = &conds[r];
-                    let target = c.rules[r].target as usize;
-                    let mut ok = vec![true; n];
-                    for (positive, ss) in states {
-                        for (x, allowed) in ok.iter_mut().enumerate() {
-                            *allowed &= ss.contains(&(x as u32)) == *positive;
-                        }
-                    }
-                    ok[target] = false;
-                    let in_state = self.aig.or_all((0..n).filter(|&x| ok[x]).map(|x| sel[codes[x]]));
-                    self.aig.and(*mem_cond, in_state)
-                })
-                .collect();
+            let acts = self.activated(&mem, &allowed, &sel, codes);
             let mut cases = Vec::new();
             // Whether a rule of a higher class is activated.
             let mut higher = FALSE;
@@ -123,22 +123,21 @@ impl Builder<'_> {
         }
         // Still activated after as many firings as states: it never rests.
         let sel = s.decode(&mut self.aig, n);
-        let mut still = Vec::new();
-        for (r, (mem_cond, states)) in conds.iter().enumerate() {
-            let target = c.rules[r].target as usize;
-            let mut ok = vec![true; n];
-            for (positive, ss) in states {
-                for (x, allowed) in ok.iter_mut().enumerate() {
-                    *allowed &= ss.contains(&(x as u32)) == *positive;
-                }
-            }
-            ok[target] = false;
-            let in_state = self.aig.or_all((0..n).filter(|&x| ok[x]).map(|x| sel[codes[x]]));
-            let act = self.aig.and(*mem_cond, in_state);
-            still.push(act);
-        }
+        let still = self.activated(&mem, &allowed, &sel, codes);
         let err = self.aig.or_all(still);
         Ok((s, err))
+    }
+
+    /// Per rule: whether it is activated in the state `sel` decodes, its
+    /// condition on the memory holds and the state is one it may fire in.
+    fn activated(&mut self, mem: &[Lit], allowed: &[Vec<usize>], sel: &[Lit], codes: &[usize]) -> Vec<Lit> {
+        mem.iter()
+            .zip(allowed)
+            .map(|(mem_cond, states)| {
+                let in_state = self.aig.or_all(states.iter().map(|&x| sel[codes[x]]));
+                self.aig.and(*mem_cond, in_state)
+            })
+            .collect()
     }
 
     /// Whether the agent of `event` holds a fact of it that passes the
