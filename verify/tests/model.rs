@@ -95,7 +95,7 @@ fn agree(path: &Path, runs: usize, len: usize) -> Result<usize, String> {
                 break;
             }
             alphabet.key(&sys, &mut want);
-            model.key(&content, &alphabet, &val, &mut got);
+            model.key(&alphabet, &val, &mut got);
             if want != got || model.cascade(&val) {
                 return Err(format!(
                     "{}: run {run} step {step} ({}): engine {want:?}, circuit {got:?}",
@@ -135,7 +135,7 @@ fn agree(path: &Path, runs: usize, len: usize) -> Result<usize, String> {
                 break;
             }
             alphabet.key(&sys, &mut want);
-            model.key(&content, &alphabet, &val, &mut got);
+            model.key(&alphabet, &val, &mut got);
             if want != got || model.cascade(&val) {
                 return Err(format!("{}: stream {seed} step {step}: engine {want:?}, circuit {got:?}", path.display()));
             }

@@ -248,8 +248,7 @@ impl Model {
         let (s1, err1) = b.rest(&state, &state_code, &slots, &aged, &order)?;
         // 3. The new fact, then rest.
         let aig = &mut b.aig;
-        let inserted: Vec<SlotVal> =
-            slots.iter().zip(&aged).map(|(s, v)| s.insert(aig, v, &lsel, alphabet, c)).collect();
+        let inserted: Vec<SlotVal> = slots.iter().zip(&aged).map(|(s, v)| s.insert(aig, v, &lsel, alphabet)).collect();
         let order2 = order.after(aig, &slots, &lsel);
         let (s2, err2) = b.rest(&s1, &state_code, &slots, &inserted, &order2)?;
         // 4. The FSMs see a new state.
@@ -345,7 +344,7 @@ impl Model {
     }
 
     /// The abstract state the latches hold, as [`Alphabet::key`] writes it.
-    pub fn key(&self, c: &Content, alphabet: &Alphabet, val: &[bool], out: &mut Vec<u64>) {
+    pub fn key(&self, alphabet: &Alphabet, val: &[bool], out: &mut Vec<u64>) {
         out.clear();
         let s = self.state.value(val);
         out.push(self.state_code.iter().position(|&k| k == s).unwrap_or(usize::MAX) as u64);
@@ -381,7 +380,6 @@ impl Model {
             }
         });
         out.extend(with.iter().map(|&a| a as u64));
-        let _ = c;
     }
 }
 
@@ -418,7 +416,7 @@ impl Slot {
     }
 
     /// The slot after the chosen letter was posted (unchanged for another agent's).
-    fn insert(&self, aig: &mut Aig, v: &SlotVal, lsel: &[Lit], alphabet: &Alphabet, c: &Content) -> SlotVal {
+    fn insert(&self, aig: &mut Aig, v: &SlotVal, lsel: &[Lit], alphabet: &Alphabet) -> SlotVal {
         let mine: Vec<Lit> = self.letters.iter().map(|&l| lsel[l]).collect();
         let ins = aig.or_all(mine.iter().copied());
         let was_fact = v.kind.eq(aig, FACT);
@@ -442,7 +440,6 @@ impl Slot {
         let new_run = Word::mux(aig, same, &inc, &one);
         let letter_cases: Vec<(Lit, usize)> = mine.iter().enumerate().map(|(i, &l)| (l, i)).collect();
         let new_letter = Word::select(aig, self.letter.bits.len(), &letter_cases);
-        let _ = c;
         SlotVal {
             kind: Word::mux(aig, ins, &Word::constant(FACT, 2), &v.kind),
             letter: Word::mux(aig, ins, &new_letter, &v.letter),

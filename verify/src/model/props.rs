@@ -20,7 +20,6 @@ impl Builder<'_> {
         slots: &[Slot],
         mem: &[SlotVal],
     ) -> Result<Lit, Unsupported> {
-        let c = self.c;
         Ok(match p {
             Pred::Or(ps) => {
                 let ls = ps
@@ -63,10 +62,7 @@ impl Builder<'_> {
                 self.aig.or(out, inc)
             }
             Pred::Stale(a) => mem[*a as usize].kind.eq(&mut self.aig, STALE),
-            Pred::Event { event, tests, min_run } => {
-                let _ = c;
-                self.pattern(*event, tests, &[], *min_run, None, slots, mem)?
-            }
+            Pred::Event { event, tests, min_run } => self.pattern(*event, tests, &[], *min_run, None, slots, mem)?,
         })
     }
 
