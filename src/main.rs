@@ -15,6 +15,9 @@ struct Cli {
     command: Command,
 }
 
+// Parsed once per process: the size of the largest subcommand's arguments
+// costs nothing worth boxing them for.
+#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand)]
 enum Command {
     /// Parse, resolve and check rule files; exit 0 clean, 1 findings that fail, 2 usage or I/O.
@@ -123,6 +126,12 @@ enum Command {
         #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8765",
               conflicts_with = "compare")]
         foxglove: Option<String>,
+        /// Serve the Supervisor's page of the run live (`situ view`'s page, following the run) at
+        /// this port or address (default: a free port on 127.0.0.1; the URL is the first line on
+        /// standard output). A run in simulated time waits for the page, then runs in real time.
+        #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:0",
+              conflicts_with = "compare")]
+        serve: Option<String>,
         /// Any rules file: play this `script` block (its name) or the first script of this
         /// `.situ` file, every agent a stand-in that follows its table or FSM.
         #[arg(long, conflicts_with_all = ["compare", "scenario", "random"])]
@@ -376,6 +385,7 @@ fn main() -> ExitCode {
             until,
             compare,
             foxglove,
+            serve,
             script,
             random,
             stack,
@@ -390,13 +400,10 @@ fn main() -> ExitCode {
                 return ExitCode::from(code);
             }
             let local = stack == cmd::distributed::Stack::Sim && transport == cmd::distributed::Transport::Inproc;
-            if foxglove.is_some() && (!local || script.is_some() || random.is_some()) {
-                eprintln!("error: --foxglove serves the runs of the reference stacks (rules/outdoor.situ, rules/ugv.situ) only, for now");
-                cmd::USAGE
-            } else if local && (script.is_some() || random.is_some()) {
-                cmd::scripted::run(cmd::scripted::Args { file, script, random, until, out, record })
+            if local && (script.is_some() || random.is_some()) {
+                cmd::scripted::run(cmd::scripted::Args { file, script, random, until, out, record, foxglove, serve })
             } else if local {
-                cmd::run::run(cmd::run::Args { file, scenario, record, out, seed, until, compare, foxglove })
+                cmd::run::run(cmd::run::Args { file, scenario, record, out, seed, until, compare, foxglove, serve })
             } else {
                 cmd::distributed::run(cmd::distributed::Args {
                     file,
@@ -407,6 +414,8 @@ fn main() -> ExitCode {
                     only,
                     duration,
                     record,
+                    foxglove,
+                    serve,
                 })
             }
         }

@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{code, situ, stderr, text};
+use common::{code, situ, stderr, stdout, text};
 use std::net::TcpListener;
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
@@ -33,14 +33,17 @@ impl Drop for Run {
     }
 }
 
-#[test]
-fn a_foxglove_client_receives_the_runs_channels_and_messages_live() {
+/// `situ run FILE ARGS… --foxglove ADDR --record F` watched by the Python
+/// client (with `client_args`); the client's report and the run's output.
+fn watched(file: &str, args: &[&str], client_args: &[&str]) -> (String, std::process::Output, String) {
     let tmp = tempfile::tempdir().unwrap();
     let recording = tmp.path().join("run.mcap");
     let port = free_port();
     let addr = format!("127.0.0.1:{port}");
     let child = Command::new(env!("CARGO_BIN_EXE_situ"))
-        .args(["run", "rules/outdoor.situ", "--until", "4", "--foxglove", &addr, "--record"])
+        .args(["run", file])
+        .args(args)
+        .args(["--foxglove", &addr, "--record"])
         .arg(&recording)
         .current_dir(root())
         .env("NO_COLOR", "1")
@@ -54,6 +57,7 @@ fn a_foxglove_client_receives_the_runs_channels_and_messages_live() {
         .arg(format!("ws://{addr}"))
         .arg("--recording")
         .arg(&recording)
+        .args(client_args)
         .output()
         .expect("python3 runs");
     let client_text = text(&client);
@@ -67,6 +71,12 @@ fn a_foxglove_client_receives_the_runs_channels_and_messages_live() {
     }
     let out = run.0.take().unwrap().wait_with_output().unwrap();
     assert!([0, 1].contains(&code(&out)), "{}", text(&out));
+    (client_text, out, addr)
+}
+
+#[test]
+fn a_foxglove_client_receives_the_runs_channels_and_messages_live() {
+    let (client_text, out, addr) = watched("rules/outdoor.situ", &["--until", "4"], &[]);
     for topic in ["/pose", "/obstacles", "/state", "/events", "/situ/events"] {
         assert!(client_text.contains(topic), "{topic} not received:\n{client_text}");
     }
@@ -74,6 +84,17 @@ fn a_foxglove_client_receives_the_runs_channels_and_messages_live() {
     let err = stderr(&out);
     assert!(err.contains(&format!("foxglove: serving ws://{addr}")), "{err}");
     assert!(err.contains("a client subscribed"), "{err}");
+}
+
+#[test]
+fn a_users_scripted_run_is_watched_in_foxglove_too() {
+    // A greenhouse of our own, on its script: no vehicle, the rules' channels.
+    let (client_text, out, _) = watched("tests/view/greenhouse.situ", &[], &["--rules-only"]);
+    for topic in ["/state", "/events", "/situ/events", "/situ/modes"] {
+        assert!(client_text.contains(topic), "{topic} not received:\n{client_text}");
+    }
+    assert!(!client_text.contains("/pose"), "no vehicle, no pose:\n{client_text}");
+    assert!(stdout(&out).contains("path: GROWING → VENTING"), "{}", text(&out));
 }
 
 #[test]

@@ -205,3 +205,17 @@ fn the_mower_example_prints_its_expected_summary() {
         "`situ run {MOWER} --script \"a day on the lawn\" > examples/mower/expected-summary.txt` changed"
     );
 }
+
+#[test]
+fn a_long_path_is_shown_by_its_ends() {
+    // Ten minutes of random weather in a greenhouse of our own: hundreds of
+    // changes, too many for one line.
+    let o = common::situ(&["run", "tests/view/greenhouse.situ", "--random", "3", "--until", "600"]);
+    assert!(code(&o) < 2, "{}", text(&o));
+    let out = stdout(&o);
+    let line = out.lines().find(|l| l.starts_with("path: ")).expect("a path line");
+    assert!(line.starts_with("path: GROWING → "), "{line}");
+    let more: usize = line.split("… ").nth(1).and_then(|r| r.split(' ').next()).and_then(|n| n.parse().ok()).unwrap();
+    assert!(more > 100, "{line}");
+    assert_eq!(line.matches(" → ").count(), 40, "40 states shown: {line}");
+}

@@ -7,6 +7,10 @@
 //! are saved under `target/tmp/view/` for a person to open. Bad input (a
 //! damaged recording, one of other rules, a port in use) exits 2 before
 //! anything is served.
+//!
+//! A live run (`situ run … --serve`) is followed twice: by a page in
+//! Chromium, and by a plain HTTP client that compares what it heard with
+//! the run's recording and says how late it heard each change.
 
 mod common;
 use common::*;
@@ -24,15 +28,22 @@ struct Served {
 
 impl Served {
     fn start(args: &[&str]) -> Served {
+        Served::command(&[&["view"], args].concat())
+    }
+
+    /// `situ ARGS…` that prints `serving URL` as its first line.
+    fn command(args: &[&str]) -> Served {
         let mut child = Command::new(env!("CARGO_BIN_EXE_situ"))
-            .arg("view")
             .args(args)
             .stdout(Stdio::piped())
             .stderr(Stdio::inherit())
             .spawn()
             .expect("situ view starts");
+        let mut out = BufReader::new(child.stdout.take().unwrap());
         let mut line = String::new();
-        BufReader::new(child.stdout.take().unwrap()).read_line(&mut line).expect("the first line");
+        out.read_line(&mut line).expect("the first line");
+        // The rest is read to its end: a run's report is not cut short.
+        std::thread::spawn(move || std::io::copy(&mut out, &mut std::io::sink()));
         let url =
             line.trim().strip_prefix("serving ").unwrap_or_else(|| panic!("not a URL line: {line:?}")).to_string();
         assert!(url.starts_with("http://127.0.0.1:") && url.ends_with('/'), "{url}");
@@ -218,4 +229,98 @@ fn bad_input_exits_2_before_serving() {
     let o = situ(&["view", "rules/outdoor.situ", "--port", &port]);
     assert_eq!(code(&o), 2, "{}", text(&o));
     assert!(stderr(&o).contains(&format!("port {port} on 127.0.0.1 is in use")), "{}", text(&o));
+    // The same for a live run's page, before the run starts.
+    let o = situ(&["run", "tests/view/greenhouse.situ", "--serve", &port]);
+    assert_eq!(code(&o), 2, "{}", text(&o));
+    assert!(
+        stderr(&o).contains(&format!("port {port} on 127.0.0.1 is in use: choose another with --serve")),
+        "{}",
+        text(&o)
+    );
+    let o = situ(&["run", "tests/view/greenhouse.situ", "--serve", "localhost:http"]);
+    assert_eq!(code(&o), 2, "{}", text(&o));
+    assert!(stderr(&o).contains("is not a port or an address"), "{}", text(&o));
+}
+
+/// Follows a live run's `/api/live` to its end: every entry, and how late
+/// each state change was heard (ms, the server's stamp to here).
+fn follow(url: &str) -> (Vec<serde_json::Value>, Vec<f64>) {
+    let (mut entries, mut lags) = (Vec::new(), Vec::new());
+    let mut since = 0u64;
+    let deadline = Instant::now() + Duration::from_secs(120);
+    loop {
+        assert!(Instant::now() < deadline, "the run did not end");
+        let a: serde_json::Value = serde_json::from_str(&http_get(&format!("{url}api/live?since={since}"))).unwrap();
+        let heard = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap().as_micros() as f64;
+        assert_eq!(a["reset"], false, "no entry folded in a short run");
+        for e in a["entries"].as_array().unwrap() {
+            if e["kind"] == "change" {
+                lags.push((heard - e["wall_us"].as_f64().unwrap()) / 1000.0);
+            }
+            entries.push(e.clone());
+        }
+        since = a["next"].as_u64().unwrap();
+        if a["over"] == true {
+            return (entries, lags);
+        }
+    }
+}
+
+/// The state changes (from, to) of a recording.
+fn recorded_changes(path: &Path) -> Vec<(String, String)> {
+    let bytes = std::fs::read(path).unwrap();
+    let (messages, _) = situ_runtime::record::mcap::read_messages(&bytes).unwrap();
+    messages
+        .iter()
+        .filter(|(t, _, m)| t == "/state" && m["from"] != m["state"])
+        .map(|(_, _, m)| (m["from"].as_str().unwrap().to_string(), m["state"].as_str().unwrap().to_string()))
+        .collect()
+}
+
+fn percentile(lags: &mut [f64], p: f64) -> f64 {
+    lags.sort_by(f64::total_cmp);
+    lags[((lags.len() - 1) as f64 * p).round() as usize]
+}
+
+#[test]
+fn a_live_run_is_heard_change_by_change() {
+    let dir = tempfile::tempdir().unwrap();
+    // A user's greenhouse on its script; then the reference stack.
+    for (file, extra) in [("tests/view/greenhouse.situ", &[][..]), ("rules/outdoor.situ", &["--until", "4"][..])] {
+        let rec = dir.path().join("live.mcap");
+        let rec_s = rec.to_str().unwrap();
+        let mut served = Served::command(&[&["run", file, "--serve", "--record", rec_s], extra].concat());
+        let (entries, mut lags) = follow(&served.url);
+        let status = served.child.wait().unwrap();
+        assert!(status.code().is_some_and(|c| c < 2), "{file}: {status}");
+        let heard: Vec<(String, String)> = entries
+            .iter()
+            .filter(|e| e["kind"] == "change")
+            .map(|e| (e["from"].as_str().unwrap().to_string(), e["to"].as_str().unwrap().to_string()))
+            .collect();
+        assert!(!heard.is_empty(), "{file}: no change heard");
+        assert_eq!(heard, recorded_changes(&rec), "{file}: the page heard the recording's changes, in order");
+        assert!(entries.iter().any(|e| e["kind"] == "mode"), "{file}: the agents' modes");
+        if file.ends_with("greenhouse.situ") {
+            let path: Vec<&str> = heard.iter().map(|(_, to)| to.as_str()).collect();
+            assert_eq!(path, ["VENTING", "GROWING", "HEATING", "PAUSED", "HEATING", "GROWING"]);
+        }
+        let (p50, max) = (percentile(&mut lags, 0.5), percentile(&mut lags, 1.0));
+        eprintln!("{file}: {} changes heard; lag p50 {p50:.2} ms, max {max:.2} ms", lags.len());
+    }
+}
+
+#[test]
+fn a_live_run_follows_in_a_browser() {
+    require_chromium();
+    let served = Served::command(&["run", "tests/view/greenhouse.situ", "--serve"]);
+    // The run starts when the page opens, plays three seconds in real
+    // time, and tells the page it is over.
+    let dom = dom(&served.url);
+    assert!(dom.contains("data-live=\"over\""), "the page heard the end of the run:\n{dom}");
+    assert_eq!(current(&dom), "GROWING");
+    assert_eq!(dom.matches("<li class=\"firing").count(), 6, "six firings, as they came");
+    assert!(dom.contains("by door_open") && dom.contains("rule `door_open`"), "a firing explained");
+    assert_eq!(mode(&dom, "Heater"), "sleeping", "GROWING's wiring");
+    assert!(dom.contains("(live)"), "the timeline says it is live");
 }

@@ -4,6 +4,8 @@
 //! keeps what was recorded. Loopback only, on free ports.
 #![cfg(feature = "zenoh")]
 
+mod common;
+
 use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Duration;
@@ -83,4 +85,62 @@ fn a_killed_process_is_stale_and_the_recording_keeps_what_came_before() {
         .filter_map(|(_, _, m)| m["state"].as_str())
         .collect();
     assert_eq!(states, ["RO", "SP"]);
+}
+
+#[test]
+fn the_bulletinboard_process_serves_the_live_page() {
+    use std::io::{BufRead, BufReader};
+    let dir = tempfile::tempdir().unwrap();
+    let deploy = deployment(dir.path());
+    let run = |process: &str, extra: &[&str]| {
+        situ()
+            .args(["run", "examples/fig5/fig5.situ", "--stack", "demo", "--transport", "zenoh", "--deploy", &deploy])
+            .args(["--process", process, "--duration", "4"])
+            .args(extra)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    // Only the process of the Bulletinboard has the state to serve.
+    let o = situ()
+        .args(["run", "examples/fig5/fig5.situ", "--stack", "demo", "--transport", "zenoh", "--deploy", &deploy])
+        .args(["--process", "sensors", "--duration", "1", "--serve"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("process `sensors` has no Bulletinboard"));
+
+    let mut board = run("board", &["--serve"]);
+    let mut out = BufReader::new(board.stdout.take().unwrap());
+    let mut line = String::new();
+    out.read_line(&mut line).unwrap();
+    let url = line.trim().strip_prefix("serving ").unwrap_or_else(|| panic!("{line}")).to_string();
+    let others = [run("sensors", &[]), run("pipeline", &[])];
+    // The page's requests, as the page makes them: the program, then the
+    // run's entries as they come.
+    assert!(common::http_get(&format!("{url}api/program")).contains("\"RO\""));
+    let mut since = 0;
+    let mut states = Vec::new();
+    loop {
+        let a: serde_json::Value =
+            serde_json::from_str(&common::http_get(&format!("{url}api/live?since={since}"))).unwrap();
+        for e in a["entries"].as_array().unwrap() {
+            if e["kind"] == "change" {
+                states.push(e["to"].as_str().unwrap().to_string());
+            }
+        }
+        since = a["next"].as_u64().unwrap();
+        if a["over"] == true {
+            break;
+        }
+    }
+    assert_eq!(states, ["RO"], "the page heard RS -> RO over Zenoh");
+    let mut rest = String::new();
+    std::io::Read::read_to_string(&mut out, &mut rest).unwrap();
+    assert!(board.wait().unwrap().success());
+    assert!(rest.contains("path: RS → RO"), "{rest}");
+    for o in others {
+        let _ = o.wait_with_output();
+    }
 }

@@ -10,6 +10,9 @@ use situ_compiler::bundle::Content;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
+/// States of a path shown whole at the end of a run (see [`Summary::path_line`]).
+pub const PATH_SHOWN: usize = 40;
+
 #[derive(Debug, Clone, Serialize)]
 pub struct Summary {
     /// Simulated (or wall) time covered, seconds.
@@ -120,11 +123,28 @@ impl Summary {
         self.agents = agents.into_iter().map(|(a, c)| (self.agent_names[a as usize].clone(), c)).collect();
     }
 
+    /// The path for a person: whole up to [`PATH_SHOWN`] states, else its
+    /// start and its end around the count of the changes left out (the
+    /// whole path is in `path`, and in metrics.json).
+    pub fn path_line(&self) -> String {
+        const TAIL: usize = 5;
+        if self.path.len() <= PATH_SHOWN {
+            return self.path.join(" → ");
+        }
+        let head = PATH_SHOWN - TAIL;
+        let left_out = self.path.len() - PATH_SHOWN;
+        format!(
+            "{} → … {left_out} more … → {}",
+            self.path[..head].join(" → "),
+            self.path[self.path.len() - TAIL..].join(" → ")
+        )
+    }
+
     /// The table a person reads at the end of a run.
     pub fn table(&self) -> String {
         let mut s = String::new();
         let _ = writeln!(s, "{:.1} s, final state {}", self.duration_s, self.final_state);
-        let _ = writeln!(s, "path: {}", self.path.join(" → "));
+        let _ = writeln!(s, "path: {}", self.path_line());
         let w = self.states.iter().map(|f| f.state.chars().count()).max().unwrap_or(0).max(6);
         let _ = writeln!(s, "\n  {:<w$} {:>9}  entered  agent steps", "state", "time (s)");
         for f in self.states.iter().filter(|f| f.entered > 0) {

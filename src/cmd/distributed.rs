@@ -11,6 +11,8 @@
 //! default stack needs all its agents and its physics in one process, in
 //! simulated time: it does not run over Zenoh.
 
+use super::view::data::Site;
+use super::watchers::Watchers;
 use super::{FAILED, OK, USAGE};
 use situ_compiler::bundle::{self, Content, Encoding};
 use situ_runtime::agent::{self, Agent};
@@ -50,6 +52,11 @@ pub struct Args {
     pub only: Option<Vec<String>>,
     pub duration: f64,
     pub record: Option<PathBuf>,
+    /// Serve the run live over Foxglove's WebSocket protocol at this address.
+    pub foxglove: Option<String>,
+    /// Serve the Supervisor's page of the run live at this address (the
+    /// process of the Bulletinboard).
+    pub serve: Option<String>,
 }
 
 /// The flag Ctrl-C and SIGTERM raise.
@@ -82,24 +89,39 @@ fn agents_of(stack: Stack, names: &[String]) -> Result<Vec<Box<dyn Agent>>, Stri
 }
 
 /// The recording, with the bundle attached: the file's bytes as they were
-/// read and checked (its signature with them), or the source compiled.
-fn recorder(args: &Args, content: &Arc<Content>, file: Option<&[u8]>) -> Result<Option<Box<dyn Sink>>, u8> {
-    let Some(path) = &args.record else { return Ok(None) };
-    let compiled;
-    let bytes = match file {
-        Some(b) => b,
-        None => {
-            compiled = bundle::encode(content, Encoding::Json);
-            &compiled
+/// read and checked (its signature with them), or the source compiled; the
+/// watchers asked for tapped to it. `None`: no file, no watcher.
+fn recorder(
+    args: &Args,
+    content: &Arc<Content>,
+    file: Option<&[u8]>,
+    checked: Option<&situ_compiler::Checked>,
+) -> Result<(Option<Box<dyn Sink>>, Watchers), u8> {
+    let recording = match &args.record {
+        None => None,
+        Some(path) => {
+            let compiled;
+            let bytes = match file {
+                Some(b) => b,
+                None => {
+                    compiled = bundle::encode(content, Encoding::Json);
+                    &compiled
+                }
+            };
+            match McapRecorder::create(path, content.clone(), bytes) {
+                Ok(r) => Some(r),
+                Err(e) => {
+                    eprintln!("error: cannot write `{}`: {e}", path.display());
+                    return Err(USAGE);
+                }
+            }
         }
     };
-    match McapRecorder::create(path, content.clone(), bytes) {
-        Ok(r) => Ok(Some(Box::new(r))),
-        Err(e) => {
-            eprintln!("error: cannot write `{}`: {e}", path.display());
-            Err(USAGE)
-        }
-    }
+    let watchers = Watchers::start(args.foxglove.as_deref(), args.serve.as_deref(), || {
+        Site::live(args.file.display().to_string(), content.clone(), checked)
+    })?;
+    let sink = watchers.recorder(recording, content).map(|r| Box::new(r) as Box<dyn Sink>);
+    Ok((sink, watchers))
 }
 
 pub fn run(args: Args) -> u8 {
@@ -112,9 +134,10 @@ pub fn run(args: Args) -> u8 {
         Err(code) => return code,
     };
     let file = program.bytes.as_deref();
+    let checked = program.checked.as_ref();
     match args.transport {
-        Transport::Inproc => inproc(&args, program.content.clone(), file),
-        Transport::Zenoh => zenoh(&args, program.content.clone(), file),
+        Transport::Inproc => inproc(&args, program.content.clone(), file, checked),
+        Transport::Zenoh => zenoh(&args, program.content.clone(), file, checked),
     }
 }
 
@@ -138,13 +161,13 @@ fn finish(summary: situ_runtime::summary::Summary) -> u8 {
     }
 }
 
-fn inproc(args: &Args, content: Arc<Content>, file: Option<&[u8]>) -> u8 {
+fn inproc(args: &Args, content: Arc<Content>, file: Option<&[u8]>, checked: Option<&situ_compiler::Checked>) -> u8 {
     let names: Vec<String> = content.agents.iter().map(|a| a.name.clone()).collect();
     let bound = match bound_agents(args.stack, &content, &names) {
         Ok(b) => b,
         Err(code) => return code,
     };
-    let sink = match recorder(args, &content, file) {
+    let (sink, watchers) = match recorder(args, &content, file, checked) {
         Ok(s) => s,
         Err(code) => return code,
     };
@@ -152,18 +175,19 @@ fn inproc(args: &Args, content: Arc<Content>, file: Option<&[u8]>) -> u8 {
     let summary = realtime::run(content, bound, sink, config, Duration::from_secs_f64(args.duration), &mut |c| {
         eprintln!("state {}", c.to)
     });
+    watchers.end();
     finish(summary)
 }
 
 #[cfg(not(feature = "zenoh"))]
-fn zenoh(args: &Args, _content: Arc<Content>, _file: Option<&[u8]>) -> u8 {
-    let _ = (&args.deploy, &args.process, &args.only);
+fn zenoh(args: &Args, _content: Arc<Content>, _file: Option<&[u8]>, _: Option<&situ_compiler::Checked>) -> u8 {
+    let _ = (&args.deploy, &args.process, &args.only, &args.serve, &args.foxglove);
     eprintln!("error: {NO_ZENOH}");
     USAGE
 }
 
 #[cfg(feature = "zenoh")]
-fn zenoh(args: &Args, content: Arc<Content>, file: Option<&[u8]>) -> u8 {
+fn zenoh(args: &Args, content: Arc<Content>, file: Option<&[u8]>, checked: Option<&situ_compiler::Checked>) -> u8 {
     use situ_bus_zenoh::deploy::Deployment;
     use situ_bus_zenoh::{Placement, ZenohBus};
     use situ_runtime::bus::Bus;
@@ -210,7 +234,16 @@ fn zenoh(args: &Args, content: Arc<Content>, file: Option<&[u8]>) -> u8 {
             return USAGE;
         }
     };
-    let sink = match recorder(args, &content, file) {
+    if !process.board && (args.serve.is_some() || args.foxglove.is_some()) {
+        eprintln!(
+            "error: process `{}` has no Bulletinboard: the process that has it (`board = true` in `{}`) serves \
+             --serve and --foxglove",
+            process.name,
+            deploy.display()
+        );
+        return USAGE;
+    }
+    let (sink, watchers) = match recorder(args, &content, file, checked) {
         Ok(s) => s,
         Err(code) => return code,
     };
@@ -229,6 +262,7 @@ fn zenoh(args: &Args, content: Arc<Content>, file: Option<&[u8]>) -> u8 {
         realtime::run_on(content, bound, sink, config, Duration::from_secs_f64(args.duration), bus, &mut |c| {
             eprintln!("{name}: state {}", states[c.to as usize])
         });
+    watchers.end();
     finish(summary)
 }
 

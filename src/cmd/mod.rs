@@ -20,6 +20,7 @@ pub mod scripted;
 pub mod test;
 pub mod view;
 pub mod watch;
+pub mod watchers;
 
 use std::io::IsTerminal;
 use std::path::Path;

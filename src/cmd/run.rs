@@ -1,6 +1,6 @@
 //! `situ run FILE|BUNDLE [--scenario S] [--record F.mcap] [--out DIR]
 //! [--seed N] [--until SECONDS] [--compare hard-switch,merge]
-//! [--foxglove [ADDR]]`: runs the
+//! [--foxglove [ADDR]] [--serve [ADDR]]`: runs the
 //! rules' reference stack (`rules/outdoor.situ` or `rules/ugv.situ`, told by
 //! the agents) in simulated time, in process, the compiled rules deciding
 //! the state; shows what happened and how well. Exit 0 when the mission is
@@ -8,16 +8,19 @@
 //! time ran out), 2 on usage, I/O, a bad scenario or a damaged bundle.
 //!
 //! `--foxglove [ADDR]` (default 127.0.0.1:8765) serves the run live over
-//! Foxglove's WebSocket protocol: the recording's own channels, schemas and
-//! messages (one [`McapRecorder`], its [`Tap`] the server), with or without
-//! a file. The run waits for a client's first subscription, then goes in
-//! real time (a simulated second a second), so a person watches it.
+//! Foxglove's WebSocket protocol, `--serve [ADDR]` the Supervisor's page
+//! (`situ view`'s, fed live): both are taps of the run's one recorder (see
+//! [`super::watchers`]). The run waits for its watchers, then goes in real
+//! time (a simulated second a second), so a person watches it.
 //!
-//! (The transport is in process; `--transport zenoh` is for later.)
+//! (The transport is in process; `--transport zenoh` runs a deployment,
+//! [`super::distributed`].)
 
+use super::view::data::Site;
+use super::watchers::Watchers;
 use super::{FAILED, OK, USAGE};
 use situ_compiler::bundle::{self, Content, Encoding};
-use situ_runtime::record::mcap::{McapRecorder, Tap};
+use situ_runtime::record::mcap::McapRecorder;
 use situ_sim::scenario::{self, Scenario};
 use situ_sim::stack::{self, Recording, StackConfig, StackKind, StackRun};
 use situ_sim::ugv::Strategy;
@@ -34,6 +37,8 @@ pub struct Args {
     pub compare: Option<Vec<String>>,
     /// Serve the run live over Foxglove's WebSocket protocol at this address.
     pub foxglove: Option<String>,
+    /// Serve the Supervisor's page of the run live at this address.
+    pub serve: Option<String>,
 }
 
 /// A built-in scenario by name, or a TOML file; the error names the field
@@ -60,19 +65,13 @@ pub fn run(args: Args) -> u8 {
         Ok(p) => p,
         Err(code) => return code,
     };
-    let content = program.content;
-    let file_bytes = program.bytes;
+    let content = program.content.clone();
+    let file_bytes = program.bytes.clone();
     let kind = match StackKind::of(&content) {
         Ok(k) => k,
-        Err(_) if args.scenario.is_none() && args.compare.is_none() && args.foxglove.is_some() => {
-            eprintln!(
-                "error: --foxglove serves the runs of the reference stacks (rules/outdoor.situ, rules/ugv.situ) only, for now"
-            );
-            return USAGE;
-        }
         Err(_) if args.scenario.is_none() && args.compare.is_none() => {
             // Any other robot: its first script, every agent a stand-in.
-            let Args { file, until, out, record, .. } = args;
+            let Args { file, until, out, record, foxglove, serve, .. } = args;
             return super::scripted::run(super::scripted::Args {
                 file,
                 script: None,
@@ -80,6 +79,8 @@ pub fn run(args: Args) -> u8 {
                 until,
                 out,
                 record,
+                foxglove,
+                serve,
             });
         }
         Err(e) => {
@@ -112,7 +113,7 @@ pub fn run(args: Args) -> u8 {
 
     // The recording: at --record, else in --out.
     let record_path = args.record.clone().or_else(|| args.out.as_ref().map(|d| d.join("recording.mcap")));
-    let mut mcap = match &record_path {
+    let mcap = match &record_path {
         Some(path) => match McapRecorder::create(path, content.clone(), &bundle_bytes(file_bytes, &content)) {
             Ok(m) => Some(m),
             Err(e) => {
@@ -122,22 +123,15 @@ pub fn run(args: Args) -> u8 {
         },
         None => None,
     };
-    // Live: the same recorder, its channels and messages to the server too.
-    let live = match &args.foxglove {
-        Some(addr) => match LiveServer::start(addr) {
-            Ok(server) => {
-                let m = mcap.get_or_insert_with(|| McapRecorder::live(content.clone()));
-                m.tap(Box::new(server.tap()));
-                Some(server)
-            }
-            Err(e) => {
-                eprintln!("error: --foxglove: {e}");
-                return USAGE;
-            }
-        },
-        None => None,
+    // Live: the same recorder, its channels and messages to the watchers too.
+    let checked = program.checked;
+    let watchers = match Watchers::start(args.foxglove.as_deref(), args.serve.as_deref(), || {
+        Site::live(args.file.display().to_string(), content.clone(), checked.as_ref())
+    }) {
+        Ok(w) => w,
+        Err(code) => return code,
     };
-    let mcap = mcap.map(|m| Arc::new(Mutex::new(m)));
+    let mcap = watchers.recorder(mcap, &content).map(|m| Arc::new(Mutex::new(m)));
     let cfg = StackConfig { seed: args.seed, until, ..StackConfig::default() };
     let physics_step = cfg.physics_step;
     let mut run =
@@ -149,9 +143,9 @@ pub fn run(args: Args) -> u8 {
             }
         };
     let mut line = super::LiveLine::new();
-    match &live {
-        Some(server) => {
-            server.wait_for_a_client();
+    match watchers.any() {
+        true => {
+            watchers.wait();
             // Real time: a simulated second a wall second.
             let start = std::time::Instant::now();
             let per_second = (1_000_000_000 / physics_step).max(1);
@@ -168,10 +162,12 @@ pub fn run(args: Args) -> u8 {
                 }
             }
         }
-        None => run.run(&mut |r| line.draw(|| r.progress().line())),
+        false => run.run(&mut |r| line.draw(|| r.progress().line())),
     }
     line.clear();
-    let report = match run.finish() {
+    let finished = run.finish();
+    watchers.end();
+    let report = match finished {
         Ok(r) => r,
         Err(e) => {
             eprintln!("error: {e}");
@@ -190,9 +186,6 @@ pub fn run(args: Args) -> u8 {
     }
     if let Some(path) = &args.record {
         println!("recorded {}", path.display());
-    }
-    if let Some(server) = live {
-        server.stop();
     }
     if report.outcome.success() {
         OK
@@ -299,111 +292,4 @@ fn write_comparison(out: &Path, scenario: &Scenario, table: &situ_sim::ugv::Comp
         write(format!("timeline-{slug}.svg"), timeline)?;
     }
     Ok(())
-}
-
-/// `--foxglove`: a Foxglove WebSocket server of its own (its own context,
-/// so only this run's channels are on it).
-struct LiveServer {
-    context: Arc<foxglove::Context>,
-    handle: foxglove::WebSocketServerHandle,
-    addr: String,
-    subscribed: Arc<(Mutex<bool>, std::sync::Condvar)>,
-}
-
-/// Tells the run that a client subscribed.
-struct Subscriptions(Arc<(Mutex<bool>, std::sync::Condvar)>);
-
-impl foxglove::websocket::ServerListener for Subscriptions {
-    fn on_subscribe(&self, _client: foxglove::websocket::Client, _channel: foxglove::websocket::ChannelView) {
-        let (lock, cvar) = &*self.0;
-        *lock.lock().unwrap_or_else(|e| e.into_inner()) = true;
-        cvar.notify_all();
-    }
-}
-
-impl LiveServer {
-    /// Listens on `addr` (HOST:PORT); the error names the address.
-    fn start(addr: &str) -> Result<LiveServer, String> {
-        let (host, port) = addr
-            .rsplit_once(':')
-            .and_then(|(h, p)| Some((h.trim_start_matches('[').trim_end_matches(']'), p.parse::<u16>().ok()?)))
-            .filter(|(h, _)| !h.is_empty())
-            .ok_or_else(|| format!("`{addr}` is not an address (HOST:PORT, say 127.0.0.1:8765)"))?;
-        // The port must be free: the error names it (the server's own error
-        // does not always).
-        if let Err(e) = std::net::TcpListener::bind((host, port)) {
-            return Err(if e.kind() == std::io::ErrorKind::AddrInUse {
-                format!("cannot listen on {addr}: the port {port} is in use")
-            } else {
-                format!("cannot listen on {addr}: {e}")
-            });
-        }
-        let context = foxglove::Context::new();
-        let subscribed = Arc::new((Mutex::new(false), std::sync::Condvar::new()));
-        let handle = foxglove::WebSocketServer::new()
-            .name(format!("situ {}", env!("CARGO_PKG_VERSION")))
-            .bind(host, port)
-            .context(&context)
-            .listener(Arc::new(Subscriptions(subscribed.clone())))
-            .start_blocking()
-            .map_err(|e| format!("cannot listen on {addr}: {e}"))?;
-        let addr = format!("{host}:{}", handle.port());
-        Ok(LiveServer { context, handle, addr, subscribed })
-    }
-
-    fn tap(&self) -> FoxgloveTap {
-        FoxgloveTap { context: self.context.clone(), channels: std::collections::HashMap::new() }
-    }
-
-    /// Waits for a client's first subscription (and a moment for its
-    /// others), so that the run is watched from its start.
-    fn wait_for_a_client(&self) {
-        eprintln!(
-            "foxglove: serving ws://{} (Foxglove: Open connection, Foxglove WebSocket); waiting for a client",
-            self.addr
-        );
-        let (lock, cvar) = &*self.subscribed;
-        let mut done = lock.lock().unwrap_or_else(|e| e.into_inner());
-        while !*done {
-            done = cvar.wait(done).unwrap_or_else(|e| e.into_inner());
-        }
-        drop(done);
-        std::thread::sleep(std::time::Duration::from_millis(500));
-        eprintln!("foxglove: a client subscribed; running in real time");
-    }
-
-    fn stop(self) {
-        // A moment for the last messages to leave.
-        std::thread::sleep(std::time::Duration::from_millis(500));
-        self.handle.stop().wait_blocking();
-        eprintln!("foxglove: the run is over; server stopped");
-    }
-}
-
-/// The recorder's [`Tap`] to the server: a raw JSON channel per channel.
-struct FoxgloveTap {
-    context: Arc<foxglove::Context>,
-    channels: std::collections::HashMap<u16, Arc<foxglove::RawChannel>>,
-}
-
-impl Tap for FoxgloveTap {
-    fn channel(&mut self, id: u16, topic: &str, schema_name: &str, schema: &str) {
-        let built = foxglove::ChannelBuilder::new(topic)
-            .message_encoding("json")
-            .schema(foxglove::Schema::new(schema_name, "jsonschema", schema.as_bytes().to_vec()))
-            .context(&self.context)
-            .build_raw();
-        match built {
-            Ok(c) => {
-                self.channels.insert(id, c);
-            }
-            Err(e) => eprintln!("foxglove: channel {topic}: {e}"),
-        }
-    }
-
-    fn message(&mut self, id: u16, time: u64, bytes: &[u8]) {
-        if let Some(c) = self.channels.get(&id) {
-            c.log_with_meta(bytes, foxglove::PartialMetadata { log_time: Some(time) });
-        }
-    }
 }

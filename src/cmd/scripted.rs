@@ -3,11 +3,15 @@
 //! stand-in that follows its table or FSM and reports what the script (or
 //! the guided generator) gives it. `S` is the name of a `script` block of
 //! FILE or its includes, or a `.situ` file of scripts read after FILE.
+//! With `--foxglove [ADDR]` or `--serve [ADDR]` the run waits for its
+//! watchers ([`super::watchers`]) and plays in real time.
 //!
 //! Exit 0 when the run played to its end (or to a final state) with every
 //! event taken; 1 when the Bulletinboard refused an event or a cascade did
 //! not settle, or the rules have errors; 2 on usage and I/O.
 
+use super::view::data::Site;
+use super::watchers::Watchers;
 use super::{FAILED, OK, USAGE};
 use situ_compiler::bundle::{self, Content, Encoding};
 use situ_compiler::loader::FsLoader;
@@ -26,6 +30,10 @@ pub struct Args {
     pub until: Option<f64>,
     pub out: Option<PathBuf>,
     pub record: Option<PathBuf>,
+    /// Serve the run live over Foxglove's WebSocket protocol at this address.
+    pub foxglove: Option<String>,
+    /// Serve the Supervisor's page of the run live at this address.
+    pub serve: Option<String>,
 }
 
 /// The rules and the scripts they can be run with.
@@ -37,6 +45,8 @@ struct Loaded {
     /// The bundle file's bytes, to attach to the recording as they are
     /// (signature included).
     bytes: Option<Vec<u8>>,
+    /// The checked source (none for a bundle), for the live page's graph.
+    checked: Option<situ_compiler::Checked>,
 }
 
 fn load(file: &Path, script_file: Option<&Path>) -> Result<Loaded, u8> {
@@ -46,7 +56,7 @@ fn load(file: &Path, script_file: Option<&Path>) -> Result<Loaded, u8> {
             return Err(USAGE);
         }
         let p = super::program::load(file, false)?;
-        return Ok(Loaded { content: p.content, scripts: Vec::new(), bundle: true, bytes: p.bytes });
+        return Ok(Loaded { content: p.content, scripts: Vec::new(), bundle: true, bytes: p.bytes, checked: None });
     }
     super::program::refuse_source_under_trust(file)?;
     let extra: Vec<&Path> = script_file.into_iter().collect();
@@ -64,7 +74,8 @@ fn load(file: &Path, script_file: Option<&Path>) -> Result<Loaded, u8> {
         return Err(FAILED);
     }
     let content = Arc::new(bundle::build(&checked));
-    Ok(Loaded { content, scripts: spec::scripts(&checked), bundle: false, bytes: None })
+    let scripts = spec::scripts(&checked);
+    Ok(Loaded { content, scripts, bundle: false, bytes: None, checked: Some(checked) })
 }
 
 /// The script named `name` (the first without one), or why not.
@@ -140,11 +151,11 @@ pub fn run(args: Args) -> u8 {
         let name = p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         p.with_file_name(format!(".{name}.situ-tmp.{}", std::process::id()))
     });
-    let sink: Option<Box<dyn Sink>> = match &partial {
+    let file = match &partial {
         Some(path) => {
             let bytes = loaded.bytes.clone().unwrap_or_else(|| bundle::encode(&content, Encoding::Json));
             match McapRecorder::create(path, content.clone(), &bytes) {
-                Ok(m) => Some(Box::new(m.flush_by_message_time())),
+                Ok(m) => Some(m.flush_by_message_time()),
                 Err(e) => {
                     eprintln!("error: cannot write `{}`: {e}", path.display());
                     return USAGE;
@@ -153,14 +164,28 @@ pub fn run(args: Args) -> u8 {
         }
         None => None,
     };
+    let watchers = match Watchers::start(args.foxglove.as_deref(), args.serve.as_deref(), || {
+        Site::live(args.file.display().to_string(), content.clone(), loaded.checked.as_ref())
+    }) {
+        Ok(w) => w,
+        Err(code) => return code,
+    };
+    let sink = watchers.recorder(file, &content).map(|m| Box::new(m) as Box<dyn Sink>);
     let mut run = ScriptRun::new(content.clone(), driver.clone(), until, sink);
     let mut live = super::LiveLine::new();
-    run.run(&mut |r| live.draw(|| r.progress().line()));
+    if watchers.any() {
+        watchers.wait();
+        in_real_time(&mut run, &mut live);
+    } else {
+        run.run(&mut |r| live.draw(|| r.progress().line()));
+    }
     live.clear();
     let tracked = run.tracked();
     let snapshots = run.snapshots().to_vec();
     let end = run.now();
-    let report = match run.finish() {
+    let finished = run.finish();
+    watchers.end();
+    let report = match finished {
         Ok(r) => r,
         Err(e) => {
             if let Some(p) = &partial {
@@ -203,6 +228,23 @@ pub fn run(args: Args) -> u8 {
         OK
     } else {
         FAILED
+    }
+}
+
+/// Plays the run a simulated second a wall second (its watchers follow it),
+/// in slices of [`SLICE`].
+fn in_real_time(run: &mut ScriptRun, line: &mut super::LiveLine) {
+    const SLICE: u64 = 5_000_000;
+    let start = std::time::Instant::now();
+    let mut t = 0u64;
+    while !run.finished() && t < run.end() {
+        t = t.saturating_add(SLICE).min(run.end());
+        run.run_until(t);
+        let ahead = std::time::Duration::from_nanos(t).saturating_sub(start.elapsed());
+        if !ahead.is_zero() {
+            std::thread::sleep(ahead);
+        }
+        line.draw(|| run.progress().line());
     }
 }
 

@@ -142,6 +142,11 @@ impl ScriptRun {
         self.end
     }
 
+    /// Whether a final state ended the run.
+    pub fn finished(&self) -> bool {
+        self.rt.finished()
+    }
+
     /// The state at rest now.
     pub fn state(&self) -> &str {
         &self.content.states[self.rt.state() as usize].name

@@ -33,7 +33,10 @@ function askedTime() {
 // The state, visited states, recorded modes and last firing at time t.
 function at(t) {
   const p = view.program, tl = view.timeline;
-  const out = { state: p.initial, visited: [p.initial], modes: {}, last: -1 };
+  // A live run's log may start after the run did: from its base.
+  const base = tl.base || {};
+  const out = { state: base.state || p.initial, visited: (base.visited || []).slice(), modes: Object.assign({}, base.modes || {}), last: -1 };
+  if (out.visited.indexOf(out.state) < 0) out.visited.unshift(out.state);
   if (!tl.recording) return out;
   tl.changes.forEach(function (c, i) {
     if (c.t <= t) {
@@ -109,7 +112,7 @@ function draw() {
   $("current-state").textContent = now.state;
   document.body.setAttribute("data-current-state", now.state);
   $("current-time").textContent = view.timeline.recording ? "at " + seconds(t) : "(initial)";
-  $("time-label").textContent = seconds(t) + " / " + seconds(view.timeline.end_ns || 0);
+  $("time-label").textContent = seconds(t) + " / " + seconds(view.timeline.end_ns || 0) + (view.timeline.live ? " (live)" : "");
   drawGraph(now);
   drawWiring(now);
   drawRules(now);
@@ -150,6 +153,77 @@ function buildStatic() {
   });
 }
 
+function addFiring(c) {
+  const li = el("li", { class: "firing", "data-t": String(c.t) });
+  const a = el("a", { href: "#t=" + (c.t / 1e9).toFixed(3) }, seconds(c.t) + ": " + c.from + " → " + c.to + " by " + c.rules.join(", "));
+  a.addEventListener("click", function (ev) { ev.preventDefault(); setTime(c.t); });
+  li.appendChild(a);
+  li.appendChild(el("pre", { class: "explain" }, c.explain));
+  $("firings").appendChild(li);
+}
+
+// The first 500 refusals are listed, the rest counted.
+function addRefused(r) {
+  view.refusedSeen = (view.refusedSeen || 0) + 1;
+  if (view.refusedSeen <= 500) {
+    $("refused").appendChild(el("li", { "data-t": String(r.t) }, seconds(r.t) + ": " + r.agent + " " + r.event + " refused: " + r.reason));
+  }
+  $("refused-more").textContent = view.refusedSeen > 500 ? (view.refusedSeen - 500) + " more" : "";
+}
+
+// A live run (`situ run … --serve`): asks /api/live for what came after the
+// entries it has, as soon as there is any; follows the run's latest time
+// unless the person scrubbed back.
+async function follow() {
+  const tl = view.timeline;
+  let since = 0;
+  $("live").hidden = false;
+  document.body.setAttribute("data-live", "running");
+  for (;;) {
+    let a;
+    try {
+      a = await get("/api/live?since=" + since);
+    } catch (e) {
+      $("live").textContent = "the run's server went away";
+      document.body.setAttribute("data-live", "gone");
+      return;
+    }
+    const atEnd = view.t >= tl.end_ns;
+    if (a.reset) {
+      tl.base = a.base;
+      tl.changes = []; tl.modes = []; tl.refused = [];
+      $("firings").textContent = ""; $("refused").textContent = "";
+      view.refusedSeen = a.base.refused;
+    }
+    const now = Date.now() * 1000;
+    a.entries.forEach(function (e) {
+      if (e.kind === "change") {
+        tl.changes.push(e);
+        addFiring(e);
+        // How late the page heard of the change (the server stamped it).
+        view.lagMs = Math.max(view.lagMs || 0, (now - e.wall_us) / 1000);
+      } else if (e.kind === "mode") {
+        tl.modes.push(e);
+      } else if (e.kind === "refused") {
+        tl.refused.push(e);
+        addRefused(e);
+      }
+    });
+    tl.end_ns = Math.max(tl.end_ns, a.end_ns);
+    $("scrub").max = String(Math.ceil(tl.end_ns / 1e6));
+    view.received = (view.received || 0) + a.entries.length;
+    document.body.setAttribute("data-received", String(view.received));
+    document.body.setAttribute("data-lag-ms", (view.lagMs || 0).toFixed(1));
+    if (atEnd) setTime(tl.end_ns); else draw();
+    since = a.next;
+    if (a.over) {
+      $("live").textContent = "the run is over: the page keeps what it was sent";
+      document.body.setAttribute("data-live", "over");
+      return;
+    }
+  }
+}
+
 function buildTimeline() {
   const tl = view.timeline;
   if (!tl.recording) return;
@@ -160,20 +234,8 @@ function buildTimeline() {
   const scrub = $("scrub");
   scrub.max = String(Math.ceil(tl.end_ns / 1e6));
   scrub.addEventListener("input", function () { setTime(Number(scrub.value) * 1e6, true); });
-  const list = $("firings");
-  tl.changes.forEach(function (c) {
-    const li = el("li", { class: "firing", "data-t": String(c.t) });
-    const a = el("a", { href: "#t=" + (c.t / 1e9).toFixed(3) }, seconds(c.t) + ": " + c.from + " → " + c.to + " by " + c.rules.join(", "));
-    a.addEventListener("click", function (ev) { ev.preventDefault(); setTime(c.t); });
-    li.appendChild(a);
-    li.appendChild(el("pre", { class: "explain" }, c.explain));
-    list.appendChild(li);
-  });
-  const refused = $("refused");
-  tl.refused.slice(0, 500).forEach(function (r) {
-    refused.appendChild(el("li", { "data-t": String(r.t) }, seconds(r.t) + ": " + r.agent + " " + r.event + " refused: " + r.reason));
-  });
-  if (tl.refused.length > 500) refused.appendChild(el("li", {}, (tl.refused.length - 500) + " more"));
+  tl.changes.forEach(addFiring);
+  tl.refused.forEach(addRefused);
   $("play").addEventListener("click", function () {
     if (view.timer) {
       clearInterval(view.timer);
@@ -214,6 +276,7 @@ async function main() {
   // ?play: plays from the time chosen (a link that shows a run as it went).
   if (view.timeline.recording && new URLSearchParams(location.search).has("play")) $("play").click();
   document.body.setAttribute("data-ready", "true");
+  if (view.timeline.live) follow();
 }
 
 main();

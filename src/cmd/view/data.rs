@@ -7,26 +7,112 @@ use situ_compiler::bundle::{self, Action, Behaviour, Content, Mode};
 use situ_compiler::checks::transitions::Transitions;
 use situ_compiler::loader::FsLoader;
 use situ_compiler::Checked;
-use situ_runtime::record::mcap::{attached_bundle, read_file, read_recording, topics};
+use situ_runtime::record::mcap::{attached_bundle, read_file, read_topics, topics};
 use std::fmt::Write as _;
 use std::path::Path;
 use std::sync::Arc;
 
-/// A state change of a recording.
-struct Change {
-    t: u64,
-    from: String,
-    to: String,
-    rules: Vec<String>,
-    explain: String,
+/// A state change of a run.
+pub struct Change {
+    pub t: u64,
+    pub from: String,
+    pub to: String,
+    pub rules: Vec<String>,
+    pub explain: String,
 }
 
 /// An agent's mode as recorded.
-struct ModeAt {
-    t: u64,
-    agent: String,
-    function: String,
-    mode: String,
+pub struct ModeAt {
+    pub t: u64,
+    pub agent: String,
+    pub function: String,
+    pub mode: String,
+}
+
+/// An event the Bulletinboard refused, and why.
+pub struct Refusal {
+    pub t: u64,
+    pub agent: String,
+    pub event: String,
+    pub reason: String,
+}
+
+/// What the page draws of one message of a run (a recording's, or a live
+/// run's as its recorder writes it).
+pub enum Entry {
+    Change(Change),
+    Mode(ModeAt),
+    Refused(Refusal),
+    /// A message of the run that moves only its clock: an accepted event,
+    /// a tick, a state message that did not change the state.
+    Time(u64),
+}
+
+impl Entry {
+    /// The entry of a message on `topic` at `time` (ns); `None` when the
+    /// topic is not one of a situ run's (a simulation's pose, say).
+    pub fn of(topic: &str, time: u64, msg: &Json) -> Option<Entry> {
+        let text = |k: &str| msg[k].as_str().unwrap_or("").to_string();
+        let t = msg["time_ns"].as_u64().unwrap_or(time);
+        Some(match topic {
+            topics::STATE if msg["from"] != msg["state"] => {
+                let rules = msg["rules"]
+                    .as_array()
+                    .map(|r| r.iter().filter_map(|x| x.as_str().map(String::from)).collect())
+                    .unwrap_or_default();
+                Entry::Change(Change { t, from: text("from"), to: text("state"), rules, explain: text("explain") })
+            }
+            topics::MODES => {
+                Entry::Mode(ModeAt { t, agent: text("agent"), function: text("function"), mode: text("mode") })
+            }
+            topics::EVENTS if msg["accepted"] == Json::Bool(false) => {
+                Entry::Refused(Refusal { t, agent: text("agent"), event: text("event"), reason: text("reason") })
+            }
+            topics::STATE | topics::EVENTS | topics::TICKS => Entry::Time(t),
+            _ => return None,
+        })
+    }
+
+    /// What in the entry is not of `content` (a state, an agent), if anything.
+    pub fn foreign(&self, content: &Content) -> Option<String> {
+        match self {
+            Entry::Change(c) => [&c.from, &c.to]
+                .into_iter()
+                .find(|s| content.state_id(s).is_none())
+                .map(|s| format!("its state `{s}` is not a state")),
+            Entry::Mode(m) => {
+                content.agent_id(&m.agent).is_none().then(|| format!("its agent `{}` is not an agent", m.agent))
+            }
+            Entry::Refused(_) | Entry::Time(_) => None,
+        }
+    }
+
+    pub fn time(&self) -> u64 {
+        match self {
+            Entry::Change(c) => c.t,
+            Entry::Mode(m) => m.t,
+            Entry::Refused(r) => r.t,
+            Entry::Time(t) => *t,
+        }
+    }
+}
+
+impl Change {
+    pub fn json(&self) -> Json {
+        json!({ "t": self.t, "from": self.from, "to": self.to, "rules": self.rules, "explain": self.explain })
+    }
+}
+
+impl ModeAt {
+    pub fn json(&self) -> Json {
+        json!({ "t": self.t, "agent": self.agent, "function": self.function, "mode": self.mode })
+    }
+}
+
+impl Refusal {
+    pub fn json(&self) -> Json {
+        json!({ "t": self.t, "agent": self.agent, "event": self.event, "reason": self.reason })
+    }
 }
 
 pub struct Site {
@@ -60,7 +146,10 @@ impl Site {
             eprintln!("error: `{name}`: {e}");
             USAGE
         })?;
-        let reading = read_recording(&bytes).map_err(|e| {
+        // The page draws the rules' topics only (not a simulation's pose,
+        // not the /events log that repeats /situ/events).
+        let wanted = |t: &str| [topics::STATE, topics::MODES, topics::EVENTS, topics::TICKS].contains(&t);
+        let reading = read_topics(&bytes, &wanted).map_err(|e| {
             eprintln!("error: `{name}` is not a readable recording: {e}");
             USAGE
         })?;
@@ -104,67 +193,24 @@ impl Site {
         let mut refused = Vec::new();
         let mut ours = 0usize;
         for (topic, time, msg) in &reading.messages {
-            let text = |k: &str| msg[k].as_str().unwrap_or("").to_string();
-            match topic.as_str() {
-                topics::STATE => {
-                    ours += 1;
-                    for s in [text("from"), text("state")] {
-                        if content.state_id(&s).is_none() {
-                            eprintln!(
-                                "error: `{name}` was recorded on other rules: its state `{s}` is not a state of `{}`",
-                                content.source
-                            );
-                            return Err(USAGE);
-                        }
-                    }
-                    if msg["from"] != msg["state"] {
-                        let rules = msg["rules"]
-                            .as_array()
-                            .map(|r| r.iter().filter_map(|x| x.as_str().map(String::from)).collect())
-                            .unwrap_or_default();
-                        let t = msg["time_ns"].as_u64().unwrap_or(*time);
-                        changes.push(Change {
-                            t,
-                            from: text("from"),
-                            to: text("state"),
-                            rules,
-                            explain: text("explain"),
-                        });
-                    }
-                }
-                topics::MODES => {
-                    ours += 1;
-                    let agent = text("agent");
-                    if content.agent_id(&agent).is_none() {
-                        eprintln!(
-                            "error: `{name}` was recorded on other rules: its agent `{agent}` is not an agent of `{}`",
-                            content.source
-                        );
-                        return Err(USAGE);
-                    }
-                    let t = msg["time_ns"].as_u64().unwrap_or(*time);
-                    modes.push(ModeAt { t, agent, function: text("function"), mode: text("mode") });
-                }
-                topics::EVENTS => {
-                    ours += 1;
-                    if msg["accepted"] == Json::Bool(false) {
-                        refused.push(json!({
-                            "t": msg["time_ns"].as_u64().unwrap_or(*time),
-                            "agent": text("agent"),
-                            "event": text("event"),
-                            "reason": text("reason"),
-                        }));
-                    }
-                }
-                topics::TICKS => ours += 1,
-                _ => {}
+            let Some(entry) = Entry::of(topic, *time, msg) else { continue };
+            ours += 1;
+            if let Some(why) = entry.foreign(&content) {
+                eprintln!("error: `{name}` was recorded on other rules: {why} of `{}`", content.source);
+                return Err(USAGE);
+            }
+            match entry {
+                Entry::Change(c) => changes.push(c),
+                Entry::Mode(m) => modes.push(m),
+                Entry::Refused(r) => refused.push(r.json()),
+                Entry::Time(_) => {}
             }
         }
         if ours == 0 {
             eprintln!("error: `{name}` holds no message of a situ run (/state, /situ/events, /situ/modes)");
             return Err(USAGE);
         }
-        let end = reading.messages.iter().map(|m| m.1).max().unwrap_or(0);
+        let end = reading.end;
         Ok(Site::new(name, "recording", content, checked.as_ref(), changes, modes, refused, Some((end, reading.cut))))
     }
 
@@ -187,17 +233,26 @@ impl Site {
                 "recording": true,
                 "end_ns": end,
                 "cut": cut,
-                "changes": changes.iter().map(|c| json!({
-                    "t": c.t, "from": c.from, "to": c.to, "rules": c.rules, "explain": c.explain,
-                })).collect::<Vec<_>>(),
-                "modes": modes.iter().map(|m| json!({
-                    "t": m.t, "agent": m.agent, "function": m.function, "mode": m.mode,
-                })).collect::<Vec<_>>(),
+                "changes": changes.iter().map(Change::json).collect::<Vec<_>>(),
+                "modes": modes.iter().map(ModeAt::json).collect::<Vec<_>>(),
                 "refused": refused,
             }),
         }
         .to_string();
         Site { name, kind, content, program, graph, timeline, changes, modes }
+    }
+
+    /// The page of a run as it goes (`situ run --serve`): the rules, and a
+    /// timeline the page fills from `/api/live`.
+    pub fn live(name: String, content: Arc<Content>, checked: Option<&Checked>) -> Site {
+        let found = checked.is_none().then(|| source_of(&content)).flatten();
+        let checked = checked.or(found.as_ref());
+        let mut site = Site::new(name, "live run", content, checked, Vec::new(), Vec::new(), Vec::new(), None);
+        site.timeline = json!({
+            "recording": true, "live": true, "end_ns": 0, "cut": null, "changes": [], "modes": [], "refused": [],
+        })
+        .to_string();
+        site
     }
 
     /// One line for the terminal: what is served.

@@ -17,69 +17,137 @@
 //! rules than `--rules`, is refused before the server starts (exit 2), as
 //! is a port in use.
 
-mod data;
+pub mod data;
+pub mod live;
 
 use super::USAGE;
+use live::Live;
 use std::io::Write as _;
 use std::net::TcpListener;
 use std::path::Path;
+use std::sync::Arc;
 
 const INDEX: &str = include_str!("index.html");
 const APP: &str = include_str!("app.js");
 const STYLE: &str = include_str!("style.css");
+
+/// Pages waiting on `/api/live` at once, at most (each waits in a thread
+/// of its own); one more is told to come back.
+const MAX_WAITING: usize = 64;
 
 pub fn run(file: &Path, rules: Option<&Path>, port: Option<u16>) -> u8 {
     let site = match data::Site::load(file, rules) {
         Ok(s) => s,
         Err(code) => return code,
     };
-    let listener = match TcpListener::bind(("127.0.0.1", port.unwrap_or(0))) {
-        Ok(l) => l,
-        Err(e) if e.kind() == std::io::ErrorKind::AddrInUse => {
-            eprintln!(
-                "error: port {} on 127.0.0.1 is in use: choose another with --port, or leave --port out for a free one",
-                port.unwrap_or(0)
-            );
-            return USAGE;
-        }
-        Err(e) => {
-            eprintln!("error: cannot listen on 127.0.0.1:{}: {e}", port.unwrap_or(0));
-            return USAGE;
-        }
-    };
-    let addr = match listener.local_addr() {
-        Ok(a) => a,
-        Err(e) => {
-            eprintln!("error: cannot tell the port listened on: {e}");
-            return USAGE;
-        }
-    };
-    let server = match tiny_http::Server::from_listener(listener, None) {
+    let server = match listen("127.0.0.1", port.unwrap_or(0), "--port") {
         Ok(s) => s,
-        Err(e) => {
-            eprintln!("error: cannot serve on {addr}: {e}");
-            return USAGE;
-        }
+        Err(code) => return code,
     };
     // Ctrl-C ends the server; nothing is half written, nothing to undo.
     let _ = ctrlc::set_handler(|| std::process::exit(0));
-    println!("serving http://{addr}/");
+    println!("serving http://{}/", server.1);
     let _ = std::io::stdout().flush();
     eprintln!("{}; Ctrl-C stops", site.summary());
-    for request in server.incoming_requests() {
-        let (status, kind, body) = answer(&site, request.url());
-        let header = tiny_http::Header::from_bytes(&b"Content-Type"[..], kind.as_bytes()).expect("a valid header");
-        let nocache = tiny_http::Header::from_bytes(&b"Cache-Control"[..], &b"no-store"[..]).expect("a valid header");
-        let response = tiny_http::Response::from_data(body.into_bytes())
-            .with_status_code(status)
-            .with_header(header)
-            .with_header(nocache);
-        // A browser that went away is not an error of the server.
-        let _ = request.respond(response);
-    }
+    serve(Arc::new(site), server.0, None);
     super::OK
 }
 
+/// Serves a run's page live (`situ run … --serve [ADDR]`) from a thread of
+/// its own: the page's URL, and the log the run's [`live::PageTap`] fills.
+/// `addr` is `PORT` or `HOST:PORT` (default host 127.0.0.1).
+pub fn serve_live(site: data::Site, addr: &str) -> Result<(String, Arc<Live>), u8> {
+    let (host, port) = match addr.rsplit_once(':') {
+        Some((h, p)) => (h.trim_start_matches('[').trim_end_matches(']'), p),
+        None => ("127.0.0.1", addr),
+    };
+    let Ok(port) = port.parse::<u16>() else {
+        eprintln!("error: --serve `{addr}` is not a port or an address (PORT or HOST:PORT, say 127.0.0.1:8080)");
+        return Err(USAGE);
+    };
+    let (server, bound) = listen(host, port, "--serve")?;
+    let live = Arc::new(Live::default());
+    let site = Arc::new(site);
+    let l = live.clone();
+    std::thread::Builder::new().name("situ-view".into()).spawn(move || serve(site, server, Some(l))).map_err(|e| {
+        eprintln!("error: cannot start the page's server: {e}");
+        USAGE
+    })?;
+    Ok((format!("http://{bound}/"), live))
+}
+
+/// A server listening on `host:port`; the error names the port and the
+/// option that chose it.
+fn listen(host: &str, port: u16, option: &str) -> Result<(tiny_http::Server, std::net::SocketAddr), u8> {
+    let listener = match TcpListener::bind((host, port)) {
+        Ok(l) => l,
+        Err(e) if e.kind() == std::io::ErrorKind::AddrInUse => {
+            eprintln!(
+                "error: port {port} on {host} is in use: choose another with {option}, or leave the port out for a free one"
+            );
+            return Err(USAGE);
+        }
+        Err(e) => {
+            eprintln!("error: cannot listen on {host}:{port}: {e}");
+            return Err(USAGE);
+        }
+    };
+    let addr = listener.local_addr().map_err(|e| {
+        eprintln!("error: cannot tell the port listened on: {e}");
+        USAGE
+    })?;
+    let server = tiny_http::Server::from_listener(listener, None).map_err(|e| {
+        eprintln!("error: cannot serve on {addr}: {e}");
+        USAGE
+    })?;
+    Ok((server, addr))
+}
+
+fn respond(request: tiny_http::Request, status: u16, kind: &str, body: String) {
+    let header = tiny_http::Header::from_bytes(&b"Content-Type"[..], kind.as_bytes()).expect("a valid header");
+    let nocache = tiny_http::Header::from_bytes(&b"Cache-Control"[..], &b"no-store"[..]).expect("a valid header");
+    let response = tiny_http::Response::from_data(body.into_bytes())
+        .with_status_code(status)
+        .with_header(header)
+        .with_header(nocache);
+    // A browser that went away is not an error of the server.
+    let _ = request.respond(response);
+}
+
+/// Answers requests until the process ends; a live page's polls wait in
+/// threads of their own.
+fn serve(site: Arc<data::Site>, server: tiny_http::Server, live: Option<Arc<Live>>) {
+    let waiting = Arc::new(std::sync::atomic::AtomicUsize::new(0));
+    for request in server.incoming_requests() {
+        let url = request.url().to_string();
+        let (path, query) = url.split_once('?').unwrap_or((&url, ""));
+        match (&live, path) {
+            (Some(live), "/api/live") => {
+                use std::sync::atomic::Ordering::SeqCst;
+                if waiting.fetch_add(1, SeqCst) >= MAX_WAITING {
+                    waiting.fetch_sub(1, SeqCst);
+                    respond(request, 503, "text/plain; charset=utf-8", "too many pages waiting".into());
+                    continue;
+                }
+                let since = query.split('&').find_map(|kv| kv.strip_prefix("since=")).and_then(|v| v.parse().ok());
+                let (live, count) = (live.clone(), waiting.clone());
+                let spawned = std::thread::Builder::new().name("situ-view-poll".into()).spawn(move || {
+                    let (body, over) = live.poll(since.unwrap_or(0));
+                    respond(request, 200, "application/json; charset=utf-8", body);
+                    live.delivered(over);
+                    count.fetch_sub(1, SeqCst);
+                });
+                if spawned.is_err() {
+                    waiting.fetch_sub(1, SeqCst);
+                }
+            }
+            _ => {
+                let (status, kind, body) = answer(&site, &url);
+                respond(request, status, kind, body);
+            }
+        }
+    }
+}
 /// The status, content type and body for a request's URL.
 fn answer(site: &data::Site, url: &str) -> (u16, &'static str, String) {
     let (path, query) = url.split_once('?').unwrap_or((url, ""));

@@ -47,6 +47,9 @@ pub struct Reading {
     /// Why the recording stops before its end, when it does (a run that
     /// was killed): everything before that point is in `messages`.
     pub cut: Option<String>,
+    /// The latest log time of any message (those left out by
+    /// [`read_topics`] too).
+    pub end: u64,
 }
 
 /// Where the checked records stop, and why when it is not the end.
@@ -200,12 +203,18 @@ fn scan(bytes: &[u8]) -> Result<Scan, String> {
 /// Reads every message of a recording, whole or cut short (see the module);
 /// an error says what is wrong with the file and where.
 pub fn read_recording(bytes: &[u8]) -> Result<Reading, String> {
+    read_topics(bytes, &|_| true)
+}
+
+/// [`read_recording`] keeping only the messages of the topics `keep`
+/// accepts (the others are checked as the file is, not decoded).
+pub fn read_topics(bytes: &[u8], keep: &dyn Fn(&str) -> bool) -> Result<Reading, String> {
     let scan = scan(bytes)?;
     // The scan checks the top-level records; inside a chunk whose CRC is 0
     // ("not checked", by the MCAP specification) a malformed record could
     // still reach a slicing bug of the `mcap` crate (one was found by the
     // fuzz target at the top level): a panic there is damage, not a crash.
-    std::panic::catch_unwind(|| decode(bytes, scan)).unwrap_or_else(|_| {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| decode(bytes, scan, keep))).unwrap_or_else(|_| {
         Err(format!(
             "damaged: a record inside a chunk is malformed (the MCAP reader failed on it); {} bytes",
             bytes.len()
@@ -214,7 +223,7 @@ pub fn read_recording(bytes: &[u8]) -> Result<Reading, String> {
 }
 
 /// The `mcap` crate's reader over the records [`scan`] checked.
-fn decode(bytes: &[u8], scan: Scan) -> Result<Reading, String> {
+fn decode(bytes: &[u8], scan: Scan, keep: &dyn Fn(&str) -> bool) -> Result<Reading, String> {
     let options = LinearReaderOptions::default()
         .with_skip_end_magic(true)
         .with_validate_chunk_crcs(true)
@@ -223,6 +232,10 @@ fn decode(bytes: &[u8], scan: Scan) -> Result<Reading, String> {
     let mut reader = MessageReader::new_with_options(options);
     let mut rest = &bytes[..scan.end];
     let mut messages = Vec::new();
+    let mut end = 0u64;
+    // The last channel asked about, and the answer (messages come in runs
+    // of one channel).
+    let mut kept: Option<(u16, bool)> = None;
     while let Some(event) = reader.next_event() {
         match event {
             Ok(MessageReadEvent::ReadRequest(need)) => {
@@ -233,8 +246,19 @@ fn decode(bytes: &[u8], scan: Scan) -> Result<Reading, String> {
                 rest = &rest[n..];
             }
             Ok(MessageReadEvent::Message(m)) => {
-                let json: Json = serde_json::from_slice(&m.data).unwrap_or(Json::Null);
-                messages.push((m.channel.topic.clone(), m.log_time, json));
+                end = end.max(m.log_time);
+                let wanted = match kept {
+                    Some((id, k)) if id == m.channel.id => k,
+                    _ => {
+                        let k = keep(&m.channel.topic);
+                        kept = Some((m.channel.id, k));
+                        k
+                    }
+                };
+                if wanted {
+                    let json: Json = serde_json::from_slice(&m.data).unwrap_or(Json::Null);
+                    messages.push((m.channel.topic.clone(), m.log_time, json));
+                }
             }
             Err(e) => {
                 let near = scan.end - rest.len();
@@ -246,7 +270,7 @@ fn decode(bytes: &[u8], scan: Scan) -> Result<Reading, String> {
             }
         }
     }
-    Ok(Reading { messages, size: bytes.len(), cut: scan.cut })
+    Ok(Reading { messages, size: bytes.len(), cut: scan.cut, end })
 }
 
 /// Reads every message of a recording, whole or cut short, in file order,
