@@ -4,9 +4,11 @@
 #
 #   bash bench/vs-clips.sh                    # 1,000,000 events, seed 1
 #   EVENTS=100000 SEED=7 bash bench/vs-clips.sh
+#   PROFILE=debug EVENTS=200000 bash bench/vs-clips.sh   # scripts/test.sh
 #
-# 1. builds `situ` and `situ-handwritten` in release and installs CLIPS
-#    from Debian's package `clips` if it is missing;
+# 1. builds `situ` and `situ-handwritten` in release (with PROFILE=debug,
+#    the test build's: the agreement is checked, the speeds mean nothing)
+#    and installs CLIPS from Debian's package `clips` if it is missing;
 # 2. `situ bench` generates the stream (written to a file) and runs on it;
 #    CLIPS and the hand-written matcher read that file;
 # 3. the three state sequences must be equal, else it stops with exit 1
@@ -19,13 +21,19 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 events="${EVENTS:-1000000}"
 seed="${SEED:-1}"
+profile="${PROFILE:-release}"
 rules="$root/rules/outdoor.situ"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 
-echo "== building situ and the hand-written matcher (release)" >&2
-(cd "$root" && cargo build --release --quiet -p situ -p situ-handwritten)
-target="${CARGO_TARGET_DIR:-$root/target}/release"
+echo "== building situ and the hand-written matcher ($profile)" >&2
+case "$profile" in
+release) (cd "$root" && cargo build --release --quiet -p situ -p situ-handwritten) ;;
+# The features of `cargo test --workspace --all-features`: its binary, not a rebuild.
+debug) (cd "$root" && cargo build --quiet --all-features -p situ -p situ-handwritten) ;;
+*) echo "error: PROFILE is release or debug, not $profile" >&2; exit 2 ;;
+esac
+target="${CARGO_TARGET_DIR:-$root/target}/$profile"
 bash "$root/bench/clips/install.sh" >&2
 
 echo "== $events events, seed $seed, over rules/outdoor.situ" >&2
@@ -61,3 +69,6 @@ print(f"handwritten: {hand:>13,.0f} events/s")
 print(f"situ/clips ratio: {situ / clips:.1f}")
 print(f"handwritten/situ ratio: {hand / situ:.2f}")
 PY
+if [[ $profile != release ]]; then
+    echo "(a $profile build: the speeds above are not figures; docs/performance.md has the release ones)"
+fi
