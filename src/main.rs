@@ -35,6 +35,9 @@ enum Command {
         /// (exit 0); each round ends with a line of the time and the summary.
         #[arg(long)]
         watch: bool,
+        /// Also check this ROS 2 map (TOML, docs/ros2.md) against the rules; one root file only.
+        #[arg(long, value_name = "MAP")]
+        ros2_map: Option<PathBuf>,
     },
     /// Format rule files in place; with --check, only report which would change.
     Fmt {
@@ -321,7 +324,9 @@ fn main() -> ExitCode {
     }
     let cli = Cli::parse();
     let code = match cli.command {
-        Command::Check { files, format, deny_warnings, watch } => cmd::check::run(&files, format, deny_warnings, watch),
+        Command::Check { files, format, deny_warnings, watch, ros2_map } => {
+            cmd::check::run(&files, format, deny_warnings, watch, ros2_map.as_deref())
+        }
         Command::Completions { shell } => cmd::manners::completions(shell, Cli::command()),
         Command::Man { output } => cmd::manners::man(Cli::command(), output.as_deref()),
         Command::Fmt { files, check } => cmd::fmt::run(&files, check),

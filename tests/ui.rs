@@ -168,7 +168,9 @@ fn every_code_has_inputs() {
     let mut announced = announced_in("tests/ui");
     announced.extend(announced_in("tests/checks"));
     let mut failures = Vec::new();
-    for code in situ_compiler::codes::ALL {
+    // The ROS 2 map's codes have their inputs in tests/ros2/ (tests/ros2_map.rs)
+    // and in situ-ros2's own tests.
+    for code in situ_compiler::codes::ALL.iter().filter(|c| !situ_compiler::codes::is_ros2_map(c.code)) {
         let raising: BTreeSet<&str> =
             announced.iter().filter(|(_, _, c)| c == code.code).map(|(f, _, _)| f.as_str()).collect();
         if raising.is_empty() {

@@ -90,6 +90,25 @@ codes! {
     SENSOR_WITHOUT_OUTPUT = "W0317", Warning, "running sensor whose outputs go nowhere";
     DATA_CYCLE = "W0318", Warning, "data cycle";
     MAY_CONFLICT = "W0319", Warning, "rules that may conflict";
+    ROS2_BAD_MAP = "E0401", Error, "ROS 2 map that is not a valid map";
+    ROS2_UNKNOWN_TYPE = "E0402", Error, "unknown ROS 2 message type";
+    ROS2_UNKNOWN_FIELD = "E0403", Error, "field not in the ROS 2 message";
+    ROS2_BAD_EXPRESSION = "E0404", Error, "malformed map expression";
+    ROS2_UNKNOWN_NAME = "E0405", Error, "map names an agent or event the rules do not have";
+    ROS2_FOREIGN_EVENT = "E0406", Error, "event mapped for an agent that does not report it";
+    ROS2_EXTRA_PAYLOAD = "E0407", Error, "map fills a payload field the event does not have";
+    ROS2_MISSING_PAYLOAD = "E0408", Error, "payload field the map does not fill";
+    ROS2_TYPE_MISMATCH = "E0409", Error, "type mismatch in a map expression";
+    ROS2_WHEN_NOT_BOOL = "E0410", Error, "`when` that is not a condition";
+    ROS2_UNMAPPED_EVENT = "W0411", Warning, "event of a mapped agent that no map entry produces";
+    ROS2_TWO_NODES = "E0412", Error, "agent played by two lifecycle nodes";
+    ROS2_TOPIC_TYPES = "E0413", Error, "topic read as two message types";
+}
+
+/// Whether the code is a ROS 2 map's (E04xx, W04xx: `situ check
+/// --ros2-map`, crate `situ-ros2`): a map raises it, never rules alone.
+pub fn is_ros2_map(code: &str) -> bool {
+    code.get(1..3) == Some("04")
 }
 
 /// Looks a code up, with or without its `situ::` prefix, in any case.

@@ -270,7 +270,10 @@ fn items(a: &Analysis, file: situ_grammar::diag::FileId, offset: usize) -> Vec<V
         Some(Frame::States) => it.keywords(&["initial", "final"]),
         Some(Frame::Payload) => it.keywords(&["f64", "i64", "bool"]),
         Some(Frame::Attribute) => {
-            for c in situ_compiler::codes::ALL.iter().filter(|c| c.code.starts_with('W')) {
+            // A map's warnings are not allowed in rules: only the rules' own.
+            let rules_warnings =
+                |c: &&situ_compiler::codes::Code| c.code.starts_with('W') && !situ_compiler::codes::is_ros2_map(c.code);
+            for c in situ_compiler::codes::ALL.iter().filter(rules_warnings) {
                 it.add(c.code, KEYWORD, Some(c.title));
             }
         }

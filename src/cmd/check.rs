@@ -1,9 +1,12 @@
-//! `situ check FILE… [--format human|json|sarif] [--deny-warnings] [--watch]`.
+//! `situ check FILE… [--format human|json|sarif] [--deny-warnings] [--watch]
+//! [--ros2-map MAP]`.
 
 use super::{FAILED, OK, USAGE};
 use situ_compiler::loader::{FsLoader, Loader};
 use situ_compiler::render;
-use std::path::PathBuf;
+use situ_compiler::source::SourceFile;
+use situ_compiler::RootError;
+use std::path::{Path, PathBuf};
 
 /// The output formats of `check`.
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -16,22 +19,60 @@ pub enum Format {
     Sarif,
 }
 
-pub fn run(files: &[PathBuf], format: Format, deny_warnings: bool, watch: bool) -> u8 {
+pub fn run(files: &[PathBuf], format: Format, deny_warnings: bool, watch: bool, ros2_map: Option<&Path>) -> u8 {
+    if ros2_map.is_some() && files.len() > 1 {
+        eprintln!("error: --ros2-map applies to one root file; {} were given", files.len());
+        return USAGE;
+    }
     if watch {
         let machine = !matches!(format, Format::Human);
-        return super::watch::run(|loader| check_all(files, format, deny_warnings, loader).1, machine);
+        return super::watch::run(|loader| check_all(files, format, deny_warnings, ros2_map, loader).1, machine);
     }
-    check_all(files, format, deny_warnings, &FsLoader).0
+    check_all(files, format, deny_warnings, ros2_map, &FsLoader).0
+}
+
+/// Checks the ROS 2 map `map` against the checked rules: the map becomes one
+/// more source of the check and its findings join the rules' ones, so every
+/// format renders them with the map's name, line and column. Not done when
+/// the rules have errors (their model is then partial). A map that cannot be
+/// read, or is not UTF-8, is an I/O error like an unreadable root.
+fn check_map(checked: &mut situ_compiler::Checked, map: &Path, loader: &dyn Loader) -> Result<(), RootError> {
+    let failure = |error| RootError { path: map.to_path_buf(), error };
+    let bytes = loader.read(map).map_err(failure)?;
+    let text = String::from_utf8(bytes)
+        .map_err(|_| failure(std::io::Error::new(std::io::ErrorKind::InvalidData, "the map is not UTF-8 text")))?;
+    if checked.errors() > 0 {
+        eprintln!("note: `{}` is not checked: the rules have errors", map.display());
+        return Ok(());
+    }
+    let file = checked.sources.add(SourceFile::new(map.display().to_string(), text));
+    let found = situ_ros2::check_map(&checked.model, &checked.sources.get(file).text, file);
+    checked.diagnostics.extend(found);
+    Ok(())
 }
 
 /// Checks every root and prints the report; the exit code and a one-line
 /// summary of the whole (for `--watch`).
-fn check_all(files: &[PathBuf], format: Format, deny_warnings: bool, loader: &dyn Loader) -> (u8, String) {
+fn check_all(
+    files: &[PathBuf],
+    format: Format,
+    deny_warnings: bool,
+    ros2_map: Option<&Path>,
+    loader: &dyn Loader,
+) -> (u8, String) {
     let mut checks = Vec::new();
     let mut failures = Vec::new();
     for path in files {
         match situ_compiler::check(path, loader) {
-            Ok(checked) => checks.push((path, checked)),
+            Ok(mut checked) => {
+                if let Some(map) = ros2_map {
+                    if let Err(err) = check_map(&mut checked, map, loader) {
+                        eprintln!("error: {err}");
+                        failures.push(err);
+                    }
+                }
+                checks.push((path, checked));
+            }
             Err(err) => {
                 eprintln!("error: {err}");
                 failures.push(err);

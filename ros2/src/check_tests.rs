@@ -1,0 +1,451 @@
+//! Each check: three maps that raise it and three near misses that do not.
+
+use super::*;
+use situ_compiler::check_source;
+
+const RULES: &str = r#"
+states { IDLE initial DRIVING BLOCKED CHARGING DONE final }
+agent Lidar sensor { event OBSTACLE { distance: f64 } event CLEAR }
+agent Base actuator { event MOVING { speed: f64 } event STOPPED }
+agent Battery sensor { event LOW { percent: f64, cells: i64 } }
+agent Diag interface { event FAULT { level: {warn, error}, present: bool } }
+agent Planner processing { event PLANNED }
+rule go { when state == IDLE and PLANNED then DRIVING }
+rule block { when state == DRIVING and OBSTACLE then BLOCKED }
+rule free { when state == BLOCKED and CLEAR then DRIVING }
+rule charge salience 5 { when state in {IDLE, DRIVING} and LOW then CHARGING }
+rule fault salience 10 { when state != DONE and FAULT then DONE }
+rule arrive salience 1 { when state == DRIVING and STOPPED then DONE }
+rule towed salience 1 { when state == CHARGING and MOVING then DONE }
+"#;
+
+fn codes_of(map: &str) -> Vec<&'static str> {
+    let checked = check_source("rules.situ", RULES);
+    assert_eq!(checked.errors(), 0, "{:?}", checked.diagnostics);
+    check_map(&checked.model, map, FileId(1)).into_iter().map(|d| d.code).collect()
+}
+
+fn raises(code: &str, maps: [&str; 3]) {
+    for map in maps {
+        let found = codes_of(map);
+        assert!(found.contains(&code), "expected {code} from:\n{map}\nfound {found:?}");
+    }
+}
+
+fn spares(code: &str, maps: [&str; 3]) {
+    for map in maps {
+        let found = codes_of(map);
+        assert!(!found.contains(&code), "unexpected {code} from:\n{map}\nfound {found:?}");
+    }
+}
+
+/// One `[[event]]` of `agent`, `event` from `topic` as `ty`, then `rest`.
+fn ev(agent: &str, event: &str, topic: &str, ty: &str, rest: &str) -> String {
+    format!("[[event]]\nagent = \"{agent}\"\nevent = \"{event}\"\ntopic = \"{topic}\"\ntype = \"{ty}\"\n{rest}\n")
+}
+
+fn scan(event: &str, rest: &str) -> String {
+    ev("Lidar", event, "/scan", "sensor_msgs/msg/LaserScan", rest)
+}
+
+fn odom(event: &str, rest: &str) -> String {
+    ev("Base", event, "/odom", "nav_msgs/msg/Odometry", rest)
+}
+
+const DIST: &str = "[event.payload]\ndistance = \"min(ranges)\"";
+
+/// The clean map of the tests: every event of every agent it maps.
+fn clean() -> String {
+    [
+        scan("OBSTACLE", &format!("when = \"min(ranges) < 0.5\"\n{DIST}")),
+        scan("CLEAR", "when = \"not (min(ranges) < 0.5)\""),
+        odom("MOVING", "when = \"twist.twist.linear.x > 0.05\"\n[event.payload]\nspeed = \"twist.twist.linear.x * 3.6\""),
+        odom("STOPPED", "when = \"twist.twist.linear.x <= 0.05\""),
+        ev(
+            "Battery",
+            "LOW",
+            "/battery",
+            "sensor_msgs/BatteryState",
+            "when = \"percentage < 0.2 and present\"\n[event.payload]\npercent = \"percentage * 100\"\ncells = \"len(cell_voltage)\"",
+        ),
+        ev(
+            "Diag",
+            "FAULT",
+            "/diagnostics",
+            "diagnostic_msgs/msg/DiagnosticArray",
+            "when = \"status[0].level >= 2 and status[0].name == 'base'\"\n[event.payload]\nlevel = \"'error'\"\npresent = \"true\"",
+        ),
+        "[[node]]\nagent = \"Planner\"\nnode = \"/planner\"\n".into(),
+    ]
+    .join("\n")
+}
+
+#[test]
+fn the_clean_map_has_no_findings() {
+    assert_eq!(codes_of(&clean()), Vec::<&str>::new());
+}
+
+#[test]
+fn bad_map() {
+    raises(
+        codes::ROS2_BAD_MAP,
+        ["[[event]\n", "[[event]]\nagent = \"Lidar\"\n", "[[node]]\nagent = \"Base\"\nnode = 1\n"],
+    );
+    spares(codes::ROS2_BAD_MAP, ["", "# nothing mapped yet\n", "[[node]]\nagent = \"Base\"\nnode = \"/base\"\n"]);
+}
+
+#[test]
+fn unknown_type() {
+    raises(
+        codes::ROS2_UNKNOWN_TYPE,
+        [
+            &ev("Lidar", "CLEAR", "/scan", "sensor_msgs/msg/LaserScn", ""),
+            &ev("Lidar", "CLEAR", "/scan", "LaserScan", ""),
+            &ev("Lidar", "CLEAR", "/scan", "sensor_msgs/srv/LaserScan", ""),
+        ],
+    );
+    spares(
+        codes::ROS2_UNKNOWN_TYPE,
+        [
+            &ev("Lidar", "CLEAR", "/scan", "sensor_msgs/LaserScan", ""),
+            &ev("Lidar", "CLEAR", "/scan", "sensor_msgs/msg/LaserScan", ""),
+            &ev("Lidar", "CLEAR", "/range", "sensor_msgs/Range", ""),
+        ],
+    );
+}
+
+#[test]
+fn unknown_field() {
+    raises(
+        codes::ROS2_UNKNOWN_FIELD,
+        [
+            &scan("CLEAR", "when = \"min(range) > 1\""),
+            &odom("STOPPED", "when = \"twist.linear.x == 0\""),
+            &odom("STOPPED", "when = \"pose.covariance[36] > 1\""),
+        ],
+    );
+    spares(
+        codes::ROS2_UNKNOWN_FIELD,
+        [
+            &scan("CLEAR", "when = \"min(ranges) > 1\""),
+            &odom("STOPPED", "when = \"twist.twist.linear.x == 0\""),
+            &odom("STOPPED", "when = \"pose.covariance[35] > 1\""),
+        ],
+    );
+}
+
+#[test]
+fn bad_expression() {
+    raises(
+        codes::ROS2_BAD_EXPRESSION,
+        [
+            &scan("CLEAR", "when = \"min(ranges) >\""),
+            &scan("CLEAR", "when = \"ranges[-1] > 2\""),
+            &scan("OBSTACLE", "[event.payload]\ndistance = \"median(ranges)\""),
+        ],
+    );
+    spares(
+        codes::ROS2_BAD_EXPRESSION,
+        [
+            &scan("CLEAR", "when = \"min(ranges) > 2\""),
+            &scan("CLEAR", "when = \"ranges[1] > 2\""),
+            &scan("OBSTACLE", "[event.payload]\ndistance = \"mean(ranges)\""),
+        ],
+    );
+}
+
+#[test]
+fn unknown_name() {
+    raises(
+        codes::ROS2_UNKNOWN_NAME,
+        [
+            &ev("Lidar", "CLEARED", "/scan", "sensor_msgs/LaserScan", ""),
+            &ev("Laser", "CLEAR", "/scan", "sensor_msgs/LaserScan", ""),
+            "[[node]]\nagent = \"Planer\"\nnode = \"/planner\"\n",
+        ],
+    );
+    spares(
+        codes::ROS2_UNKNOWN_NAME,
+        [
+            &ev("Lidar", "CLEAR", "/scan", "sensor_msgs/LaserScan", ""),
+            &ev("Base", "STOPPED", "/odom", "nav_msgs/Odometry", ""),
+            "[[node]]\nagent = \"Planner\"\nnode = \"/planner\"\n",
+        ],
+    );
+}
+
+#[test]
+fn foreign_event() {
+    raises(
+        codes::ROS2_FOREIGN_EVENT,
+        [
+            &ev("Lidar", "STOPPED", "/odom", "nav_msgs/Odometry", ""),
+            &ev("Base", "CLEAR", "/scan", "sensor_msgs/LaserScan", ""),
+            &ev("Planner", "FAULT", "/diagnostics", "diagnostic_msgs/DiagnosticArray", ""),
+        ],
+    );
+    spares(
+        codes::ROS2_FOREIGN_EVENT,
+        [
+            &ev("Base", "STOPPED", "/odom", "nav_msgs/Odometry", ""),
+            &ev("Lidar", "CLEAR", "/scan", "sensor_msgs/LaserScan", ""),
+            // An unknown agent is E0405, not this.
+            &ev("Nobody", "CLEAR", "/scan", "sensor_msgs/LaserScan", ""),
+        ],
+    );
+}
+
+#[test]
+fn extra_payload_field() {
+    raises(
+        codes::ROS2_EXTRA_PAYLOAD,
+        [
+            &scan("OBSTACLE", &format!("{DIST}\nheight = \"0.3\"")),
+            &scan("CLEAR", "[event.payload]\ndistance = \"1\""),
+            &scan("OBSTACLE", "[event.payload]\ndistanse = \"min(ranges)\""),
+        ],
+    );
+    spares(codes::ROS2_EXTRA_PAYLOAD, [&scan("OBSTACLE", DIST), &scan("CLEAR", ""), &scan("CLEAR", "[event.payload]")]);
+}
+
+#[test]
+fn missing_payload_field() {
+    raises(
+        codes::ROS2_MISSING_PAYLOAD,
+        [
+            &scan("OBSTACLE", ""),
+            &scan("OBSTACLE", "[event.payload]\ndistanse = \"min(ranges)\""),
+            &ev("Battery", "LOW", "/b", "sensor_msgs/BatteryState", "[event.payload]\npercent = \"percentage\""),
+        ],
+    );
+    spares(
+        codes::ROS2_MISSING_PAYLOAD,
+        [
+            &scan("OBSTACLE", DIST),
+            &scan("CLEAR", ""),
+            &ev(
+                "Battery",
+                "LOW",
+                "/b",
+                "sensor_msgs/BatteryState",
+                "[event.payload]\npercent = \"percentage\"\ncells = \"len(cell_voltage)\"",
+            ),
+        ],
+    );
+}
+
+#[test]
+fn type_mismatch() {
+    raises(
+        codes::ROS2_TYPE_MISMATCH,
+        [
+            &scan("OBSTACLE", "[event.payload]\ndistance = \"header.frame_id\""),
+            &scan("CLEAR", "when = \"min(range_max) > 1\""),
+            &scan("CLEAR", "when = \"header.frame_id == 2\""),
+        ],
+    );
+    spares(
+        codes::ROS2_TYPE_MISMATCH,
+        [
+            &scan("OBSTACLE", "[event.payload]\ndistance = \"range_max\""),
+            &scan("CLEAR", "when = \"min(ranges) > 1\""),
+            &scan("CLEAR", "when = \"header.frame_id == 'laser'\""),
+        ],
+    );
+}
+
+#[test]
+fn payload_types_fit_fields() {
+    let diag = |level: &str, present: &str| {
+        ev(
+            "Diag",
+            "FAULT",
+            "/d",
+            "diagnostic_msgs/DiagnosticArray",
+            &format!("[event.payload]\nlevel = \"{level}\"\npresent = \"{present}\""),
+        )
+    };
+    let battery = |cells: &str| {
+        ev(
+            "Battery",
+            "LOW",
+            "/b",
+            "sensor_msgs/BatteryState",
+            &format!("[event.payload]\npercent = \"1\"\ncells = \"{cells}\""),
+        )
+    };
+    raises(codes::ROS2_TYPE_MISMATCH, [&diag("'fatal'", "true"), &diag("'warn'", "1"), &battery("percentage")]);
+    spares(
+        codes::ROS2_TYPE_MISMATCH,
+        [&diag("'warn'", "true"), &diag("status[0].name", "len(status) > 0"), &battery("len(cell_voltage)")],
+    );
+}
+
+#[test]
+fn when_not_a_condition() {
+    raises(
+        codes::ROS2_WHEN_NOT_BOOL,
+        [
+            &scan("CLEAR", "when = \"min(ranges)\""),
+            &scan("CLEAR", "when = \"header.frame_id\""),
+            &scan("CLEAR", "when = \"ranges\""),
+        ],
+    );
+    spares(
+        codes::ROS2_WHEN_NOT_BOOL,
+        [
+            &scan("CLEAR", "when = \"min(ranges) > 1\""),
+            &scan("CLEAR", "when = \"header.frame_id != ''\""),
+            &ev("Battery", "LOW", "/b", "sensor_msgs/BatteryState", "when = \"present\""),
+        ],
+    );
+}
+
+#[test]
+fn unmapped_event() {
+    raises(
+        codes::ROS2_UNMAPPED_EVENT,
+        [&scan("OBSTACLE", DIST), &scan("CLEAR", ""), &odom("MOVING", "[event.payload]\nspeed = \"1\"")],
+    );
+    spares(
+        codes::ROS2_UNMAPPED_EVENT,
+        [
+            &format!("{}\n{}", scan("OBSTACLE", DIST), scan("CLEAR", "")),
+            // Agents the map does not mention are not reported.
+            "[[node]]\nagent = \"Base\"\nnode = \"/base\"\n",
+            &ev("Battery", "LOW", "/b", "sensor_msgs/BatteryState", ""),
+        ],
+    );
+}
+
+#[test]
+fn two_nodes_for_one_agent() {
+    let node = |agent: &str, node: &str| format!("[[node]]\nagent = \"{agent}\"\nnode = \"{node}\"\n");
+    raises(
+        codes::ROS2_TWO_NODES,
+        [
+            &(node("Planner", "/a") + &node("Planner", "/b")),
+            &(node("Planner", "/a") + &node("Planner", "/a")),
+            &(node("Base", "/a") + &node("Planner", "/b") + &node("Base", "/c")),
+        ],
+    );
+    spares(
+        codes::ROS2_TWO_NODES,
+        [
+            &node("Planner", "/a"),
+            &(node("Planner", "/a") + &node("Base", "/a")),
+            &(node("Planner", "/a") + &node("Base", "/b")),
+        ],
+    );
+}
+
+#[test]
+fn topic_with_two_types() {
+    raises(
+        codes::ROS2_TOPIC_TYPES,
+        [
+            &(scan("CLEAR", "") + &ev("Lidar", "OBSTACLE", "/scan", "sensor_msgs/Range", "")),
+            &(odom("MOVING", "") + &ev("Base", "STOPPED", "/odom", "geometry_msgs/TwistStamped", "")),
+            &(scan("CLEAR", "") + &ev("Lidar", "OBSTACLE", "/scan", "sensor_msgs/msg/Range", "")),
+        ],
+    );
+    spares(
+        codes::ROS2_TOPIC_TYPES,
+        [
+            &(scan("CLEAR", "") + &ev("Lidar", "OBSTACLE", "/scan", "sensor_msgs/LaserScan", "")),
+            &(odom("MOVING", "") + &odom("STOPPED", "")),
+            &(scan("CLEAR", "") + &ev("Lidar", "OBSTACLE", "/range", "sensor_msgs/Range", "")),
+        ],
+    );
+}
+
+#[test]
+fn every_finding_at_once_and_in_the_map() {
+    let map = format!(
+        "{}\n{}\n[[node]]\nagent = \"Ghost\"\nnode = \"/g\"\n",
+        scan("OBSTACLE", "when = \"min(rangez) < 1\""),
+        ev("Lidar", "CLEAR", "/scan", "sensor_msgs/Rang", "")
+    );
+    let checked = check_source("rules.situ", RULES);
+    let found = check_map(&checked.model, &map, FileId(1));
+    let codes: Vec<_> = found.iter().map(|d| d.code).collect();
+    for code in
+        [codes::ROS2_UNKNOWN_FIELD, codes::ROS2_MISSING_PAYLOAD, codes::ROS2_UNKNOWN_TYPE, codes::ROS2_UNKNOWN_NAME]
+    {
+        assert!(codes.contains(&code), "{code} not in {codes:?}");
+    }
+    let field = found.iter().find(|d| d.code == codes::ROS2_UNKNOWN_FIELD).unwrap();
+    assert_eq!(&map[field.primary.span.start..field.primary.span.end], "rangez");
+    assert_eq!(field.help.as_deref().map(|h| h.starts_with("did you mean `ranges`?")), Some(true));
+    for d in found.iter().filter(|d| d.primary.file == FileId(1)) {
+        assert!(d.primary.span.start <= d.primary.span.end && d.primary.span.end <= map.len(), "{d:?}");
+    }
+}
+
+/// The ```situ and ```toml blocks after a heading of a code's doc.
+fn blocks<'a>(doc: &'a str, heading: &str, lang: &str) -> Vec<&'a str> {
+    let start = doc.find(heading).expect("the heading");
+    let section = &doc[start + heading.len()..];
+    let section = &section[..section.find("\n## ").unwrap_or(section.len())];
+    section.split(&format!("```{lang}\n")).skip(1).filter_map(|b| b.split("```").next()).collect()
+}
+
+#[test]
+fn the_examples_of_the_codes_are_real() {
+    for c in codes::ALL.iter().filter(|c| c.code.starts_with("E04") || c.code.starts_with("W04")) {
+        for (heading, raised) in [("## Example", true), ("## Use instead", false)] {
+            let rules = blocks(c.explain, heading, "situ");
+            let maps = blocks(c.explain, heading, "toml");
+            assert!(!rules.is_empty() && !maps.is_empty(), "{}: {heading} needs rules and a map", c.code);
+            let checked = check_source("rules.situ", rules[0]);
+            assert_eq!(checked.errors(), 0, "{}: {heading}: the rules have errors", c.code);
+            let found: Vec<_> = check_map(&checked.model, maps[0], FileId(1)).into_iter().map(|d| d.code).collect();
+            assert_eq!(found.contains(&c.code), raised, "{}: {heading}: found {found:?}", c.code);
+        }
+    }
+}
+
+#[test]
+fn deep_and_long_inputs_are_refused_not_crashed() {
+    let checked = check_source("rules.situ", RULES);
+    let deep_array = format!("x = {}", "[".repeat(100_000));
+    let deep_table = format!("x = {}", "{a = ".repeat(100_000));
+    let long_chain = scan("CLEAR", &format!("when = \"{} > 1\"", vec!["range_max"; 255].join(" + ")));
+    for map in [deep_array, deep_table, long_chain] {
+        let _ = check_map(&checked.model, &map, FileId(1));
+    }
+}
+
+mod no_panic {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(512))]
+
+        /// Any cut, insertion or byte replacement of the clean map is checked
+        /// without a panic, and every place is inside the map.
+        #[test]
+        fn mutated_maps(at in 0usize..2000, len in 0usize..40, insert in "[\\PC\\[\\]().\"'=<>!+*/ -]{0,12}") {
+            let map = clean();
+            let mut at = at.min(map.len());
+            while !map.is_char_boundary(at) { at -= 1; }
+            let mut end = (at + len).min(map.len());
+            while !map.is_char_boundary(end) { end -= 1; }
+            let mutated = format!("{}{}{}", &map[..at], insert, &map[end..]);
+            let checked = check_source("rules.situ", RULES);
+            for d in check_map(&checked.model, &mutated, FileId(1)) {
+                prop_assert!(d.primary.span.start <= d.primary.span.end && d.primary.span.end <= mutated.len());
+            }
+        }
+
+        /// Any expression text parses or fails without a panic.
+        #[test]
+        fn any_expression(text in "[a-z0-9_\\[\\]().'<>=!+*/ -]{0,80}") {
+            let _ = crate::expr::parse(&text);
+            let map = scan("CLEAR", &format!("when = {text:?}"));
+            let checked = check_source("rules.situ", RULES);
+            let _ = check_map(&checked.model, &map, FileId(1));
+        }
+    }
+}
