@@ -10,7 +10,10 @@
 //!
 //! A live run (`situ run … --serve`) is followed twice: by a page in
 //! Chromium, and by a plain HTTP client that compares what it heard with
-//! the run's recording and says how late it heard each change.
+//! the run's recording and says how late it heard each change. Chromium is
+//! driven over the DevTools protocol (`tests/python/cdp_view.py`) where a
+//! person's hand or real time matters: the timeline scrubbed with the mouse,
+//! a live page left open in real time.
 
 mod common;
 use common::*;
@@ -310,17 +313,59 @@ fn a_live_run_is_heard_change_by_change() {
     }
 }
 
-#[test]
-fn a_live_run_follows_in_a_browser() {
+/// `tests/python/cdp_view.py MODE URL SCREENSHOT`: Chromium driven over the
+/// DevTools protocol; its JSON lines.
+fn cdp(mode: &str, url: &str, shot: &str) -> Vec<serde_json::Value> {
     require_chromium();
+    let path = screens().join(shot);
+    let o = Command::new("python3")
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/cdp_view.py"))
+        .args([mode, url])
+        .arg(&path)
+        .output()
+        .expect("python3 runs");
+    let all = text(&o);
+    assert!(
+        !all.contains("ModuleNotFoundError"),
+        "a Python package is missing: pip install -r examples/python/requirements.txt\n{all}"
+    );
+    assert!(o.status.success(), "cdp_view.py {mode} {url}:\n{all}");
+    eprintln!("screenshot: {}", path.display());
+    stdout(&o).lines().map(|l| serde_json::from_str(l).unwrap()).collect()
+}
+
+#[test]
+fn a_person_scrubs_a_recording_with_the_mouse() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("run.mcap");
+    let rec = rec.to_str().unwrap();
+    situ(&["run", "rules/outdoor.situ", "--record", rec, "--until", "25"]);
+    let served = Served::start(&[rec]);
+    let at = cdp("scrub", &served.url, "scrubbed.png");
+    assert_eq!(at.len(), 4, "{at:?}");
+    let (start, end, back) = (&at[0], &at[2], &at[3]);
+    assert_eq!(start["state"], "IT", "at the start the robot initialises: {start}");
+    assert_ne!(end["state"], start["state"], "at the end it is elsewhere: {end}");
+    assert_ne!(end["modes"], start["modes"], "the agents' modes move with the slider");
+    assert_eq!(back["state"], start["state"], "Home: the page shows the start again: {back}");
+    assert_eq!(back["modes"], start["modes"]);
+    assert_ne!(start["time"], end["time"], "the time label follows the slider");
+}
+
+#[test]
+fn a_live_page_draws_each_change_in_real_time() {
     let served = Served::command(&["run", "tests/view/greenhouse.situ", "--serve"]);
-    // The run starts when the page opens, plays three seconds in real
-    // time, and tells the page it is over.
-    let dom = dom(&served.url);
-    assert!(dom.contains("data-live=\"over\""), "the page heard the end of the run:\n{dom}");
-    assert_eq!(current(&dom), "GROWING");
-    assert_eq!(dom.matches("<li class=\"firing").count(), 6, "six firings, as they came");
-    assert!(dom.contains("by door_open") && dom.contains("rule `door_open`"), "a firing explained");
-    assert_eq!(mode(&dom, "Heater"), "sleeping", "GROWING's wiring");
-    assert!(dom.contains("(live)"), "the timeline says it is live");
+    let out = cdp("live", &served.url, "live.png");
+    let out = &out[0];
+    assert_eq!(out["state"], "GROWING", "{out}");
+    assert_eq!(out["firings"], 6, "six firings, as they came: {out}");
+    let firings = out["firing_text"].as_str().unwrap();
+    assert!(firings.contains("by door_open") && firings.contains("rule `door_open`"), "a firing explained: {out}");
+    assert_eq!(out["modes"]["Heater"], "sleeping", "GROWING's wiring: {out}");
+    assert!(out["time"].as_str().unwrap().ends_with("(live)"), "the timeline says it is live: {out}");
+    let lags: Vec<f64> = out["lags_ms"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    assert_eq!(lags.len(), 6, "a lag per change: {out}");
+    let mut sorted = lags.clone();
+    sorted.sort_by(f64::total_cmp);
+    eprintln!("the page drew each change {:.1}–{:.1} ms after the server stamped it", sorted[0], sorted[5]);
 }
