@@ -101,6 +101,8 @@ pub struct Agent {
     pub stale_after: Option<u64>,
     /// How often the runtime steps the agent.
     pub rate_hz: Option<f64>,
+    /// The agents it sends commands to (`commands X`), with where each is named.
+    pub commands: Vec<(AgentId, Origin)>,
     /// The events it reports.
     pub events: Vec<EventId>,
     /// The functions it offers; [`FunctionRef`] indexes this.

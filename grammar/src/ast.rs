@@ -150,6 +150,7 @@ pub struct Agent {
 pub enum AgentMember {
     Stale(StaleDecl),
     Rate(RateDecl),
+    Commands(CommandsDecl),
     Event(EventDecl),
     Function(FunctionDecl),
     Table(Table),
@@ -161,6 +162,7 @@ impl AgentMember {
         match self {
             AgentMember::Stale(m) => m.span,
             AgentMember::Rate(m) => m.span,
+            AgentMember::Commands(m) => m.span,
             AgentMember::Event(m) => m.span,
             AgentMember::Function(m) => m.span,
             AgentMember::Table(m) => m.span,
@@ -180,6 +182,13 @@ pub struct StaleDecl {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RateDecl {
     pub hertz: f64,
+    pub span: Span,
+}
+
+/// `commands Vehicle, Arm`: the agents this one sends commands to.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CommandsDecl {
+    pub targets: Vec<Ident>,
     pub span: Span,
 }
 

@@ -314,6 +314,10 @@ impl Layout<'_> {
                     self.push(inner, format!("stale after {}", duration(s.after.nanos)), anchor, Blank::Keep)
                 }
                 AgentMember::Rate(r) => self.push(inner, format!("rate {}Hz", r.hertz), anchor, Blank::Keep),
+                AgentMember::Commands(c) => {
+                    let names: Vec<&str> = c.targets.iter().map(|t| t.name.as_str()).collect();
+                    self.push(inner, format!("commands {}", names.join(", ")), anchor, Blank::Keep)
+                }
                 AgentMember::Event(e) => self.push(inner, event_decl(e), anchor, Blank::Keep),
                 AgentMember::Function(f) => {
                     let mut cells = vec![format!("function {}", f.name.name)];

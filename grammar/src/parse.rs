@@ -363,6 +363,11 @@ impl Builder<'_> {
                         _ => self.literal_error(fs, "this frequency"),
                     }
                 }
+                Rule::commands_decl => {
+                    let s = self.span(&p);
+                    let targets = p.into_inner().map(|t| self.ident(t)).collect();
+                    members.push(AgentMember::Commands(CommandsDecl { targets, span: s }));
+                }
                 Rule::event_decl => members.push(AgentMember::Event(self.event_decl(p))),
                 Rule::function_decl => {
                     let s = self.span(&p);

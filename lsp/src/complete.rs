@@ -278,7 +278,7 @@ fn items(a: &Analysis, file: situ_grammar::diag::FileId, offset: usize) -> Vec<V
             }
         }
         Some(Frame::Agent(_)) => {
-            it.keywords(&["event", "function", "table", "fsm", "rate", "stale"]);
+            it.keywords(&["event", "function", "table", "fsm", "rate", "stale", "commands"]);
             it.snippet("table …", "table {\n    ${1:STATE} => run ${2:work}()\n    _ => sleep\n}");
         }
         Some(Frame::Table(agent)) | Some(Frame::Fsm(agent)) => {

@@ -291,6 +291,7 @@ impl Walker<'_> {
         for m in &a.members {
             match m {
                 ast::AgentMember::Stale(_) | ast::AgentMember::Rate(_) => {}
+                ast::AgentMember::Commands(c) => c.targets.iter().for_each(|t| self.agent(t)),
                 ast::AgentMember::Event(e) => {
                     let event = e.name.name.clone();
                     self.push(e.name.span, Sym::Event(event.clone()), true);

@@ -1,4 +1,4 @@
-//! W0315–W0318: the wiring graph of every system state (§10.6). The graph
+//! W0315–W0318, W0320: the wiring graph of every system state (§10.6). The graph
 //! of a state is the union of the links of the agents running in it: for a
 //! running agent A, `from X` gives `X -> A` and `to Y` gives `A -> Y`. What
 //! an agent does in a state is [`behaviour::action_in`].
@@ -12,6 +12,7 @@
 //!
 //! [`behaviour::action_in`]: super::behaviour::action_in
 
+mod commands;
 mod cycles;
 mod ends;
 mod idle;
@@ -31,6 +32,7 @@ pub fn check(model: &Model, _tr: &Transitions) -> Vec<Diagnostic> {
     let mut out = idle::check(model, &wirings);
     out.extend(ends::check(model, &wirings));
     out.extend(cycles::check(model, &wirings));
+    out.extend(commands::check(model, &wirings));
     out
 }
 

@@ -11,6 +11,16 @@ pub(super) fn agent(cx: &mut Cx, file: FileId, agent: &ast::Agent) {
     if cx.model.agent(id).origin != Cx::origin(file, agent.name.span) {
         return; // a duplicate agent, already reported
     }
+    for member in &agent.members {
+        if let ast::AgentMember::Commands(c) = member {
+            for t in &c.targets {
+                if let Some(target) = cx.agent(file, t) {
+                    let origin = Cx::origin(file, t.span);
+                    cx.model.agents[id.index()].commands.push((target, origin));
+                }
+            }
+        }
+    }
     let mut first: Option<(Span, &str)> = None;
     for member in &agent.members {
         let (span, what) = match member {

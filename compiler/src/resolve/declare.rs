@@ -85,6 +85,7 @@ fn declare_agent(cx: &mut Cx, file: FileId, agent: &ast::Agent) {
         description: agent.description.as_ref().map(|d| d.value.clone()),
         stale_after: None,
         rate_hz: None,
+        commands: Vec::new(),
         events: Vec::new(),
         functions: Vec::new(),
         behaviour: Behaviour::Always,
@@ -114,7 +115,8 @@ fn declare_agent(cx: &mut Cx, file: FileId, agent: &ast::Agent) {
             }
             ast::AgentMember::Event(e) => event(cx, file, id, e),
             ast::AgentMember::Function(f) => function(cx, file, id, f),
-            ast::AgentMember::Table(_) | ast::AgentMember::Fsm(_) => {}
+            // Names other agents: resolved with the behaviour, once every agent is declared.
+            ast::AgentMember::Commands(_) | ast::AgentMember::Table(_) | ast::AgentMember::Fsm(_) => {}
         }
     }
 }
