@@ -1,18 +1,24 @@
-//! The ROS 2 map of situ (issue 17, first slice): the file that says which
-//! ROS 2 topic and message each event comes from, and its static check
-//! against the rules (`situ check FILE --ros2-map MAP`). No DDS here; the
-//! bridge process will reuse this crate.
+//! The ROS 2 map of situ (issue 17): the file that says which ROS 2 topic
+//! and message each event comes from, its static check against the rules
+//! (`situ check FILE --ros2-map MAP`), and the decoding of messages from
+//! their CDR bytes into the map's events. No DDS here; the bridge process
+//! will reuse this crate.
 //!
 //! - [`map`]: the map file (TOML), parsed with the place of every value.
 //! - [`msgs`]: the message catalogue, as data.
 //! - [`expr`]: the expressions of `when` and of payload fields.
 //! - [`types`]: the types of expressions against a message.
 //! - [`check`]: the checks, one function each; [`check_map`] runs them all.
+//! - [`cdr`]: decoding of the catalogue's messages from their CDR bytes.
+//! - [`eval`]: expressions on a decoded message; the [`Translator`] of messages to events.
 
+pub mod cdr;
 pub mod check;
+pub mod eval;
 pub mod expr;
 pub mod map;
 pub mod msgs;
 pub mod types;
 
 pub use check::check_map;
+pub use eval::Translator;
