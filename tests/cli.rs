@@ -9,7 +9,7 @@ const VALID: &str = "states { IT initial RD final }\nagent Ready sensor { event 
 
 #[test]
 fn the_papers_stacks_check_clean() {
-    for file in ["rules/outdoor.situ", "rules/ugv.situ"] {
+    for file in ["rules/outdoor.situ", "rules/ugv.situ", "rules/ugv-merge.situ"] {
         let o = situ(&["check", file]);
         assert_eq!(code(&o), 0, "{file}:\n{}{}", stdout(&o), stderr(&o));
         assert!(stdout(&o).contains("no findings"), "{}", stdout(&o));

@@ -82,9 +82,36 @@ fn the_ugv_compares_the_hard_switch_of_the_rules_with_the_merge() {
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(out.contains("scenario dafflon-4"), "{out}");
     assert!(out.contains("hard-switch (rules/ugv.situ, stack)") && out.contains("merge (sim loop)"), "{out}");
+    // The merge is a situ program too, run through the stack.
+    assert!(out.contains("merge (rules/ugv-merge.situ, stack)"), "{out}");
+    let merge = std::fs::read_to_string(dir.path().join("trajectory-merge-rules-ugv-merge-situ-stack.svg")).unwrap();
+    assert!(merge.starts_with("<svg") && merge.contains("<polyline"), "a drawn trajectory");
     let o = situ(&["run", "rules/ugv.situ", "--compare", "hard-switch,teleport"]);
     assert_eq!(code(&o), 2);
     assert!(text(&o).contains("teleport"), "{}", text(&o));
+}
+
+#[test]
+fn the_merge_program_runs_alone_and_compares_from_either_side() {
+    let o = situ(&["run", "rules/ugv-merge.situ"]);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    assert!(text(&o).contains("scenario          dafflon-4"), "{}", text(&o));
+    assert!(text(&o).contains("mission done: goal reached"), "{}", text(&o));
+    assert!(text(&o).contains("Docking"), "{}", text(&o));
+    // From the merge's side: the hard switch is ugv.situ beside it.
+    let o = situ(&["run", "rules/ugv-merge.situ", "--compare", "merge,hard-switch"]);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("merge (rules/ugv-merge.situ, stack)") && out.contains("hard-switch (rules/ugv.situ, stack)"));
+    // A copy of ugv.situ with no ugv-merge.situ beside it: a usage error that says so.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy("rules/ugv.situ", dir.path().join("ugv.situ")).unwrap();
+    let o = situ(&["run", s(&dir.path().join("ugv.situ")), "--compare", "hard-switch,merge"]);
+    assert_eq!(code(&o), 2, "{}", text(&o));
+    assert!(text(&o).contains("ugv-merge.situ"), "{}", text(&o));
+    // Only the hard switch asked: nothing else is read.
+    let o = situ(&["run", s(&dir.path().join("ugv.situ")), "--compare", "hard-switch"]);
+    assert_eq!(code(&o), 0, "{}", text(&o));
 }
 
 #[test]

@@ -28,7 +28,7 @@ property "the lamp glows when armed" { always (state == Armed -> Lamp running) }
 
 #[test]
 fn the_papers_stacks_pass_their_tests_and_properties() {
-    for file in ["rules/outdoor.situ", "rules/ugv.situ"] {
+    for file in ["rules/outdoor.situ", "rules/ugv.situ", "rules/ugv-merge.situ"] {
         let o = situ(&["test", file]);
         let out = stdout(&o);
         assert_eq!(code(&o), 0, "{file}:\n{out}");

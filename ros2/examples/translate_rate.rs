@@ -18,7 +18,7 @@ use std::time::Instant;
 fn laser_scan(ranges: usize, min: f32, stamp: u32) -> Vec<u8> {
     let mut b = vec![0x00, 0x01, 0x00, 0x00];
     let align = |b: &mut Vec<u8>, n: usize| {
-        while (b.len() - 4) % n != 0 {
+        while !(b.len() - 4).is_multiple_of(n) {
             b.push(0);
         }
     };
@@ -30,7 +30,8 @@ fn laser_scan(ranges: usize, min: f32, stamp: u32) -> Vec<u8> {
     b.extend(frame);
     align(&mut b, 4);
     // angle_min, angle_max, angle_increment, time_increment, scan_time, range_min, range_max
-    for v in [-3.14f32, 3.14, 0.0087, 0.0, 0.1, 0.05, 30.0] {
+    use std::f32::consts::PI;
+    for v in [-PI, PI, PI / 360.0, 0.0, 0.1, 0.05, 30.0] {
         b.extend(v.to_le_bytes());
     }
     b.extend((ranges as u32).to_le_bytes());

@@ -47,6 +47,7 @@ fn every_event_the_agents_report_is_one_of_the_rules_file() {
     }
     assert_eq!(StackKind::of(&c), Ok(StackKind::Outdoor));
     assert_eq!(StackKind::of(&rules("ugv.situ")), Ok(StackKind::Ugv));
+    assert_eq!(StackKind::of(&rules("ugv-merge.situ")), Ok(StackKind::UgvMerge));
 }
 
 #[test]
@@ -109,18 +110,28 @@ fn zhang_zhu_fig_5_fusion_sleeps_on_the_straight_road_and_wakes_at_the_obstacle(
     assert!(fusion_events.iter().all(|&t| t >= t_ro), "no Fusion event before the obstacle");
 }
 
+fn ugv_programs() -> stack::UgvPrograms {
+    stack::UgvPrograms { hard_switch: Some(rules("ugv.situ")), merge: Some(rules("ugv-merge.situ")) }
+}
+
+/// Both strategies through the stack (and the sim loop for reference), once.
+fn dafflon() -> &'static (situ_sim::ugv::Comparison, Vec<RunReport>) {
+    static RUN: OnceLock<(situ_sim::ugv::Comparison, Vec<RunReport>)> = OnceLock::new();
+    RUN.get_or_init(|| {
+        let world = scenario::dafflon_4().world;
+        stack::compare(&ugv_programs(), &world, &[Strategy::HardSwitch, Strategy::Merge], 1).expect("compared")
+    })
+}
+
 #[test]
 fn dafflon_the_merge_is_smoother_than_the_hard_switch_of_the_rules() {
-    let content = rules("ugv.situ");
-    let world = scenario::dafflon_4().world;
-    let (table, stack_run) =
-        stack::compare(content, &world, &[Strategy::HardSwitch, Strategy::Merge], 1).expect("compared");
+    let (table, reports) = dafflon();
     println!("{table}");
-    let report = stack_run.expect("the hard switch ran through the stack");
+    let report = &reports[0];
     assert!(matches!(report.outcome, Outcome::GoalReached { .. }), "{:?}", report.outcome);
     assert!(report.runtime.path.iter().any(|s| s == "AvoidCW") && report.runtime.path.iter().any(|s| s == "AvoidCCW"));
     let hard = &table.rows[0];
-    let merge = table.rows.iter().find(|r| r.strategy.starts_with("merge")).expect("merge row");
+    let merge = table.rows.iter().find(|r| r.strategy == "merge (sim loop)").expect("merge row");
     assert!(hard.strategy.contains("stack"));
     for r in [hard, merge] {
         assert_eq!(r.collisions, 0, "{}", r.strategy);
@@ -136,6 +147,64 @@ fn dafflon_the_merge_is_smoother_than_the_hard_switch_of_the_rules() {
         hard.max_steer_rate
     );
     assert!(merge.rms_steer_rate < hard.rms_steer_rate);
+}
+
+#[test]
+fn dafflon_the_merge_of_the_rules_is_smoother_and_faster_than_the_hard_switch_of_the_rules() {
+    let (table, reports) = dafflon();
+    println!("{table}");
+    let stack_row = |strategy: &str| {
+        let prefix = format!("{strategy} (");
+        table
+            .rows
+            .iter()
+            .find(|r| r.strategy.starts_with(&prefix) && r.strategy.ends_with(", stack)"))
+            .unwrap_or_else(|| panic!("{strategy} through the stack: {table}"))
+    };
+    let hard = stack_row("hard-switch");
+    let merge = stack_row("merge");
+    assert!(hard.strategy.contains("ugv.situ") && merge.strategy.contains("ugv-merge.situ"));
+    let report = &reports[1];
+    assert_eq!(report.stack, StackKind::UgvMerge);
+    assert!(matches!(report.outcome, Outcome::GoalReached { .. }), "{:?}", report.outcome);
+    // The Merger blended both limit cycles, then handed the last metres over.
+    for st in ["Reaching", "AvoidCW", "AvoidCCW", "Docking", "Reached"] {
+        assert!(report.runtime.path.iter().any(|s| s == st), "{st}: {:?}", report.runtime.path);
+    }
+    for r in [hard, merge] {
+        assert_eq!(r.collisions, 0, "{}", r.strategy);
+        assert!(r.closest_distance > 0.3, "{}: a safe closest distance, {:.2} m", r.strategy, r.closest_distance);
+        assert!(r.time_to_goal.is_some(), "{}: reaches the target", r.strategy);
+    }
+    // Smaller steering-rate peaks (the paper's Fig. 5: no discontinuity).
+    // While the Merger blends, by the sim loop's factor of 5; over the run,
+    // with the Docking state's target reaching alone, by half.
+    let samples = &report.metrics.samples;
+    let blending = samples
+        .windows(2)
+        .filter(|w| ["Reaching", "AvoidCW", "AvoidCCW"].contains(&w[1].label.as_str()))
+        .map(|w| ((w[1].steer_cmd - w[0].steer_cmd) / (w[1].t - w[0].t)).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        blending > 0.0 && blending * 5.0 < hard.max_steer_rate,
+        "peaks merging {blending} vs {}",
+        hard.max_steer_rate
+    );
+    assert!(
+        merge.max_steer_rate * 2.0 < hard.max_steer_rate,
+        "steering-rate peaks: {} vs {}",
+        merge.max_steer_rate,
+        hard.max_steer_rate
+    );
+    assert!(merge.rms_steer_rate < hard.rms_steer_rate, "{} vs {}", merge.rms_steer_rate, hard.rms_steer_rate);
+    // Speed, as in the sim loop's test: both reach vmax on the free stretch
+    // (the top speed is capped there); the merge keeps its speed among the
+    // obstacles, so its mean speed is higher and it arrives sooner.
+    assert!(merge.max_speed >= hard.max_speed - 0.05, "top speed {} vs {}", merge.max_speed, hard.max_speed);
+    assert!(merge.mean_speed > hard.mean_speed + 0.1, "mean speed {} vs {}", merge.mean_speed, hard.mean_speed);
+    assert!(merge.time_to_goal < hard.time_to_goal);
+    // A larger margin in time: the smallest time to collision is longer.
+    assert!(merge.min_ttc.unwrap_or(f64::INFINITY) > hard.min_ttc.unwrap_or(f64::INFINITY));
 }
 
 #[test]

@@ -1,8 +1,8 @@
 //! `situ run FILE|BUNDLE [--scenario S] [--record F.mcap] [--out DIR]
 //! [--seed N] [--until SECONDS] [--compare hard-switch,merge]
-//! [--foxglove [ADDR]] [--serve [ADDR]]`: runs the
-//! rules' reference stack (`rules/outdoor.situ` or `rules/ugv.situ`, told by
-//! the agents) in simulated time, in process, the compiled rules deciding
+//! [--foxglove [ADDR]] [--serve [ADDR]]`: runs the rules' reference stack
+//! (`rules/outdoor.situ`, `rules/ugv.situ` or `rules/ugv-merge.situ`, told
+//! by the agents) in simulated time, in process, the compiled rules deciding
 //! the state; shows what happened and how well. Exit 0 when the mission is
 //! done (the goal, no collision), 1 when it failed (a collision, a stop, the
 //! time ran out), 2 on usage, I/O, a bad scenario or a damaged bundle.
@@ -108,7 +108,7 @@ pub fn run(args: Args) -> u8 {
         }
     }
     if let Some(list) = &args.compare {
-        return compare(&args, content, &scenario, list);
+        return compare(&args, content, kind, &scenario, list);
     }
 
     // The recording: at --record, else in --out.
@@ -220,8 +220,28 @@ fn write_out(
     Ok(())
 }
 
-/// `--compare`: Dafflon et al.'s table.
-fn compare(args: &Args, content: Arc<Content>, scenario: &Scenario, list: &[String]) -> u8 {
+/// The other program of the comparison, beside the rules file: the merge
+/// (`ugv-merge.situ`) beside the hard switch (`ugv.situ`), or the other way
+/// round. Read from the file, not built in, so that the table compares the
+/// programs as they are on disk, edits included.
+fn sibling(file: &Path, name: &str, strategy: Strategy) -> Result<Arc<Content>, u8> {
+    let path = file.parent().unwrap_or(Path::new("")).join(name);
+    if !path.is_file() {
+        eprintln!(
+            "error: --compare: the {} strategy runs `{name}` through the stack, and there is no `{}` beside `{}`",
+            strategy.name(),
+            path.display(),
+            file.display()
+        );
+        return Err(USAGE);
+    }
+    super::program::load(&path, false).map(|p| p.content)
+}
+
+/// `--compare`: Dafflon et al.'s table, both strategies situ programs run
+/// through the stack (`ugv.situ` and `ugv-merge.situ`, side by side), each
+/// with the sim's own closed loop for reference.
+fn compare(args: &Args, content: Arc<Content>, kind: StackKind, scenario: &Scenario, list: &[String]) -> u8 {
     let mut strategies = Vec::new();
     for s in list {
         match Strategy::parse(s.trim()) {
@@ -235,7 +255,31 @@ fn compare(args: &Args, content: Arc<Content>, scenario: &Scenario, list: &[Stri
     if args.record.is_some() {
         eprintln!("warning: --record is not used with --compare");
     }
-    let (table, _) = match stack::compare(content, &scenario.world, &strategies, args.seed) {
+    let wants = |s: Strategy| strategies.contains(&s);
+    let mut programs = stack::UgvPrograms::default();
+    let other = match kind {
+        StackKind::Ugv => {
+            programs.hard_switch = Some(content);
+            wants(Strategy::Merge).then_some((&mut programs.merge, "ugv-merge.situ", Strategy::Merge))
+        }
+        StackKind::UgvMerge => {
+            programs.merge = Some(content);
+            wants(Strategy::HardSwitch).then_some((&mut programs.hard_switch, "ugv.situ", Strategy::HardSwitch))
+        }
+        StackKind::Outdoor => {
+            eprintln!(
+                "error: --compare needs the UGV's rules (rules/ugv.situ or rules/ugv-merge.situ): hard-switch and merge are its controllers"
+            );
+            return USAGE;
+        }
+    };
+    if let Some((slot, name, strategy)) = other {
+        match sibling(&args.file, name, strategy) {
+            Ok(c) => *slot = Some(c),
+            Err(code) => return code,
+        }
+    }
+    let (table, _) = match stack::compare(&programs, &scenario.world, &strategies, args.seed) {
         Ok(t) => t,
         Err(e) => {
             eprintln!("error: {e}");
@@ -244,11 +288,11 @@ fn compare(args: &Args, content: Arc<Content>, scenario: &Scenario, list: &[Stri
     };
     print!("{table}");
     println!(
-        "\nThe hard switch runs on the rules through the stack (the Selector's events, the rules \
-         avoid_ccw/avoid_cw/way_free, the tables' links) and, for reference, in the sim's own closed \
-         loop; the merge blends both controllers at once, which no table of the rules links to the \
-         Vehicle: it runs in the sim's closed loop (situ_sim::ugv::run). Steering rates are taken at \
-         20 Hz in both."
+        "\nBoth strategies are situ programs run through the stack: the hard switch (ugv.situ: the \
+         Selector's events, the rules avoid_ccw/avoid_cw/way_free, only the selected controller linked \
+         to the Vehicle) and the merge (ugv-merge.situ: both controllers command the Merger, which \
+         blends them (eqs. 16-19) and alone commands the Vehicle); the sim-loop rows are the sim's own \
+         closed loop (situ_sim::ugv::run), for reference. Steering rates are taken at 20 Hz in all."
     );
     if let Some(out) = &args.out {
         let json = serde_json::to_string_pretty(&table).expect("the table serializes");

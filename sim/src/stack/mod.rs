@@ -1,8 +1,9 @@
 //! The reference stacks on the **real** rules: every agent of
-//! `rules/outdoor.situ` (Zhang & Zhu) and of `rules/ugv.situ` (Dafflon et
-//! al.) as a runtime [`Agent`](situ_runtime::agent::Agent) wrapping the sim's
-//! parts, run by the runtime's simulated-time scheduler with the compiled
-//! rules deciding the state. This is what `situ run` drives.
+//! `rules/outdoor.situ` (Zhang & Zhu) and of `rules/ugv.situ` and
+//! `rules/ugv-merge.situ` (Dafflon et al.: hard switch, merge) as a runtime
+//! [`Agent`](situ_runtime::agent::Agent) wrapping the sim's parts, run by
+//! the runtime's simulated-time scheduler with the compiled rules deciding
+//! the state. This is what `situ run` drives.
 //!
 //! - [`Physics`]: the ground truth the agents share (world, vehicle, time,
 //!   the last command). Sensors read it; the actuator (Drive, Vehicle)
@@ -21,6 +22,9 @@
 //!   bytes.
 
 pub mod events;
+pub mod merge;
+
+pub use merge::{compare, UgvPrograms};
 pub mod outdoor;
 pub mod ugv;
 
@@ -72,8 +76,11 @@ pub fn lock(p: &SharedPhysics) -> MutexGuard<'_, Physics> {
 pub enum StackKind {
     /// Zhang & Zhu's outdoor vehicle (`rules/outdoor.situ`).
     Outdoor,
-    /// Dafflon et al.'s urban UGV (`rules/ugv.situ`).
+    /// Dafflon et al.'s urban UGV with the hard switch (`rules/ugv.situ`).
     Ugv,
+    /// Dafflon et al.'s urban UGV with the multi-agent merge
+    /// (`rules/ugv-merge.situ`): the agents of `rules/ugv.situ` and a Merger.
+    UgvMerge,
 }
 
 impl StackKind {
@@ -82,19 +89,21 @@ impl StackKind {
         match self {
             StackKind::Outdoor => outdoor::AGENTS,
             StackKind::Ugv => ugv::AGENTS,
+            StackKind::UgvMerge => merge::AGENTS,
         }
     }
 
     /// The stack whose agents the program declares.
     pub fn of(content: &Content) -> Result<StackKind, String> {
         let names: BTreeSet<&str> = content.agents.iter().map(|a| a.name.as_str()).collect();
-        for kind in [StackKind::Outdoor, StackKind::Ugv] {
+        // The merge's agents include the hard switch's: it is tried first.
+        for kind in [StackKind::Outdoor, StackKind::UgvMerge, StackKind::Ugv] {
             if kind.agents().iter().all(|a| names.contains(a)) {
                 return Ok(kind);
             }
         }
         Err(format!(
-            "no simulated stack for these agents ({}): `situ run` knows the agents of rules/outdoor.situ ({}) and of rules/ugv.situ ({})",
+            "no simulated stack for these agents ({}): `situ run` knows the agents of rules/outdoor.situ ({}), of rules/ugv.situ ({}) and of rules/ugv-merge.situ (those and Merger)",
             names.into_iter().collect::<Vec<_>>().join(", "),
             outdoor::AGENTS.join(", "),
             ugv::AGENTS.join(", ")
@@ -105,7 +114,7 @@ impl StackKind {
     pub fn default_scenario(self) -> &'static str {
         match self {
             StackKind::Outdoor => "outdoor-default",
-            StackKind::Ugv => "dafflon-4",
+            StackKind::Ugv | StackKind::UgvMerge => "dafflon-4",
         }
     }
 
@@ -113,7 +122,7 @@ impl StackKind {
     pub fn goal_state(self) -> &'static str {
         match self {
             StackKind::Outdoor => "GL",
-            StackKind::Ugv => "Reached",
+            StackKind::Ugv | StackKind::UgvMerge => "Reached",
         }
     }
 
@@ -124,7 +133,7 @@ impl StackKind {
             // with no function): its heartbeat TCHB comes at 10 Hz, the
             // rate the rules' `stale after 1s` ("10 heartbeats") assumes.
             StackKind::Outdoor => [("TeleControl".to_string(), 10.0)].into(),
-            StackKind::Ugv => BTreeMap::new(),
+            StackKind::Ugv | StackKind::UgvMerge => BTreeMap::new(),
         }
     }
 
@@ -136,7 +145,7 @@ impl StackKind {
     pub fn sample_every(self) -> u64 {
         match self {
             StackKind::Outdoor => 2,
-            StackKind::Ugv => 5,
+            StackKind::Ugv | StackKind::UgvMerge => 5,
         }
     }
 
@@ -144,7 +153,7 @@ impl StackKind {
     pub fn default_until(self) -> f64 {
         match self {
             StackKind::Outdoor => 600.0,
-            StackKind::Ugv => 120.0,
+            StackKind::Ugv | StackKind::UgvMerge => 120.0,
         }
     }
 }
@@ -510,6 +519,7 @@ impl StackRun {
         let agents = match kind {
             StackKind::Outdoor => outdoor::agents(&content, &physics, world, cfg.seed),
             StackKind::Ugv => ugv::agents(&content, &physics, world, cfg.seed),
+            StackKind::UgvMerge => ugv::build(&content, &physics, world, cfg.seed, true),
         };
         let bound = agent::bind(&content, agents, true).map_err(|e| e.to_string())?;
         let counts = Arc::new(Mutex::new(StreamCounts::default()));
@@ -760,46 +770,4 @@ impl StackRun {
         recording.map_err(|e| format!("recording: {e}"))?;
         Ok(report)
     }
-}
-
-/// Dafflon et al.'s comparison with the hard switch of the **rules**: for
-/// `hard-switch`, the run of `content` (`rules/ugv.situ`) through the stack,
-/// and, for reference, the sim's own closed loop; for `merge`, the sim's
-/// closed loop ([`crate::ugv::run`]): the merge blends both controllers at
-/// once, which no table of `rules/ugv.situ` links to the Vehicle.
-pub fn compare(
-    content: Arc<Content>,
-    world: &World,
-    strategies: &[crate::ugv::Strategy],
-    seed: u64,
-) -> Result<(crate::ugv::Comparison, Option<RunReport>), String> {
-    use crate::ugv::{self, ComparisonRow, Strategy, UgvConfig};
-    let kind = StackKind::of(&content)?;
-    if kind != StackKind::Ugv {
-        return Err(
-            "--compare needs the UGV's rules (rules/ugv.situ): hard-switch and merge are its controllers".into()
-        );
-    }
-    let cfg = UgvConfig::default();
-    let mut rows = Vec::new();
-    let mut runs = Vec::new();
-    let mut stack_report = None;
-    for &s in strategies {
-        if s == Strategy::HardSwitch {
-            let stack_cfg = StackConfig { seed, until: cfg.max_time, ..StackConfig::default() };
-            let mut run = StackRun::new(content.clone(), kind, world, stack_cfg, Recording::default())?;
-            run.run(&mut |_| {});
-            let report = run.finish()?;
-            rows.push(ComparisonRow::from_metrics(
-                &format!("hard-switch ({}, stack)", content.source),
-                &report.metrics,
-            ));
-            runs.push(report.metrics.clone());
-            stack_report = Some(report);
-        }
-        let m = ugv::run(world, s, seed, &cfg);
-        rows.push(ComparisonRow::from_metrics(&format!("{} (sim loop)", s.name()), &m));
-        runs.push(m);
-    }
-    Ok((ugv::Comparison { scenario: world.name.clone(), seed, rows, runs }, stack_report))
 }

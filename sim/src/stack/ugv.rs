@@ -12,12 +12,12 @@
 //! | Avoider | Lidar, Gps | the limit cycle of its function (eqs. 6–11); ORBIT{turns} | [`ControlInput`] |
 //! | Vehicle | Reacher or Avoider | the single control law (eqs. 12–15), or brakes | the command (to the vehicle) |
 //!
-//! The multi-agent merge ([`crate::ugv::Merge`]) is not a table of this
-//! file: it needs both controllers' outputs at once, which the hard
-//! switch's links never give. `situ run --compare` runs it in the sim's own
-//! closed loop ([`crate::ugv::run`]).
+//! The multi-agent merge ([`crate::ugv::Merge`]) is `rules/ugv-merge.situ`:
+//! the same agents, the controllers commanding a Merger that alone commands
+//! the Vehicle ([`super::merge`]).
 
 use super::events::{report, Named, Plain};
+use super::merge::AvoidCommand;
 use super::{lock, SharedPhysics};
 use crate::control::{control_law, limit_cycle, target_reaching, ControlInput, Direction, Ellipse, Gains, Target};
 use crate::geom::{wrap_angle, Pose};
@@ -50,12 +50,12 @@ pub struct GpsFix {
 #[derive(Debug, Clone, PartialEq)]
 pub struct LidarScan(pub Vec<LidarObstacle>);
 
-fn names(list: &[&str]) -> Vec<String> {
+pub(super) fn names(list: &[&str]) -> Vec<String> {
     list.iter().map(|s| s.to_string()).collect()
 }
 
 /// The latest datum of type `T` among `inputs`, if newer than `slot`'s.
-fn take<T: Clone + 'static>(inputs: &[Datum], slot: &mut Option<(u64, T)>) {
+pub(super) fn take<T: Clone + 'static>(inputs: &[Datum], slot: &mut Option<(u64, T)>) {
     for d in inputs {
         if let Some(v) = d.body.get::<T>() {
             if slot.as_ref().is_none_or(|(t, _)| d.time >= *t) {
@@ -65,7 +65,7 @@ fn take<T: Clone + 'static>(inputs: &[Datum], slot: &mut Option<(u64, T)>) {
     }
 }
 
-fn fresh<T>(slot: &Option<(u64, T)>, now: u64) -> Option<&T> {
+pub(super) fn fresh<T>(slot: &Option<(u64, T)>, now: u64) -> Option<&T> {
     slot.as_ref().filter(|(t, _)| now.saturating_sub(*t) <= FRESH).map(|(_, v)| v)
 }
 
@@ -213,6 +213,9 @@ impl Agent for Reacher {
 
 /// Avoider: the elliptic limit cycles.
 pub struct Avoider {
+    /// For the Merger (`rules/ugv-merge.situ`): sends an
+    /// [`AvoidCommand`], empty when nothing hinders now.
+    merge: bool,
     cfg: UgvConfig,
     params: VehicleParams,
     target: Pose,
@@ -255,14 +258,20 @@ impl Agent for Avoider {
         let pose = fix.pose;
         // The limit cycle follows the nearest hindering obstacle (the
         // direction is the function's: it never flips mid-avoidance).
-        if let Some(h) = select(&pose, &self.target, &seen.0, &self.params, &self.cfg).hinder {
+        let hinder = select(&pose, &self.target, &seen.0, &self.params, &self.cfg).hinder;
+        if let Some(h) = hinder {
             if self.cycle.is_none_or(|(i, _)| i != h.index) {
                 self.last_angle = None;
                 self.turns = 0.0;
             }
             self.cycle = Some((h.index, h.cycle));
         }
-        let Some((_, cycle)) = self.cycle else { return };
+        let Some((_, cycle)) = self.cycle else {
+            if self.merge {
+                cx.send(Body::local(AvoidCommand(None)));
+            }
+            return;
+        };
         let angle = (pose.y - cycle.center.y).atan2(pose.x - cycle.center.x);
         if let Some(a) = self.last_angle {
             self.turns += wrap_angle(angle - a).abs() / std::f64::consts::TAU;
@@ -270,7 +279,13 @@ impl Agent for Avoider {
         self.last_angle = Some(angle);
         report(cx, &self.content, &Named("ORBIT", vec![("turns", SimValue::F64(self.turns))]));
         let input = limit_cycle(&pose, &cycle, dir, self.params.max_speed / 2.0);
-        cx.send(Body::local(input));
+        if self.merge {
+            // The merge blends the limit cycle only while an obstacle
+            // hinders (else the target reaching command with itself).
+            cx.send(Body::local(AvoidCommand(hinder.map(|_| input))));
+        } else {
+            cx.send(Body::local(input));
+        }
     }
 }
 
@@ -304,13 +319,26 @@ impl Agent for VehicleAgent {
 /// Every agent of `rules/ugv.situ` on a world, with a seed. The target is
 /// the world's goal, with its heading.
 pub fn agents(content: &Arc<Content>, physics: &SharedPhysics, world: &World, seed: u64) -> Vec<Box<dyn Agent>> {
+    build(content, physics, world, seed, false)
+}
+
+/// The agents of `rules/ugv.situ`, or (`merge`) those of
+/// `rules/ugv-merge.situ`: the Avoider sends [`AvoidCommand`]s, the Merger
+/// blends, the Vehicle applies its command.
+pub(super) fn build(
+    content: &Arc<Content>,
+    physics: &SharedPhysics,
+    world: &World,
+    seed: u64,
+    merge: bool,
+) -> Vec<Box<dyn Agent>> {
     let cfg = UgvConfig::default();
     let params = world.vehicle;
     let goal = Pose::new(world.goal.position.x, world.goal.position.y, world.goal.heading.unwrap_or(0.0));
     let target = Target { pose: goal, v: cfg.target_speed, curvature: 0.0 };
     let c = || content.clone();
     let ph = || physics.clone();
-    vec![
+    let mut agents: Vec<Box<dyn Agent>> = vec![
         Box::new(Lidar { cfg, noise: Noise::new(seed, 1), physics: ph(), content: c() }),
         Box::new(Gps {
             noise: Noise::new(seed, 2),
@@ -325,6 +353,7 @@ pub fn agents(content: &Arc<Content>, physics: &SharedPhysics, world: &World, se
         Box::new(Selector { cfg, params, target: goal, seen: None, pose: None, content: c() }),
         Box::new(Reacher { target, pose: None, content: c() }),
         Box::new(Avoider {
+            merge,
             cfg,
             params,
             target: goal,
@@ -337,6 +366,14 @@ pub fn agents(content: &Arc<Content>, physics: &SharedPhysics, world: &World, se
             turns: 0.0,
             content: c(),
         }),
-        Box::new(VehicleAgent { gains: cfg.gains, params, input: None, physics: ph() }),
-    ]
+        if merge {
+            Box::new(super::merge::Merger::new(cfg, params, c()))
+        } else {
+            Box::new(VehicleAgent { gains: cfg.gains, params, input: None, physics: ph() })
+        },
+    ];
+    if merge {
+        agents.push(Box::new(super::merge::VehicleApply::new(ph())));
+    }
+    agents
 }
