@@ -126,30 +126,28 @@ impl Live {
 
     /// Waits until a page asked for the run (or `until` passes).
     pub fn wait_for_a_page(&self, until: Option<Instant>) -> bool {
-        let mut log = self.lock();
-        while log.answered == 0 && log.waiting == 0 {
-            let left = match until {
-                Some(u) => match u.checked_duration_since(Instant::now()) {
-                    Some(d) if !d.is_zero() => d,
-                    _ => return false,
-                },
-                None => POLL,
-            };
-            log = self.moved.wait_timeout(log, left).unwrap_or_else(|p| p.into_inner()).0;
+        let no_page = |l: &mut Log| l.answered == 0 && l.waiting == 0;
+        match until {
+            None => {
+                drop(self.moved.wait_while(self.lock(), no_page).unwrap_or_else(|p| p.into_inner()));
+                true
+            }
+            Some(u) => {
+                let left = u.saturating_duration_since(Instant::now());
+                let (log, r) =
+                    self.moved.wait_timeout_while(self.lock(), left, no_page).unwrap_or_else(|p| p.into_inner());
+                drop(log);
+                !r.timed_out()
+            }
         }
-        true
     }
 
     /// After [`finish`](Self::finish): waits (at most `at_most`) until no
     /// page is left waiting and, if a page ever asked, one heard the end
     /// (a page whose next poll is on its way when the run ends).
     pub fn wait_for_the_pages(&self, at_most: Duration) {
-        let until = Instant::now() + at_most;
-        let mut log = self.lock();
-        while log.waiting > 0 || (log.answered > 0 && log.told_over == 0) {
-            let Some(left) = until.checked_duration_since(Instant::now()).filter(|d| !d.is_zero()) else { return };
-            log = self.moved.wait_timeout(log, left).unwrap_or_else(|p| p.into_inner()).0;
-        }
+        let unheard = |l: &mut Log| l.waiting > 0 || (l.answered > 0 && l.told_over == 0);
+        drop(self.moved.wait_timeout_while(self.lock(), at_most, unheard).unwrap_or_else(|p| p.into_inner()));
     }
 
     /// The answer to `/api/live?since=N`: the entries from `since` on, once
@@ -161,11 +159,8 @@ impl Live {
         let mut log = self.lock();
         log.waiting += 1;
         self.moved.notify_all();
-        let until = Instant::now() + POLL;
-        while since >= log.first + log.entries.len() as u64 && !log.over {
-            let Some(left) = until.checked_duration_since(Instant::now()).filter(|d| !d.is_zero()) else { break };
-            log = self.moved.wait_timeout(log, left).unwrap_or_else(|p| p.into_inner()).0;
-        }
+        let nothing_new = |l: &mut Log| since >= l.first + l.entries.len() as u64 && !l.over;
+        let (log, _) = self.moved.wait_timeout_while(log, POLL, nothing_new).unwrap_or_else(|p| p.into_inner());
         log.answer(since)
     }
 
