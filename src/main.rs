@@ -183,6 +183,23 @@ enum Command {
         #[arg(long, value_name = "PUBKEY")]
         trust: Vec<PathBuf>,
     },
+    /// The ROS 2 bridge: topics to events, the situation to topics, lifecycle nodes driven by the tables (docs/ros2.md; `--features ros2`).
+    Ros2 {
+        /// The rules (a `.situ` source).
+        file: PathBuf,
+        /// The ROS 2 map (TOML): which topic each event comes from, which agents are lifecycle nodes.
+        #[arg(long)]
+        map: PathBuf,
+        /// The DDS domain (default: ROS_DOMAIN_ID, else 0).
+        #[arg(long)]
+        domain: Option<u16>,
+        /// The RMW of the robot's nodes: how their lifecycle services are carried.
+        #[arg(long, value_enum, default_value_t = cmd::ros2::Rmw::Fastrtps)]
+        rmw: cmd::ros2::Rmw,
+        /// Stop after this many seconds (default: until Ctrl-C or SIGTERM).
+        #[arg(long)]
+        duration: Option<f64>,
+    },
     /// Start every local process of a deployment (Zenoh) and stop them cleanly on Ctrl-C.
     Up {
         /// The deployment file.
@@ -436,6 +453,9 @@ fn main() -> ExitCode {
         },
         Command::Graph { file, view, state, format, output } => {
             cmd::graph::run(&file, view, state.as_deref(), format, output.as_ref())
+        }
+        Command::Ros2 { file, map, domain, rmw, duration } => {
+            cmd::ros2::run(cmd::ros2::Args { file, map, domain, rmw, duration })
         }
         Command::View { file, rules, port } => cmd::view::run(&file, rules.as_deref(), port),
     };

@@ -104,6 +104,7 @@ codes! {
     ROS2_UNMAPPED_EVENT = "W0411", Warning, "event of a mapped agent that no map entry produces";
     ROS2_TWO_NODES = "E0412", Error, "agent played by two lifecycle nodes";
     ROS2_TOPIC_TYPES = "E0413", Error, "topic read as two message types";
+    ROS2_BAD_NODE = "E0414", Error, "lifecycle node entry the bridge cannot use";
 }
 
 /// Whether the code is a ROS 2 map's (E04xx, W04xx: `situ check

@@ -20,7 +20,7 @@ pub fn check_map(model: &Model, text: &str, file: FileId) -> Vec<Diagnostic> {
         Ok(map) => map,
         Err(d) => return vec![*d],
     };
-    let checks: [Check; 12] = [
+    let checks: [Check; 13] = [
         unknown_types,
         unknown_names,
         foreign_events,
@@ -33,6 +33,7 @@ pub fn check_map(model: &Model, text: &str, file: FileId) -> Vec<Diagnostic> {
         unmapped_events,
         two_nodes,
         topic_types,
+        bad_nodes,
     ];
     let mut out: Vec<Diagnostic> = checks.iter().flat_map(|c| c(model, &map, file)).collect();
     out.sort_by_key(|d| (d.primary.span.start, d.code));
@@ -102,16 +103,17 @@ pub fn unknown_names(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> 
     for n in &map.nodes {
         unknown_agent(&n.agent);
     }
-    for e in &map.events {
-        if event(model, &e.event.value).is_none() {
+    let named = map.events.iter().map(|e| &e.event).chain(map.nodes.iter().filter_map(|n| n.failed.as_ref()));
+    for e in named {
+        if event(model, &e.value).is_none() {
             let mut d = Diagnostic::error(
                 codes::ROS2_UNKNOWN_NAME,
-                format!("the rules have no event `{}`", e.event.value),
+                format!("the rules have no event `{}`", e.value),
                 file,
-                e.event.span,
+                e.span,
                 "unknown event",
             );
-            if let Some(h) = did_you_mean(&e.event.value, model.events.iter().map(|e| e.name.as_str())) {
+            if let Some(h) = did_you_mean(&e.value, model.events.iter().map(|e| e.name.as_str())) {
                 d = d.with_help(h);
             }
             out.push(d);
@@ -332,7 +334,8 @@ pub fn unmapped_events(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic
         let agent = &model.agents[a];
         for id in &agent.events {
             let ev = &model.events[id.index()];
-            if map.events.iter().any(|e| e.event.value == ev.name) {
+            let failure = map.nodes.iter().any(|n| n.failed.as_ref().is_some_and(|f| f.value == ev.name));
+            if failure || map.events.iter().any(|e| e.event.value == ev.name) {
                 continue;
             }
             out.push(
@@ -390,6 +393,73 @@ pub fn topic_types(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
                 .with_label(file, first.ty.span, "first type")
                 .with_help("a topic carries one message type: fix the type or the topic"),
             );
+        }
+    }
+    out
+}
+
+/// Whether `name` is a fully qualified ROS 2 node name: `/` then tokens
+/// of letters, digits and `_` (not starting with a digit), separated by `/`.
+pub fn is_node_name(name: &str) -> bool {
+    let Some(rest) = name.strip_prefix('/') else { return false };
+    !rest.is_empty()
+        && rest.len() <= 255
+        && rest.split('/').all(|t| {
+            !t.is_empty()
+                && !t.starts_with(|c: char| c.is_ascii_digit())
+                && !t.contains("__")
+                && t.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+        })
+}
+
+/// E0414: a `[[node]]` the bridge could not drive: a name that is not a
+/// ROS 2 node name, a failure event that is another agent's or carries a
+/// payload, a timeout that is not a duration.
+pub fn bad_nodes(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
+    let mut out = Vec::new();
+    let bad = |s: &map::Str, message: String, label: &str, help: &str| {
+        Diagnostic::error(codes::ROS2_BAD_NODE, message, file, s.span, label).with_help(help)
+    };
+    for n in &map.nodes {
+        if !is_node_name(&n.node.value) {
+            out.push(bad(
+                &n.node,
+                format!("`{}` is not a fully qualified ROS 2 node name", n.node.value),
+                "not a node name",
+                "write `/name` or `/namespace/name`: letters, digits and `_`, not starting with a digit",
+            ));
+        }
+        if let (Some(f), Some(ev)) = (&n.failed, n.failed.as_ref().and_then(|f| event(model, &f.value))) {
+            let owner = &model.agents[ev.agent.index()].name;
+            if owner != &n.agent.value && agent(model, &n.agent.value).is_some() {
+                out.push(
+                    bad(
+                        f,
+                        format!("`{}` is reported by `{owner}`, not by `{}`", f.value, n.agent.value),
+                        "another agent's event",
+                        "the failure of a node is an event of the agent it plays",
+                    )
+                    .with_label(ev.origin.file, ev.origin.span, format!("declared by `{owner}`")),
+                );
+            } else if !ev.fields.is_empty() {
+                out.push(
+                    bad(
+                        f,
+                        format!("`{}` has a payload; the bridge posts a node's failure with none", f.value),
+                        "an event with a payload",
+                        "declare an event without fields for the failure, e.g. `event PLANNER_FAILED`",
+                    )
+                    .with_label(ev.origin.file, ev.origin.span, "declared here"),
+                );
+            }
+        }
+        if let (Some(t), Err(reason)) = (&n.timeout, n.timeout()) {
+            out.push(bad(
+                t,
+                reason,
+                "not a timeout",
+                "write a whole number of `ms` or `s`, e.g. `timeout = \"500ms\"`",
+            ));
         }
     }
     out

@@ -359,6 +359,41 @@ fn topic_with_two_types() {
     );
 }
 
+fn node(agent: &str, name: &str, rest: &str) -> String {
+    format!("[[node]]\nagent = \"{agent}\"\nnode = \"{name}\"\n{rest}\n")
+}
+
+#[test]
+fn bad_nodes() {
+    raises(
+        codes::ROS2_BAD_NODE,
+        [
+            &node("Planner", "planner", ""),
+            &node("Planner", "/planner", "failed = \"CLEAR\""),
+            &node("Battery", "/battery", "failed = \"LOW\"\ntimeout = \"2\""),
+        ],
+    );
+    spares(
+        codes::ROS2_BAD_NODE,
+        [
+            &node("Planner", "/nav/planner_1", "failed = \"PLANNED\""),
+            &node("Planner", "/planner", "timeout = \"250ms\""),
+            &node("Base", "/base", "failed = \"STOPPED\"\ntimeout = \"3s\""),
+        ],
+    );
+    for (name, ok) in [("/a", true), ("/a/b_c", true), ("/", false), ("/a//b", false), ("/1a", false), ("/a-b", false)]
+    {
+        assert_eq!(is_node_name(name), ok, "{name}");
+    }
+}
+
+#[test]
+fn a_failure_event_is_produced_by_the_map() {
+    let map = node("Planner", "/planner", "failed = \"PLANNED\"");
+    assert!(!codes_of(&map).contains(&codes::ROS2_UNMAPPED_EVENT));
+    assert!(codes_of(&node("Planner", "/planner", "failed = \"PLANED\"")).contains(&codes::ROS2_UNKNOWN_NAME));
+}
+
 #[test]
 fn every_finding_at_once_and_in_the_map() {
     let map = format!(

@@ -11,11 +11,13 @@
 //! - [`check`]: the checks, one function each; [`check_map`] runs them all.
 //! - [`cdr`]: decoding of the catalogue's messages from their CDR bytes.
 //! - [`eval`]: expressions on a decoded message; the [`Translator`] of messages to events.
+//! - [`lifecycle`]: the next `change_state` request the tables ask of the lifecycle nodes.
 
 pub mod cdr;
 pub mod check;
 pub mod eval;
 pub mod expr;
+pub mod lifecycle;
 pub mod map;
 pub mod msgs;
 pub mod types;

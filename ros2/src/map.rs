@@ -7,6 +7,7 @@ use situ_compiler::codes;
 use situ_grammar::ast::Span;
 use situ_grammar::diag::{Diagnostic, FileId};
 use std::collections::BTreeMap;
+use std::time::Duration;
 use toml::Spanned;
 
 /// A string of the map and where it is.
@@ -50,6 +51,49 @@ pub struct EventEntry {
 pub struct NodeEntry {
     pub agent: Str,
     pub node: Str,
+    /// The agent's event the bridge posts when a transition of the node
+    /// fails or is not answered in time.
+    pub failed: Option<Str>,
+    /// How long the bridge waits for the node to answer a request
+    /// (`500ms`, `2s`); see [`NodeEntry::timeout`].
+    pub timeout: Option<Str>,
+}
+
+/// How long the bridge waits for a lifecycle node's answer when the map
+/// does not say.
+pub const DEFAULT_NODE_TIMEOUT: Duration = Duration::from_secs(1);
+
+impl NodeEntry {
+    /// The node's answer timeout: the map's, or [`DEFAULT_NODE_TIMEOUT`];
+    /// `Err` with the reason when the map's is not a duration.
+    pub fn timeout(&self) -> Result<Duration, String> {
+        match &self.timeout {
+            None => Ok(DEFAULT_NODE_TIMEOUT),
+            Some(t) => parse_duration(&t.value),
+        }
+    }
+}
+
+/// A duration as the rules write one: a whole number and `ms` or `s`,
+/// greater than zero and at most an hour.
+pub fn parse_duration(text: &str) -> Result<Duration, String> {
+    let text = text.trim();
+    let (digits, unit) = match text.strip_suffix("ms") {
+        Some(d) => (d, 1u64),
+        None => match text.strip_suffix('s') {
+            Some(d) => (d, 1000u64),
+            None => return Err(format!("`{text}` is not a duration: write a whole number and `ms` or `s`")),
+        },
+    };
+    let n: u64 = digits
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a duration: write a whole number and `ms` or `s`"))?;
+    let ms = n.saturating_mul(unit);
+    if ms == 0 || ms > 3_600_000 {
+        return Err(format!("`{text}` is out of range: a timeout is more than 0 and at most 1 hour"));
+    }
+    Ok(Duration::from_millis(ms))
 }
 
 /// A parsed map.
@@ -86,6 +130,8 @@ struct RawEvent {
 struct RawNode {
     agent: Spanned<String>,
     node: Spanned<String>,
+    failed: Option<Spanned<String>>,
+    timeout: Option<Spanned<String>>,
 }
 
 /// Parses a map; a text that is not TOML or not of this form is one
@@ -120,7 +166,11 @@ pub fn parse(text: &str, file: FileId) -> Result<Map, Box<Diagnostic>> {
             }
         })
         .collect();
-    let nodes = raw.node.into_iter().map(|n| NodeEntry { agent: s(n.agent), node: s(n.node) }).collect();
+    let nodes = raw
+        .node
+        .into_iter()
+        .map(|n| NodeEntry { agent: s(n.agent), node: s(n.node), failed: n.failed.map(s), timeout: n.timeout.map(s) })
+        .collect();
     Ok(Map { events, nodes })
 }
 
@@ -161,6 +211,15 @@ mod tests {
         let map = parse(text, FileId(0)).unwrap();
         assert_eq!(map.nodes[0].agent.value, "AA");
         assert_eq!(map.nodes[0].agent.inner, None);
+    }
+
+    #[test]
+    fn timeouts_are_durations() {
+        assert_eq!(parse_duration("500ms"), Ok(Duration::from_millis(500)));
+        assert_eq!(parse_duration("2s"), Ok(Duration::from_secs(2)));
+        for bad in ["", "0ms", "2", "1.5s", "-1s", "2h", "3601s", "99999999999999999999s"] {
+            assert!(parse_duration(bad).is_err(), "{bad:?}");
+        }
     }
 
     #[test]

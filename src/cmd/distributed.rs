@@ -60,7 +60,7 @@ pub struct Args {
 }
 
 /// The flag Ctrl-C and SIGTERM raise.
-fn stop_flag() -> Arc<AtomicBool> {
+pub fn stop_flag() -> Arc<AtomicBool> {
     let stop = Arc::new(AtomicBool::new(false));
     let s = stop.clone();
     // A second handler cannot be installed (tests run one command per

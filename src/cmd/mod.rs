@@ -15,6 +15,7 @@ pub mod manners;
 pub mod program;
 pub mod repl;
 pub mod replay;
+pub mod ros2;
 pub mod run;
 pub mod scripted;
 pub mod test;

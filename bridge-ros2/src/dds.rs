@@ -1,0 +1,335 @@
+//! The DDS shell of the bridge: one ROS 2 node (`/situ_bridge`, by
+//! ros2-client on RustDDS) with a reader of raw CDR samples per mapped
+//! topic, the publishers of the situation, and a `change_state` and a
+//! `get_state` client per lifecycle node; one thread polls them all and
+//! hands what arrives to the [`Core`].
+
+use crate::core::{Core, Counters, Output};
+use crate::msgs::{
+    ChangeStateRequest, ChangeStateResponse, DiagnosticArray, GetStateRequest, GetStateResponse, StringMsg, Transition,
+};
+use ros2_client::service::{Client, ServiceMapping};
+use ros2_client::{Context, ContextOptions, MessageTypeName, Name, Node, NodeName, NodeOptions, Publisher};
+use ros2_client::{QosProfile, ServiceTypeName};
+use rustdds::mio1::{Events, Interest, Poll, Token};
+use rustdds::no_key::{self, DataReader};
+use rustdds::{QosPolicyBuilder, RepresentationIdentifier};
+use std::fmt;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+/// How the lifecycle services are carried: the RMW of the nodes' ROS 2.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Rmw {
+    /// `rmw_cyclonedds_cpp`: a request header in the payload.
+    CycloneDds,
+    /// `rmw_fastrtps_cpp` (ROS 2's default): the request id in inline QoS.
+    FastRtps,
+}
+
+impl Rmw {
+    fn mapping(self) -> ServiceMapping {
+        match self {
+            Rmw::CycloneDds => ServiceMapping::Cyclone,
+            Rmw::FastRtps => ServiceMapping::Enhanced,
+        }
+    }
+}
+
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// The DDS domain (`ROS_DOMAIN_ID`).
+    pub domain: u16,
+    pub rmw: Rmw,
+    /// How often the clock ticks when nothing arrives (staleness, timeouts).
+    pub heartbeat: Duration,
+    /// Run this long, then stop; `None`: until `stop`.
+    pub duration: Option<Duration>,
+    /// Raised from outside (Ctrl-C): the loop ends.
+    pub stop: Arc<AtomicBool>,
+}
+
+/// Why the bridge could not run.
+#[derive(Debug)]
+pub struct DdsError(pub String);
+
+impl fmt::Display for DdsError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+fn dds<E: fmt::Debug>(what: &str) -> impl FnOnce(E) -> DdsError + '_ {
+    move |e| DdsError(format!("{what}: {e:?}"))
+}
+
+/// What a run did.
+#[derive(Debug, Clone)]
+pub struct Report {
+    pub state: String,
+    pub counters: Counters,
+    /// Nanoseconds from a message taken off its reader to the first
+    /// `change_state` request it caused written, one per such message.
+    pub latencies: Vec<u64>,
+    /// Messages taken per second over the run.
+    pub rate: f64,
+}
+
+/// A sample's bytes as they came, encapsulation header included: the
+/// map's decoder ([`situ_ros2::cdr`]) reads them, not serde.
+pub struct Raw(pub Vec<u8>);
+
+/// The adapter that keeps a sample's bytes.
+pub struct RawAdapter;
+
+#[derive(Debug)]
+pub struct Never;
+
+impl fmt::Display for Never {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("never")
+    }
+}
+
+impl std::error::Error for Never {}
+
+/// Every encapsulation: one the map's decoder does not read is refused
+/// and counted there, not dropped unseen.
+const ENCODINGS: [RepresentationIdentifier; 6] = [
+    RepresentationIdentifier::CDR_LE,
+    RepresentationIdentifier::CDR_BE,
+    RepresentationIdentifier::PL_CDR_LE,
+    RepresentationIdentifier::PL_CDR_BE,
+    RepresentationIdentifier::CDR2_LE,
+    RepresentationIdentifier::CDR2_BE,
+];
+
+impl no_key::DeserializerAdapter<Raw> for RawAdapter {
+    type Error = Never;
+    type Decoded = Raw;
+
+    fn supported_encodings() -> &'static [RepresentationIdentifier] {
+        &ENCODINGS
+    }
+
+    fn transform_decoded(decoded: Raw) -> Raw {
+        decoded
+    }
+}
+
+#[derive(Clone)]
+pub struct RawDecoder;
+
+impl<'de> no_key::Decode<'de, Raw> for RawDecoder {
+    type Error = Never;
+
+    fn decode_bytes(self, input: &'de [u8], encoding: RepresentationIdentifier) -> Result<Raw, Never> {
+        let mut bytes = Vec::with_capacity(4 + input.len());
+        bytes.extend(encoding.to_bytes());
+        bytes.extend([0, 0]);
+        bytes.extend_from_slice(input);
+        Ok(Raw(bytes))
+    }
+}
+
+impl no_key::DefaultDecoder<Raw> for RawAdapter {
+    type Decoder = RawDecoder;
+    const DECODER: RawDecoder = RawDecoder;
+}
+
+/// The DDS name of a message type: `sensor_msgs/msg/LaserScan` → package
+/// and name for [`MessageTypeName`].
+fn type_parts(full: &str) -> Option<(&str, &str)> {
+    let mut parts = full.split('/');
+    let (package, _, name) = (parts.next()?, parts.next()?, parts.next()?);
+    Some((package, name))
+}
+
+fn now_ns() -> u64 {
+    SystemTime::now().duration_since(UNIX_EPOCH).map_or(0, |d| d.as_nanos() as u64)
+}
+
+struct Lifecycle {
+    change: Client<ChangeStateRequest, ChangeStateResponse>,
+    get: Client<GetStateRequest, GetStateResponse>,
+    change_id: Option<ros2_client::service::RmwRequestId>,
+    get_id: Option<ros2_client::service::RmwRequestId>,
+}
+
+struct Shell {
+    _node: Node,
+    state: Publisher<StringMsg>,
+    agents: Publisher<DiagnosticArray>,
+    diagnostics: Publisher<DiagnosticArray>,
+    readers: Vec<(String, DataReader<Raw, RawAdapter>)>,
+    lifecycle: Vec<Lifecycle>,
+}
+
+/// The latched topics: a late subscriber (`ros2 topic echo`) gets the last one.
+fn latched() -> QosProfile {
+    QosProfile::publisher_default()
+        .durability(ros2_client::qos::Durability::TransientLocal)
+        .history(ros2_client::qos::History::KeepLast { depth: 1 })
+}
+
+fn open(core: &Core, options: &Options) -> Result<Shell, DdsError> {
+    let context =
+        Context::with_options(ContextOptions::new().domain_id(options.domain)).map_err(dds("the DDS participant"))?;
+    let mut node = context
+        .new_node(NodeName::new("/", "situ_bridge").map_err(dds("node name"))?, NodeOptions::new().enable_rosout(false))
+        .map_err(dds("the node"))?;
+    let publisher = |name: &str, package: &str, ty: &str, qos: QosProfile| {
+        let topic = node
+            .create_topic(&Name::parse(name).map_err(dds(name))?, MessageTypeName::new(package, ty), &qos)
+            .map_err(dds(name))?;
+        Ok::<_, DdsError>(topic)
+    };
+    let state_topic = publisher("/situ/state", "std_msgs", "String", latched())?;
+    let agents_topic = publisher("/situ/agents", "diagnostic_msgs", "DiagnosticArray", latched())?;
+    let diag_qos = QosProfile::publisher_default().history(ros2_client::qos::History::KeepLast { depth: 10 });
+    let diagnostics_topic = publisher("/diagnostics", "diagnostic_msgs", "DiagnosticArray", diag_qos)?;
+    let state = node.create_publisher(&state_topic, None).map_err(dds("/situ/state"))?;
+    let agents = node.create_publisher(&agents_topic, None).map_err(dds("/situ/agents"))?;
+    let diagnostics = node.create_publisher(&diagnostics_topic, None).map_err(dds("/diagnostics"))?;
+
+    // Best effort matches every writer, reliable or not; a burst is kept.
+    let read_qos = QosPolicyBuilder::new()
+        .reliability(rustdds::policy::Reliability::BestEffort)
+        .history(rustdds::policy::History::KeepLast { depth: 256 })
+        .build();
+    let subscriber = context.domain_participant().create_subscriber(&read_qos).map_err(dds("the subscriber"))?;
+    let mut readers = Vec::new();
+    for (topic, ty) in core.topics() {
+        let (package, name) = type_parts(ty).ok_or_else(|| DdsError(format!("type `{ty}`")))?;
+        let profile = QosProfile::subscription_default();
+        let t = node
+            .create_topic(&Name::parse(&topic).map_err(dds(&topic))?, MessageTypeName::new(package, name), &profile)
+            .map_err(dds(&topic))?;
+        let reader =
+            subscriber.create_datareader_no_key::<Raw, RawAdapter>(&t, Some(read_qos.clone())).map_err(dds(&topic))?;
+        readers.push((topic, reader));
+    }
+    let service_qos = QosProfile::publisher_default().history(ros2_client::qos::History::KeepLast { depth: 10 });
+    let mut lifecycle = Vec::new();
+    for n in core.nodes() {
+        let name = |service: &str| Name::new(&n.name, service).map_err(dds(&n.name));
+        let change = node
+            .create_client(
+                options.rmw.mapping(),
+                &name("change_state")?,
+                &ServiceTypeName::new("lifecycle_msgs", "ChangeState"),
+                service_qos.clone(),
+                service_qos.clone(),
+            )
+            .map_err(dds(&n.name))?;
+        let get = node
+            .create_client(
+                options.rmw.mapping(),
+                &name("get_state")?,
+                &ServiceTypeName::new("lifecycle_msgs", "GetState"),
+                service_qos.clone(),
+                service_qos.clone(),
+            )
+            .map_err(dds(&n.name))?;
+        lifecycle.push(Lifecycle { change, get, change_id: None, get_id: None });
+    }
+    Ok(Shell { _node: node, state, agents, diagnostics, readers, lifecycle })
+}
+
+impl Shell {
+    /// Sends the core's outputs; whether a `change_state` request was among them.
+    fn send(&mut self, out: Vec<Output>) -> bool {
+        let mut requested = false;
+        for o in out {
+            // A publication that fails (no reader's room) is dropped: the
+            // next one carries the whole picture again.
+            match o {
+                Output::State(s) => drop(self.state.publish(StringMsg { data: s })),
+                Output::Agents(a) => drop(self.agents.publish(a)),
+                Output::Diagnostics(d) => drop(self.diagnostics.publish(d)),
+                Output::ChangeState { node, transition } => {
+                    let l = &mut self.lifecycle[node];
+                    let request = ChangeStateRequest {
+                        transition: Transition { id: transition.id(), label: transition.label().to_string() },
+                    };
+                    l.change_id = l.change.send_request(request).ok();
+                    requested = true;
+                }
+                Output::GetState { node } => {
+                    let l = &mut self.lifecycle[node];
+                    l.get_id = l.get.send_request(GetStateRequest::default()).ok();
+                }
+            }
+        }
+        requested
+    }
+}
+
+/// Runs the bridge until `options.duration` passes or `options.stop` is raised.
+pub fn run(mut core: Core, options: &Options) -> Result<Report, DdsError> {
+    let mut shell = open(&core, options)?;
+    let mut poll = Poll::new().map_err(dds("poll"))?;
+    let mut readers = std::mem::take(&mut shell.readers);
+    for (i, (_, reader)) in readers.iter_mut().enumerate() {
+        poll.registry().register(reader, Token(i), Interest::READABLE).map_err(dds("poll"))?;
+    }
+    let base = readers.len();
+    for (i, l) in shell.lifecycle.iter_mut().enumerate() {
+        poll.registry().register(&mut l.change, Token(base + 2 * i), Interest::READABLE).map_err(dds("poll"))?;
+        poll.registry().register(&mut l.get, Token(base + 2 * i + 1), Interest::READABLE).map_err(dds("poll"))?;
+    }
+    let started = Instant::now();
+    let out = core.start(now_ns());
+    shell.send(out);
+    let mut events = Events::with_capacity(64);
+    let mut latencies = Vec::new();
+    let mut next_tick = Instant::now() + options.heartbeat;
+    loop {
+        if options.stop.load(Ordering::Relaxed) || options.duration.is_some_and(|d| started.elapsed() >= d) {
+            break;
+        }
+        let wait = next_tick.saturating_duration_since(Instant::now());
+        // An interrupted poll (a signal) is a tick like any other.
+        let _ = poll.poll(&mut events, Some(wait));
+        for (topic, reader) in &mut readers {
+            while let Ok(Some(sample)) = reader.take_next_sample() {
+                let taken = Instant::now();
+                let out = core.on_message(topic, &sample.into_value().0, now_ns());
+                if shell.send(out) {
+                    latencies.push(taken.elapsed().as_nanos() as u64);
+                }
+            }
+        }
+        for i in 0..shell.lifecycle.len() {
+            loop {
+                let l = &mut shell.lifecycle[i];
+                let Ok(Some((id, answer))) = l.change.receive_response() else { break };
+                if l.change_id != Some(id) {
+                    continue; // an answer to a request given up on
+                }
+                l.change_id = None;
+                let out = core.on_change_state(i, answer.success, now_ns());
+                shell.send(out);
+            }
+            loop {
+                let l = &mut shell.lifecycle[i];
+                let Ok(Some((id, answer))) = l.get.receive_response() else { break };
+                if l.get_id != Some(id) {
+                    continue;
+                }
+                l.get_id = None;
+                let out = core.on_get_state(i, answer.current_state.id, now_ns());
+                shell.send(out);
+            }
+        }
+        if Instant::now() >= next_tick {
+            next_tick = Instant::now() + options.heartbeat;
+            let out = core.on_tick(now_ns());
+            shell.send(out);
+        }
+    }
+    let counters = core.counters();
+    let rate = counters.messages as f64 / started.elapsed().as_secs_f64().max(1e-9);
+    Ok(Report { state: core.state_name().to_string(), counters, latencies, rate })
+}

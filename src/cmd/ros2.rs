@@ -1,0 +1,157 @@
+//! `situ ros2 FILE --map MAP [--domain N] [--rmw cyclonedds|fastrtps]
+//! [--duration S]`: the ROS 2 bridge (docs/ros2.md), built with
+//! `--features ros2`.
+
+use super::{FAILED, OK, USAGE};
+use std::path::PathBuf;
+
+/// The RMW of the robot's ROS 2 nodes: how their services are carried.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Rmw {
+    /// rmw_cyclonedds_cpp (Eclipse Cyclone DDS).
+    Cyclonedds,
+    /// rmw_fastrtps_cpp (eProsima Fast DDS, ROS 2's default).
+    Fastrtps,
+}
+
+pub struct Args {
+    pub file: PathBuf,
+    pub map: PathBuf,
+    pub domain: Option<u16>,
+    pub rmw: Rmw,
+    pub duration: Option<f64>,
+}
+
+const NO_BRIDGE: &str = "this situ was built without the ROS 2 bridge: `cargo build --features ros2` \
+                         (or `cargo install --path . --features ros2`)";
+
+#[cfg(not(feature = "ros2"))]
+pub fn run(args: Args) -> u8 {
+    let _ = (&args.file, &args.map, args.domain, args.rmw, args.duration, OK, FAILED);
+    eprintln!("error: {NO_BRIDGE}");
+    USAGE
+}
+
+/// The domain: `--domain`, else `ROS_DOMAIN_ID`, else 0.
+#[cfg(feature = "ros2")]
+fn domain(flag: Option<u16>) -> Result<u16, String> {
+    if let Some(d) = flag {
+        return Ok(d);
+    }
+    match std::env::var("ROS_DOMAIN_ID") {
+        Err(_) => Ok(0),
+        Ok(v) if v.trim().is_empty() => Ok(0),
+        Ok(v) => v
+            .trim()
+            .parse::<u16>()
+            .ok()
+            .filter(|&d| d <= 232)
+            .ok_or_else(|| format!("ROS_DOMAIN_ID is `{v}`: a domain is a whole number from 0 to 232")),
+    }
+}
+
+#[cfg(feature = "ros2")]
+pub fn run(args: Args) -> u8 {
+    use situ_bridge_ros2::core::{Core, SetupError};
+    use situ_bridge_ros2::dds::{self, Options};
+    use situ_compiler::loader::{read_bounded, MAX_FILE_BYTES};
+    use situ_compiler::render;
+    use situ_compiler::source::SourceFile;
+    use std::sync::Arc;
+    use std::time::Duration;
+
+    let _ = NO_BRIDGE;
+    if !super::program::is_source(&args.file) {
+        eprintln!(
+            "error: `{}` is not a `.situ` source: the bridge reads the map against the rules' source (their events' fields and places)",
+            args.file.display()
+        );
+        return USAGE;
+    }
+    let domain = match domain(args.domain) {
+        Ok(d) => d,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return USAGE;
+        }
+    };
+    let duration = match args.duration {
+        None => None,
+        Some(s) if s.is_finite() && s > 0.0 && s <= 1e7 => Some(Duration::from_secs_f64(s)),
+        Some(s) => {
+            eprintln!("error: --duration {s}: give a number of seconds above 0");
+            return USAGE;
+        }
+    };
+    let mut checked = match super::program::check(&args.file, false) {
+        Ok(c) => c,
+        Err(code) => return code,
+    };
+    let text = match read_bounded(&args.map, MAX_FILE_BYTES, "a map")
+        .and_then(|b| String::from_utf8(b).map_err(|_| std::io::Error::other("the map is not UTF-8 text")))
+    {
+        Ok(t) => t,
+        Err(e) => {
+            eprintln!("error: {}: {e}", args.map.display());
+            return USAGE;
+        }
+    };
+    let content = Arc::new(situ_compiler::bundle::build(&checked));
+    let file = checked.sources.add(SourceFile::new(args.map.display().to_string(), text));
+    let map_text = checked.sources.get(file).text.clone();
+    let core = match Core::new(content, &checked.model, &map_text, file) {
+        Ok(core) => core,
+        Err(SetupError::Map(found)) => {
+            checked.diagnostics.extend(found);
+            print!("{}", render::human_all(&checked, super::style()));
+            eprintln!(
+                "error: `{}` has errors; `situ check {} --ros2-map {}` explains each",
+                args.map.display(),
+                args.file.display(),
+                args.map.display()
+            );
+            return FAILED;
+        }
+    };
+    let rmw = match args.rmw {
+        Rmw::Cyclonedds => dds::Rmw::CycloneDds,
+        Rmw::Fastrtps => dds::Rmw::FastRtps,
+    };
+    let topics: Vec<String> = core.topics().into_iter().map(|(t, _)| t).collect();
+    let nodes: Vec<String> = core.nodes().iter().map(|n| n.name.clone()).collect();
+    eprintln!(
+        "situ ros2: domain {domain}, reading {}; driving {} (the RMW's services: {:?}); publishing /situ/state, /situ/agents, /diagnostics",
+        if topics.is_empty() { "no topic".to_string() } else { topics.join(", ") },
+        if nodes.is_empty() { "no lifecycle node".to_string() } else { nodes.join(", ") },
+        args.rmw,
+    );
+    let options =
+        Options { domain, rmw, heartbeat: Duration::from_millis(10), duration, stop: super::distributed::stop_flag() };
+    match dds::run(core, &options) {
+        Ok(report) => {
+            let c = report.counters;
+            let mut lat = report.latencies.clone();
+            lat.sort_unstable();
+            let pct =
+                |p: f64| lat.get(((lat.len() as f64 - 1.0) * p).round() as usize).map_or(0.0, |&ns| ns as f64 / 1e3);
+            eprintln!(
+                "situ ros2: ended in {}; {} messages ({:.0}/s), {} refused, {} events, {} rejected, {} state changes, {} lifecycle requests, {} failures",
+                report.state, c.messages, report.rate, c.refused, c.events, c.rejected, c.changes, c.requests, c.failures
+            );
+            if !lat.is_empty() {
+                eprintln!(
+                    "situ ros2: message to first lifecycle request: p50 {:.0} µs, p99 {:.0} µs, max {:.0} µs ({} times)",
+                    pct(0.5),
+                    pct(0.99),
+                    pct(1.0),
+                    lat.len()
+                );
+            }
+            OK
+        }
+        Err(e) => {
+            eprintln!("error: DDS: {e}");
+            USAGE
+        }
+    }
+}

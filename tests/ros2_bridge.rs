@@ -1,0 +1,182 @@
+//! `situ ros2`, the bridge, against ROS 2's own middleware: Eclipse Cyclone
+//! DDS (the `cyclonedds` Python package, `bridge-ros2/tests/peer.py`) plays
+//! the AMR of `tests/ros2/amr.situ` — its lifecycle nodes, its laser, goals
+//! and navigator, and a late subscriber of `/situ/state` — over DDS on this
+//! host. The bridge runs as a user runs it, the real binary.
+//!
+//! A missing `python3` or `cyclonedds` fails the test: install the test
+//! requirements with `python3 -m pip install -r examples/python/requirements.txt`.
+#![cfg(feature = "ros2")]
+
+use serde_json::Value as Json;
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn bridge(domain: u16) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_situ"))
+        .current_dir(root())
+        .args(["ros2", "tests/ros2/amr.situ", "--map", "tests/ros2/amr.toml", "--rmw", "cyclonedds"])
+        .args(["--domain", &domain.to_string(), "--duration", "60"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the situ binary")
+}
+
+/// Runs the peer's scenario beside a bridge; the peer's lines, and the
+/// bridge's exit code and stderr after a Ctrl-C.
+fn scenario(name: &str, domain: u16) -> (Vec<Json>, i32, String) {
+    let mut bridge = bridge(domain);
+    let peer = Command::new("python3")
+        .current_dir(root())
+        .args(["bridge-ros2/tests/peer.py", name, "--domain", &domain.to_string()])
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run python3 ({e}): the test needs python3 with cyclonedds"));
+    // SAFETY: kill(2) on our own child's pid; SIGINT is what Ctrl-C sends.
+    unsafe { libc::kill(bridge.id() as i32, libc::SIGINT) };
+    let deadline = Instant::now() + Duration::from_secs(10);
+    let status = loop {
+        if let Some(s) = bridge.try_wait().expect("wait") {
+            break s;
+        }
+        assert!(Instant::now() < deadline, "the bridge did not stop on SIGINT");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let out = bridge.wait_with_output().expect("the bridge's output");
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    let text = String::from_utf8_lossy(&peer.stdout).to_string();
+    assert_eq!(
+        peer.status.code(),
+        Some(0),
+        "the peer failed ({}); it needs cyclonedds (examples/python/requirements.txt)\npeer:\n{text}{}\nbridge:\n{stderr}",
+        peer.status,
+        String::from_utf8_lossy(&peer.stderr),
+    );
+    let lines = text.lines().map(|l| serde_json::from_str(l).expect("a JSON line")).collect();
+    (lines, status.code().unwrap_or(-1), stderr)
+}
+
+/// The lifecycle requests the nodes answered, in order: (node, transition).
+fn transitions(lines: &[Json]) -> Vec<(String, String)> {
+    lines
+        .iter()
+        .filter_map(|l| l.get("transition"))
+        .map(|t| (t["node"].as_str().unwrap().to_string(), t["label"].as_str().unwrap().to_string()))
+        .collect()
+}
+
+fn states(lines: &[Json]) -> Vec<&str> {
+    lines.iter().filter_map(|l| l.get("state")?.as_str()).collect()
+}
+
+/// The links between the lifecycle nodes in each state of amr.situ (writer, reader).
+fn links(state: &str) -> &'static [(&'static str, &'static str)] {
+    match state {
+        "NAVIGATING" => &[("/costmap", "/planner"), ("/planner", "/controller")],
+        "RECOVERING" => &[("/costmap", "/recovery"), ("/recovery", "/controller")],
+        _ => &[],
+    }
+}
+
+#[test]
+fn a_mission_drives_the_lifecycle_nodes_in_order() {
+    let (lines, code, stderr) = scenario("mission", 41);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(lines.iter().any(|l| l.get("done").is_some()), "{lines:?}");
+    let sent = transitions(&lines);
+    let (configure, rest) = sent.split_at(4);
+    let mut configured: Vec<&str> =
+        configure.iter().filter_map(|(n, l)| (l == "configure").then_some(n.as_str())).collect();
+    configured.sort();
+    assert_eq!(configured, ["/controller", "/costmap", "/planner", "/recovery"], "{sent:?}");
+    let pairs = |xs: &[(&str, &str)]| xs.iter().map(|(n, l)| (n.to_string(), l.to_string())).collect::<Vec<_>>();
+    let expected = pairs(&[
+        // NAVIGATING: writers first.
+        ("/costmap", "activate"),
+        ("/planner", "activate"),
+        ("/controller", "activate"),
+        // RECOVERING: the controller gets its new writer before losing the old one.
+        ("/recovery", "activate"),
+        ("/planner", "deactivate"),
+        // NAVIGATING again.
+        ("/planner", "activate"),
+        ("/recovery", "deactivate"),
+        // ARRIVED: readers first.
+        ("/controller", "deactivate"),
+        ("/planner", "deactivate"),
+        ("/costmap", "deactivate"),
+    ]);
+    assert_eq!(rest, expected.as_slice());
+    // The late subscriber got IDLE (latched), then every change in order.
+    assert_eq!(states(&lines), ["IDLE", "NAVIGATING", "RECOVERING", "NAVIGATING", "ARRIVED"]);
+
+    // Never a reader active without its writer, in the links of the state entered.
+    let mut active: BTreeMap<String, bool> = BTreeMap::new();
+    let mut state = "IDLE";
+    for l in &lines {
+        if let Some(s) = l.get("state").and_then(Json::as_str) {
+            state = s;
+        }
+        if let Some(t) = l.get("transition") {
+            active.insert(t["node"].as_str().unwrap().into(), t["to"] == "active");
+            for (w, r) in links(state) {
+                if active.get(*r) == Some(&true) && t["label"] == "activate" {
+                    assert_eq!(active.get(*w), Some(&true), "{r} active without {w} in {state}: {l}");
+                }
+            }
+        }
+    }
+
+    // /situ/agents: the planner asleep and inactive at the end, the controller's node named.
+    let last = lines.iter().rev().find_map(|l| l.get("agents")).expect("an /situ/agents message");
+    assert_eq!(last["Planner"]["message"], "sleeping");
+    assert_eq!(last["Planner"]["lifecycle"], "inactive");
+    assert_eq!(last["Scan"]["lifecycle"], Json::Null);
+    // The bridge's own account.
+    assert!(stderr.contains("ended in ARRIVED"), "{stderr}");
+    assert!(stderr.contains("message to first lifecycle request: p50"), "{stderr}");
+}
+
+#[test]
+fn a_node_that_never_answers_is_its_failure_event() {
+    let (lines, code, stderr) = scenario("silent-planner", 42);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(lines.iter().any(|l| l.get("done").is_some()), "{lines:?}");
+    assert_eq!(states(&lines).last(), Some(&"FAULT"));
+    let errors: Vec<&str> = lines.iter().filter_map(|l| l.get("error")?.as_str()).collect();
+    assert!(errors.iter().any(|e| e.contains("/planner did not answer configure within 500ms")), "{errors:?}");
+    // Nothing was activated: FAULT wants every node asleep.
+    assert!(transitions(&lines).iter().all(|(_, l)| l == "configure"), "{lines:?}");
+    assert!(stderr.contains("ended in FAULT") && stderr.contains("1 failures"), "{stderr}");
+}
+
+#[test]
+fn the_bridge_refuses_a_bad_map_and_a_bundle() {
+    let dir = std::env::temp_dir().join(format!("situ-ros2-bridge-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let map = dir.join("bad.toml");
+    std::fs::write(&map, "[[node]]\nagent = \"Planner\"\nnode = \"planner\"\n").unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_situ"))
+        .current_dir(root())
+        .args(["ros2", "tests/ros2/amr.situ", "--map"])
+        .arg(&map)
+        .args(["--duration", "1"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("E0414") && stdout.contains("bad.toml:3:8"), "{stdout}");
+    let out = Command::new(env!("CARGO_BIN_EXE_situ"))
+        .current_dir(root())
+        .args(["ros2", "rules/outdoor.situ.bundle", "--map", "tests/ros2/amr.toml"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
