@@ -199,6 +199,9 @@ enum Command {
         /// Stop after this many seconds (default: until Ctrl-C or SIGTERM).
         #[arg(long)]
         duration: Option<f64>,
+        /// Record what came and went as a ROS 2 bag (a new directory; MCAP storage).
+        #[arg(long, value_name = "DIR")]
+        record: Option<PathBuf>,
     },
     /// Start every local process of a deployment (Zenoh) and stop them cleanly on Ctrl-C.
     Up {
@@ -454,8 +457,8 @@ fn main() -> ExitCode {
         Command::Graph { file, view, state, format, output } => {
             cmd::graph::run(&file, view, state.as_deref(), format, output.as_ref())
         }
-        Command::Ros2 { file, map, domain, rmw, duration } => {
-            cmd::ros2::run(cmd::ros2::Args { file, map, domain, rmw, duration })
+        Command::Ros2 { file, map, domain, rmw, duration, record } => {
+            cmd::ros2::run(cmd::ros2::Args { file, map, domain, rmw, duration, record })
         }
         Command::View { file, rules, port } => cmd::view::run(&file, rules.as_deref(), port),
     };

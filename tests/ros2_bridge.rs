@@ -18,11 +18,12 @@ fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
-fn bridge(domain: u16) -> Child {
+fn bridge(domain: u16, extra: &[&std::ffi::OsStr]) -> Child {
     Command::new(env!("CARGO_BIN_EXE_situ"))
         .current_dir(root())
         .args(["ros2", "tests/ros2/amr.situ", "--map", "tests/ros2/amr.toml", "--rmw", "cyclonedds"])
         .args(["--domain", &domain.to_string(), "--duration", "60"])
+        .args(extra)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -31,15 +32,27 @@ fn bridge(domain: u16) -> Child {
 
 /// Runs the peer's scenario beside a bridge; the peer's lines, and the
 /// bridge's exit code and stderr after a Ctrl-C.
-fn scenario(name: &str, domain: u16) -> (Vec<Json>, i32, String) {
-    let mut bridge = bridge(domain);
+fn scenario(name: &str, domain: u16, extra: &[&std::ffi::OsStr]) -> (Vec<Json>, i32, String) {
+    scenario_then(name, domain, extra, libc::SIGINT, Duration::ZERO)
+}
+
+/// As [`scenario`], the bridge stopped by `signal` `after` the peer ended.
+fn scenario_then(
+    name: &str,
+    domain: u16,
+    extra: &[&std::ffi::OsStr],
+    signal: i32,
+    after: Duration,
+) -> (Vec<Json>, i32, String) {
+    let mut bridge = bridge(domain, extra);
     let peer = Command::new("python3")
         .current_dir(root())
         .args(["bridge-ros2/tests/peer.py", name, "--domain", &domain.to_string()])
         .output()
         .unwrap_or_else(|e| panic!("cannot run python3 ({e}): the test needs python3 with cyclonedds"));
+    std::thread::sleep(after);
     // SAFETY: kill(2) on our own child's pid; SIGINT is what Ctrl-C sends.
-    unsafe { libc::kill(bridge.id() as i32, libc::SIGINT) };
+    unsafe { libc::kill(bridge.id() as i32, signal) };
     let deadline = Instant::now() + Duration::from_secs(10);
     let status = loop {
         if let Some(s) = bridge.try_wait().expect("wait") {
@@ -86,7 +99,9 @@ fn links(state: &str) -> &'static [(&'static str, &'static str)] {
 
 #[test]
 fn a_mission_drives_the_lifecycle_nodes_in_order() {
-    let (lines, code, stderr) = scenario("mission", 41);
+    let bag = std::env::temp_dir().join(format!("situ-ros2-bag-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&bag);
+    let (lines, code, stderr) = scenario("mission", 41, &["--record".as_ref(), bag.as_os_str()]);
     assert_eq!(code, 0, "{stderr}");
     assert!(lines.iter().any(|l| l.get("done").is_some()), "{lines:?}");
     let sent = transitions(&lines);
@@ -141,11 +156,54 @@ fn a_mission_drives_the_lifecycle_nodes_in_order() {
     // The bridge's own account.
     assert!(stderr.contains("ended in ARRIVED"), "{stderr}");
     assert!(stderr.contains("message to first lifecycle request: p50"), "{stderr}");
+
+    // The recording is a ROS 2 bag that rosbags (PyPI) reads with no type
+    // but the bag's own definitions.
+    assert_mission_bag(&read_bag(&bag));
+    std::fs::remove_dir_all(&bag).unwrap();
+}
+
+fn read_bag(bag: &Path) -> Json {
+    let out = Command::new("python3").arg(root().join("bridge-ros2/tests/read_bag.py")).arg(bag).output().unwrap();
+    assert!(
+        out.status.success(),
+        "rosbags could not read the bag ({}): {}; the test needs rosbags (examples/python/requirements.txt)",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+fn assert_mission_bag(read: &Json) {
+    assert_eq!(read["states"], serde_json::json!(["IDLE", "NAVIGATING", "RECOVERING", "NAVIGATING", "ARRIVED"]));
+    assert_eq!(read["types"]["/scan"], "sensor_msgs/msg/LaserScan");
+    assert_eq!(read["types"]["/situ/agents"], "diagnostic_msgs/msg/DiagnosticArray");
+    assert_eq!(read["counts"]["/goal_reached"].as_u64().map(|n| n >= 1), Some(true));
+    // The last scan the peer sent was clear (1.5 m), and it was recorded as sent.
+    assert_eq!(read["nearest"].as_f64(), Some(1.5));
+}
+
+#[test]
+fn a_killed_bridge_leaves_a_bag_that_reads_up_to_its_last_second() {
+    let bag = std::env::temp_dir().join(format!("situ-ros2-killed-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&bag);
+    // SIGKILL 1.5 s after the mission: no clean end, one flush (a second) since the last message.
+    let (lines, code, _) = scenario_then(
+        "mission",
+        43,
+        &["--record".as_ref(), bag.as_os_str()],
+        libc::SIGKILL,
+        Duration::from_millis(1500),
+    );
+    assert_eq!(code, -1, "killed, not exited");
+    assert!(lines.iter().any(|l| l.get("done").is_some()));
+    assert_mission_bag(&read_bag(&bag));
+    std::fs::remove_dir_all(&bag).unwrap();
 }
 
 #[test]
 fn a_node_that_never_answers_is_its_failure_event() {
-    let (lines, code, stderr) = scenario("silent-planner", 42);
+    let (lines, code, stderr) = scenario("silent-planner", 42, &[]);
     assert_eq!(code, 0, "{stderr}");
     assert!(lines.iter().any(|l| l.get("done").is_some()), "{lines:?}");
     assert_eq!(states(&lines).last(), Some(&"FAULT"));

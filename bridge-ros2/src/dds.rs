@@ -4,6 +4,7 @@
 //! `get_state` client per lifecycle node; one thread polls them all and
 //! hands what arrives to the [`Core`].
 
+use crate::bag::Bag;
 use crate::core::{Core, Counters, Output};
 use crate::msgs::{
     ChangeStateRequest, ChangeStateResponse, DiagnosticArray, GetStateRequest, GetStateResponse, StringMsg, Transition,
@@ -13,7 +14,7 @@ use ros2_client::{Context, ContextOptions, MessageTypeName, Name, Node, NodeName
 use ros2_client::{QosProfile, ServiceTypeName};
 use rustdds::mio1::{Events, Interest, Poll, Token};
 use rustdds::no_key::{self, DataReader};
-use rustdds::{QosPolicyBuilder, RepresentationIdentifier};
+use rustdds::{QosPolicyBuilder, ReadCondition, RepresentationIdentifier};
 use std::fmt;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -50,6 +51,13 @@ pub struct Options {
     pub stop: Arc<AtomicBool>,
 }
 
+/// The topics the bridge publishes, with their types.
+pub const PUBLISHED: [(&str, &str); 3] = [
+    ("/situ/state", "std_msgs/msg/String"),
+    ("/situ/agents", "diagnostic_msgs/msg/DiagnosticArray"),
+    ("/diagnostics", "diagnostic_msgs/msg/DiagnosticArray"),
+];
+
 /// Why the bridge could not run.
 #[derive(Debug)]
 pub struct DdsError(pub String);
@@ -74,6 +82,28 @@ pub struct Report {
     pub latencies: Vec<u64>,
     /// Messages taken per second over the run.
     pub rate: f64,
+    /// The time spent on the messages taken (decoding, the map, the rules,
+    /// the outputs), over all of them.
+    pub busy: Duration,
+    /// The recording's first error, after which nothing more was recorded.
+    pub record_error: Option<String>,
+}
+
+/// Where what came and went is recorded, if anywhere.
+struct Recording {
+    bag: Option<Bag>,
+    error: Option<String>,
+}
+
+impl Recording {
+    fn keep(&mut self, write: impl FnOnce(&mut Bag) -> std::io::Result<()>) {
+        if let Some(bag) = self.bag.as_mut() {
+            if let Err(e) = write(bag) {
+                self.error = Some(e.to_string());
+                self.bag = None;
+            }
+        }
+    }
 }
 
 /// A sample's bytes as they came, encapsulation header included: the
@@ -238,16 +268,28 @@ fn open(core: &Core, options: &Options) -> Result<Shell, DdsError> {
 }
 
 impl Shell {
-    /// Sends the core's outputs; whether a `change_state` request was among them.
-    fn send(&mut self, out: Vec<Output>) -> bool {
+    /// Sends the core's outputs, recording what it publishes; whether a
+    /// `change_state` request was among them.
+    fn send(&mut self, out: Vec<Output>, recording: &mut Recording) -> bool {
         let mut requested = false;
+        let now = now_ns();
         for o in out {
             // A publication that fails (no reader's room) is dropped: the
             // next one carries the whole picture again.
             match o {
-                Output::State(s) => drop(self.state.publish(StringMsg { data: s })),
-                Output::Agents(a) => drop(self.agents.publish(a)),
-                Output::Diagnostics(d) => drop(self.diagnostics.publish(d)),
+                Output::State(s) => {
+                    let msg = StringMsg { data: s };
+                    recording.keep(|b| b.write_serde(PUBLISHED[0].0, now, &msg));
+                    drop(self.state.publish(msg));
+                }
+                Output::Agents(a) => {
+                    recording.keep(|b| b.write_serde(PUBLISHED[1].0, now, &a));
+                    drop(self.agents.publish(a));
+                }
+                Output::Diagnostics(d) => {
+                    recording.keep(|b| b.write_serde(PUBLISHED[2].0, now, &d));
+                    drop(self.diagnostics.publish(d));
+                }
                 Output::ChangeState { node, transition } => {
                     let l = &mut self.lifecycle[node];
                     let request = ChangeStateRequest {
@@ -266,8 +308,13 @@ impl Shell {
     }
 }
 
-/// Runs the bridge until `options.duration` passes or `options.stop` is raised.
-pub fn run(mut core: Core, options: &Options) -> Result<Report, DdsError> {
+/// Runs the bridge until `options.duration` passes or `options.stop` is
+/// raised, recording into `bag` when there is one (finished on return).
+pub fn run(mut core: Core, options: &Options, bag: Option<Bag>) -> Result<Report, DdsError> {
+    let mut recording = Recording { bag, error: None };
+    for (topic, ty) in core.topics().into_iter().chain(PUBLISHED.map(|(t, ty)| (t.to_string(), ty))) {
+        recording.keep(|b| b.add_topic(&topic, ty));
+    }
     let mut shell = open(&core, options)?;
     let mut poll = Poll::new().map_err(dds("poll"))?;
     let mut readers = std::mem::take(&mut shell.readers);
@@ -281,9 +328,10 @@ pub fn run(mut core: Core, options: &Options) -> Result<Report, DdsError> {
     }
     let started = Instant::now();
     let out = core.start(now_ns());
-    shell.send(out);
+    shell.send(out, &mut recording);
     let mut events = Events::with_capacity(64);
     let mut latencies = Vec::new();
+    let mut busy = Duration::ZERO;
     let mut next_tick = Instant::now() + options.heartbeat;
     loop {
         if options.stop.load(Ordering::Relaxed) || options.duration.is_some_and(|d| started.elapsed() >= d) {
@@ -293,11 +341,21 @@ pub fn run(mut core: Core, options: &Options) -> Result<Report, DdsError> {
         // An interrupted poll (a signal) is a tick like any other.
         let _ = poll.poll(&mut events, Some(wait));
         for (topic, reader) in &mut readers {
-            while let Ok(Some(sample)) = reader.take_next_sample() {
-                let taken = Instant::now();
-                let out = core.on_message(topic, &sample.into_value().0, now_ns());
-                if shell.send(out) {
-                    latencies.push(taken.elapsed().as_nanos() as u64);
+            // In batches: one take per sample walks the reader's cache each time.
+            while let Ok(samples) = reader.take(256, ReadCondition::not_read()) {
+                if samples.is_empty() {
+                    break;
+                }
+                for sample in samples {
+                    let taken = Instant::now();
+                    let bytes = sample.into_value().0;
+                    let now = now_ns();
+                    recording.keep(|b| b.write(topic, now, &bytes));
+                    let out = core.on_message(topic, &bytes, now);
+                    if shell.send(out, &mut recording) {
+                        latencies.push(taken.elapsed().as_nanos() as u64);
+                    }
+                    busy += taken.elapsed();
                 }
             }
         }
@@ -310,7 +368,7 @@ pub fn run(mut core: Core, options: &Options) -> Result<Report, DdsError> {
                 }
                 l.change_id = None;
                 let out = core.on_change_state(i, answer.success, now_ns());
-                shell.send(out);
+                shell.send(out, &mut recording);
             }
             loop {
                 let l = &mut shell.lifecycle[i];
@@ -320,16 +378,18 @@ pub fn run(mut core: Core, options: &Options) -> Result<Report, DdsError> {
                 }
                 l.get_id = None;
                 let out = core.on_get_state(i, answer.current_state.id, now_ns());
-                shell.send(out);
+                shell.send(out, &mut recording);
             }
         }
         if Instant::now() >= next_tick {
             next_tick = Instant::now() + options.heartbeat;
             let out = core.on_tick(now_ns());
-            shell.send(out);
+            shell.send(out, &mut recording);
+            recording.keep(Bag::flush_if_due);
         }
     }
+    recording.keep(|b| b.finish().map(drop));
     let counters = core.counters();
     let rate = counters.messages as f64 / started.elapsed().as_secs_f64().max(1e-9);
-    Ok(Report { state: core.state_name().to_string(), counters, latencies, rate })
+    Ok(Report { state: core.state_name().to_string(), counters, latencies, rate, busy, record_error: recording.error })
 }

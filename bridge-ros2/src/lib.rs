@@ -7,8 +7,10 @@
 //! - [`core`]: every decision, without DDS: what arrives in, what to send out;
 //! - [`dds`]: the DDS shell (ros2-client on RustDDS): readers of the raw
 //!   CDR samples, the publishers, the lifecycle service clients, the loop;
+//! - [`bag`]: the recording, a ROS 2 bag (MCAP storage) of what came and went;
 //! - [`msgs`]: the ROS 2 messages and services it writes, as serde types.
 
+pub mod bag;
 pub mod core;
 pub mod dds;
 pub mod msgs;

@@ -1,5 +1,5 @@
 //! `situ ros2 FILE --map MAP [--domain N] [--rmw cyclonedds|fastrtps]
-//! [--duration S]`: the ROS 2 bridge (docs/ros2.md), built with
+//! [--duration S] [--record DIR]`: the ROS 2 bridge (docs/ros2.md), built with
 //! `--features ros2`.
 
 use super::{FAILED, OK, USAGE};
@@ -20,6 +20,7 @@ pub struct Args {
     pub domain: Option<u16>,
     pub rmw: Rmw,
     pub duration: Option<f64>,
+    pub record: Option<PathBuf>,
 }
 
 const NO_BRIDGE: &str = "this situ was built without the ROS 2 bridge: `cargo build --features ros2` \
@@ -27,7 +28,7 @@ const NO_BRIDGE: &str = "this situ was built without the ROS 2 bridge: `cargo bu
 
 #[cfg(not(feature = "ros2"))]
 pub fn run(args: Args) -> u8 {
-    let _ = (&args.file, &args.map, args.domain, args.rmw, args.duration, OK, FAILED);
+    let _ = (&args.file, &args.map, args.domain, args.rmw, args.duration, &args.record, OK, FAILED);
     eprintln!("error: {NO_BRIDGE}");
     USAGE
 }
@@ -125,9 +126,22 @@ pub fn run(args: Args) -> u8 {
         if nodes.is_empty() { "no lifecycle node".to_string() } else { nodes.join(", ") },
         args.rmw,
     );
+    let bag = match &args.record {
+        None => None,
+        Some(dir) => match situ_bridge_ros2::bag::Bag::create(dir) {
+            Ok(bag) => Some(bag),
+            Err(e) => {
+                eprintln!(
+                    "error: --record {}: {e} (a bag is a new directory; it is never written over)",
+                    dir.display()
+                );
+                return USAGE;
+            }
+        },
+    };
     let options =
         Options { domain, rmw, heartbeat: Duration::from_millis(10), duration, stop: super::distributed::stop_flag() };
-    match dds::run(core, &options) {
+    match dds::run(core, &options, bag) {
         Ok(report) => {
             let c = report.counters;
             let mut lat = report.latencies.clone();
@@ -138,6 +152,11 @@ pub fn run(args: Args) -> u8 {
                 "situ ros2: ended in {}; {} messages ({:.0}/s), {} refused, {} events, {} rejected, {} state changes, {} lifecycle requests, {} failures",
                 report.state, c.messages, report.rate, c.refused, c.events, c.rejected, c.changes, c.requests, c.failures
             );
+            if let Some(e) = &report.record_error {
+                eprintln!("error: the recording stopped: {e}");
+            } else if let Some(dir) = &args.record {
+                eprintln!("situ ros2: recorded {} (a ROS 2 bag, MCAP storage)", dir.display());
+            }
             if !lat.is_empty() {
                 eprintln!(
                     "situ ros2: message to first lifecycle request: p50 {:.0} µs, p99 {:.0} µs, max {:.0} µs ({} times)",
@@ -147,7 +166,11 @@ pub fn run(args: Args) -> u8 {
                     lat.len()
                 );
             }
-            OK
+            if report.record_error.is_some() {
+                FAILED
+            } else {
+                OK
+            }
         }
         Err(e) => {
             eprintln!("error: DDS: {e}");
