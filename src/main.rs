@@ -185,7 +185,7 @@ enum Command {
     },
     /// The ROS 2 bridge: topics to events, the situation to topics, lifecycle nodes driven by the tables (docs/ros2.md; `--features ros2`).
     Ros2 {
-        /// The rules (a `.situ` source).
+        /// The rules (a `.situ` source or a bundle).
         file: PathBuf,
         /// The ROS 2 map (TOML): which topic each event comes from, which agents are lifecycle nodes.
         #[arg(long)]
@@ -202,6 +202,9 @@ enum Command {
         /// Record what came and went as a ROS 2 bag (a new directory; MCAP storage).
         #[arg(long, value_name = "DIR")]
         record: Option<PathBuf>,
+        /// Run only bundles signed by one of these public keys (`situ key new`); refuse others (exit 2).
+        #[arg(long, value_name = "PUBKEY")]
+        trust: Vec<PathBuf>,
     },
     /// Start every local process of a deployment (Zenoh) and stop them cleanly on Ctrl-C.
     Up {
@@ -457,8 +460,8 @@ fn main() -> ExitCode {
         Command::Graph { file, view, state, format, output } => {
             cmd::graph::run(&file, view, state.as_deref(), format, output.as_ref())
         }
-        Command::Ros2 { file, map, domain, rmw, duration, record } => {
-            cmd::ros2::run(cmd::ros2::Args { file, map, domain, rmw, duration, record })
+        Command::Ros2 { file, map, domain, rmw, duration, record, trust } => {
+            cmd::ros2::run(cmd::ros2::Args { file, map, domain, rmw, duration, record, trust })
         }
         Command::View { file, rules, port } => cmd::view::run(&file, rules.as_deref(), port),
     };

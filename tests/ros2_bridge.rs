@@ -214,27 +214,52 @@ fn a_node_that_never_answers_is_its_failure_event() {
     assert!(stderr.contains("ended in FAULT") && stderr.contains("1 failures"), "{stderr}");
 }
 
+fn situ(dir: &Path, args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_situ")).current_dir(dir).args(args).output().expect("the situ binary")
+}
+
 #[test]
-fn the_bridge_refuses_a_bad_map_and_a_bundle() {
-    let dir = std::env::temp_dir().join(format!("situ-ros2-bridge-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let map = dir.join("bad.toml");
-    std::fs::write(&map, "[[node]]\nagent = \"Planner\"\nnode = \"planner\"\n").unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_situ"))
-        .current_dir(root())
-        .args(["ros2", "tests/ros2/amr.situ", "--map"])
-        .arg(&map)
-        .args(["--duration", "1"])
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(1));
-    let stdout = String::from_utf8_lossy(&out.stdout);
+fn a_bad_map_is_refused_with_its_findings() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("bad.toml"), "[[node]]\nagent = \"Planner\"\nnode = \"planner\"\n").unwrap();
+    let rules = root().join("tests/ros2/amr.situ");
+    let o = situ(dir.path(), &["ros2", rules.to_str().unwrap(), "--map", "bad.toml", "--duration", "1"]);
+    assert_eq!(o.status.code(), Some(1));
+    let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(stdout.contains("E0414") && stdout.contains("bad.toml:3:8"), "{stdout}");
-    let out = Command::new(env!("CARGO_BIN_EXE_situ"))
-        .current_dir(root())
-        .args(["ros2", "rules/outdoor.situ.bundle", "--map", "tests/ros2/amr.toml"])
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
-    std::fs::remove_dir_all(&dir).unwrap();
+    let o = situ(dir.path(), &["ros2", rules.to_str().unwrap(), "--map", "missing.toml"]);
+    assert_eq!(o.status.code(), Some(2));
+}
+
+#[test]
+fn a_signed_bundle_runs_and_an_unsigned_one_is_refused_under_trust() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path();
+    let rules = root().join("tests/ros2/amr.situ");
+    let map = root().join("tests/ros2/amr.toml");
+    let (rules, map) = (rules.to_str().unwrap(), map.to_str().unwrap());
+    assert_eq!(situ(p, &["key", "new", "robot"]).status.code(), Some(0));
+    assert_eq!(situ(p, &["build", rules, "-o", "signed.json", "--sign", "robot.key"]).status.code(), Some(0));
+    assert_eq!(situ(p, &["build", rules, "-o", "unsigned.json"]).status.code(), Some(0));
+    let run = |bundle: &str, trust: bool| {
+        let mut args = vec!["ros2", bundle, "--map", map, "--domain", "44", "--duration", "0.5"];
+        if trust {
+            args.extend(["--trust", "robot.pub"]);
+        }
+        situ(p, &args)
+    };
+    let o = run("signed.json", true);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("ended in IDLE"));
+    let o = run("unsigned.json", true);
+    assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+    // A bundle's map is checked against its agents and events: a mistake is a finding.
+    std::fs::write(
+        p.join("typo.toml"),
+        std::fs::read_to_string(map).unwrap().replace("pose.position.x", "pose.position.q"),
+    )
+    .unwrap();
+    let o = situ(p, &["ros2", "unsigned.json", "--map", "typo.toml", "--duration", "0.5"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("E0403"), "{}", String::from_utf8_lossy(&o.stdout));
 }

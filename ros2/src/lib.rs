@@ -12,6 +12,7 @@
 //! - [`cdr`]: decoding of the catalogue's messages from their CDR bytes.
 //! - [`eval`]: expressions on a decoded message; the [`Translator`] of messages to events.
 //! - [`lifecycle`]: the next `change_state` request the tables ask of the lifecycle nodes.
+//! - [`skeleton`]: the part of a model a map needs, from a bundle.
 
 pub mod cdr;
 pub mod check;
@@ -20,6 +21,7 @@ pub mod expr;
 pub mod lifecycle;
 pub mod map;
 pub mod msgs;
+pub mod skeleton;
 pub mod types;
 
 pub use check::check_map;

@@ -1,5 +1,5 @@
 //! `situ ros2 FILE --map MAP [--domain N] [--rmw cyclonedds|fastrtps]
-//! [--duration S] [--record DIR]`: the ROS 2 bridge (docs/ros2.md), built with
+//! [--duration S] [--record DIR] [--trust PUBKEY…]`: the ROS 2 bridge (docs/ros2.md), built with
 //! `--features ros2`.
 
 use super::{FAILED, OK, USAGE};
@@ -21,6 +21,7 @@ pub struct Args {
     pub rmw: Rmw,
     pub duration: Option<f64>,
     pub record: Option<PathBuf>,
+    pub trust: Vec<PathBuf>,
 }
 
 const NO_BRIDGE: &str = "this situ was built without the ROS 2 bridge: `cargo build --features ros2` \
@@ -28,7 +29,7 @@ const NO_BRIDGE: &str = "this situ was built without the ROS 2 bridge: `cargo bu
 
 #[cfg(not(feature = "ros2"))]
 pub fn run(args: Args) -> u8 {
-    let _ = (&args.file, &args.map, args.domain, args.rmw, args.duration, &args.record, OK, FAILED);
+    let _ = (&args.file, &args.map, args.domain, args.rmw, args.duration, &args.record, &args.trust, OK, FAILED);
     eprintln!("error: {NO_BRIDGE}");
     USAGE
 }
@@ -57,18 +58,10 @@ pub fn run(args: Args) -> u8 {
     use situ_bridge_ros2::dds::{self, Options};
     use situ_compiler::loader::{read_bounded, MAX_FILE_BYTES};
     use situ_compiler::render;
-    use situ_compiler::source::SourceFile;
-    use std::sync::Arc;
+    use situ_compiler::source::{SourceFile, SourceMap};
     use std::time::Duration;
 
     let _ = NO_BRIDGE;
-    if !super::program::is_source(&args.file) {
-        eprintln!(
-            "error: `{}` is not a `.situ` source: the bridge reads the map against the rules' source (their events' fields and places)",
-            args.file.display()
-        );
-        return USAGE;
-    }
     let domain = match domain(args.domain) {
         Ok(d) => d,
         Err(e) => {
@@ -84,8 +77,11 @@ pub fn run(args: Args) -> u8 {
             return USAGE;
         }
     };
-    let mut checked = match super::program::check(&args.file, false) {
-        Ok(c) => c,
+    if let Err(code) = super::program::trust(&args.trust) {
+        return code;
+    }
+    let program = match super::program::load(&args.file, false) {
+        Ok(p) => p,
         Err(code) => return code,
     };
     let text = match read_bounded(&args.map, MAX_FILE_BYTES, "a map")
@@ -97,18 +93,25 @@ pub fn run(args: Args) -> u8 {
             return USAGE;
         }
     };
-    let content = Arc::new(situ_compiler::bundle::build(&checked));
-    let file = checked.sources.add(SourceFile::new(args.map.display().to_string(), text));
-    let map_text = checked.sources.get(file).text.clone();
-    let core = match Core::new(content, &checked.model, &map_text, file) {
+    // A bundle has no source: the map is read against its agents and events.
+    let (mut sources, model) = match program.checked {
+        Some(checked) => (checked.sources, checked.model),
+        None => {
+            let mut sources = SourceMap::new();
+            let name = format!("{} (a bundle: no source)", args.file.display());
+            let file = sources.add(SourceFile::new(name, ""));
+            (sources, situ_ros2::skeleton::model_of(&program.content, file))
+        }
+    };
+    let file = sources.add(SourceFile::new(args.map.display().to_string(), text));
+    let map_text = sources.get(file).text.clone();
+    let core = match Core::new(program.content, &model, &map_text, file) {
         Ok(core) => core,
         Err(SetupError::Map(found)) => {
-            checked.diagnostics.extend(found);
-            print!("{}", render::human_all(&checked, super::style()));
+            print!("{}", render::human_list(&sources, &found, super::style()));
             eprintln!(
-                "error: `{}` has errors; `situ check {} --ros2-map {}` explains each",
+                "error: `{}` has errors; `situ check RULES --ros2-map {}` explains each",
                 args.map.display(),
-                args.file.display(),
                 args.map.display()
             );
             return FAILED;
