@@ -20,6 +20,7 @@
 //! - [`stack`]: the same parts as runtime agents of `rules/outdoor.situ`
 //!   and `rules/ugv.situ`, run on the **real** rules by the runtime's
 //!   simulated-time scheduler (what `situ run` drives);
+//! - [`dla`]: the building blocks of DLA (Pérez et al. 2006): grid, pyramid, planners, cases;
 //! - [`metrics`] and [`plot`]: what a run measured (`metrics.json`,
 //!   deterministic to the byte), and its pictures (`trajectory.svg`,
 //!   `timeline.svg`).
@@ -36,6 +37,7 @@
 #![deny(missing_docs)]
 
 pub mod control;
+pub mod dla;
 pub mod drive;
 pub mod fusion;
 pub mod geom;
