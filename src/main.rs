@@ -106,7 +106,7 @@ enum Command {
     Run {
         /// A `.situ` source or a bundle (rules/outdoor.situ, rules/ugv.situ: the stack is told by the agents).
         file: PathBuf,
-        /// A built-in scenario (outdoor-default, dafflon-4) or a TOML file; default: the stack's own.
+        /// A built-in scenario (outdoor-default, dafflon-4, dla-offices) or a TOML file; default: the stack's own.
         #[arg(long)]
         scenario: Option<String>,
         /// Record the run to this MCAP file (Foxglove reads it).
@@ -118,12 +118,19 @@ enum Command {
         /// The noise seed.
         #[arg(long, default_value_t = 1)]
         seed: u64,
-        /// Stop after this many seconds of simulated time (default 600, the UGV 120).
+        /// Stop after this many seconds of simulated time (default 600, the UGV 120, DLA 300).
         #[arg(long)]
         until: Option<f64>,
         /// Dafflon et al.'s comparison of the controllers (rules/ugv.situ): hard-switch,merge.
         #[arg(long, value_delimiter = ',')]
         compare: Option<Vec<String>>,
+        /// DLA (rules/dla.situ): the reactive layer's case base, read before the run (a new one is
+        /// trained when the file does not exist) and written after it with the cases learnt.
+        #[arg(long, value_name = "FILE", conflicts_with = "compare")]
+        cases: Option<PathBuf>,
+        /// DLA: the reactive layer does not learn on line (the case base is used as it is).
+        #[arg(long)]
+        no_learning: bool,
         /// Serve the run live over Foxglove's WebSocket protocol at this address (the
         /// recording's channels and messages; waits for a client, then runs in real time).
         #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8765",
@@ -412,6 +419,8 @@ fn main() -> ExitCode {
             seed,
             until,
             compare,
+            cases,
+            no_learning,
             foxglove,
             serve,
             script,
@@ -431,7 +440,19 @@ fn main() -> ExitCode {
             if local && (script.is_some() || random.is_some()) {
                 cmd::scripted::run(cmd::scripted::Args { file, script, random, until, out, record, foxglove, serve })
             } else if local {
-                cmd::run::run(cmd::run::Args { file, scenario, record, out, seed, until, compare, foxglove, serve })
+                let dla = cmd::run::DlaArgs { cases, learn: !no_learning };
+                cmd::run::run(cmd::run::Args {
+                    file,
+                    scenario,
+                    record,
+                    out,
+                    seed,
+                    until,
+                    compare,
+                    foxglove,
+                    serve,
+                    dla,
+                })
             } else {
                 cmd::distributed::run(cmd::distributed::Args {
                     file,

@@ -152,3 +152,35 @@ fn rules_without_a_reference_stack_or_a_script_say_what_to_give() {
     assert_eq!(code(&o), 2);
     assert!(text(&o).contains("no reference stack") && text(&o).contains("--random SEED"), "{}", text(&o));
 }
+
+#[test]
+fn dla_reads_and_writes_its_case_base_and_refuses_a_bad_one_untouched() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = dir.path().join("cases.txt");
+    let out = dir.path().join("out");
+    // No file yet: a case base is trained, then written with what was learnt.
+    let o = situ(&["run", "rules/dla.situ", "--until", "8", "--cases", s(&cases), "--out", s(&out)]);
+    assert_eq!(code(&o), 1, "8 s is not enough to arrive: {}", text(&o));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("case(s) trained"), "{stdout}");
+    let first = std::fs::read_to_string(&cases).unwrap();
+    assert!(first.starts_with("situ-casebase 1\nsectors 8\n"), "{}", &first[..40.min(first.len())]);
+    for f in ["dla.svg", "dla-route.svg", "metrics.json"] {
+        let text = std::fs::read_to_string(out.join(f)).unwrap();
+        assert!(!text.is_empty(), "{f}");
+    }
+    assert!(std::fs::read_to_string(out.join("dla.svg")).unwrap().contains("<polyline class=\"trajectory\""));
+    // Read back on the next run.
+    let o = situ(&["run", "rules/dla.situ", "--until", "4", "--cases", s(&cases)]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("case(s) read"), "{}", text(&o));
+    // Damaged, or of another robot: exit 2, the file as it was.
+    let damaged = first.replacen("c ", "c x", 1);
+    let other = first.replacen("sectors 8", "sectors 6", 1);
+    for bad in [damaged, other] {
+        std::fs::write(&cases, &bad).unwrap();
+        let o = situ(&["run", "rules/dla.situ", "--until", "4", "--cases", s(&cases)]);
+        assert_eq!(code(&o), 2, "{}", text(&o));
+        assert!(String::from_utf8_lossy(&o.stderr).contains("--cases"), "{}", text(&o));
+        assert_eq!(std::fs::read_to_string(&cases).unwrap(), bad, "left as it was");
+    }
+}

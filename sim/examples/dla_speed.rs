@@ -1,12 +1,25 @@
 //! Speed of the DLA building blocks: building the split-and-merge pyramid
 //! of a 512 × 512 occupancy grid (rooms, doors, obstacles, unexplored
 //! parts, built from simulated scans), and retrieving the nearest case
-//! among 100,000 random cases.
+//! among 100,000 cases.
+//!
+//! Two kinds of case base are measured, and both are reported:
+//! - *uniform*: situations drawn uniformly at random (every range uniform
+//!   in [0, 4] m, the goal in any direction), the worst case for an exact
+//!   k-d tree in this many dimensions;
+//! - *obstacle fields*: situations as a robot meets them — random fields of
+//!   discs and boxes in a walled 20 × 20 m area, random poses in free
+//!   space, the sector minima of a simulated 360-beam range scan (ray cast
+//!   against the obstacles, maximum range 4 m, 1 cm noise) and the direction
+//!   to a random goal, with the scripted driver's command; the queries are
+//!   fresh situations of other fields, generated the same way.
+//!
+//! The retrieval is also measured at 10,000 cases to show how it scales.
 //!
 //! `cargo run --release -p situ-sim --example dla_speed`
 //! Targets: pyramid < 20 ms, retrieval < 5 µs per query.
 
-use situ_sim::dla::cases::{Case, CaseBase, Command, Situation};
+use situ_sim::dla::cases::{drive, Case, CaseBase, Command, DriverParams, Situation};
 use situ_sim::dla::grid::{Beam, GridParams, OccupancyGrid};
 use situ_sim::dla::pyramid::{Pyramid, PyramidParams};
 use situ_sim::geom::{v2, Pose};
@@ -134,7 +147,7 @@ fn main() {
         free_regions,
     );
 
-    let max_range = 4.0;
+    let max_range = MAX_RANGE;
     let random = |noise: &mut Noise, sectors: usize| {
         let ranges = (0..sectors).map(|_| noise.uniform() * max_range).collect();
         Situation::new(ranges, (noise.uniform() * 2.0 - 1.0) * std::f64::consts::PI)
@@ -168,29 +181,83 @@ fn main() {
         let goal = (noise.uniform() * 2.0 - 1.0) * std::f64::consts::PI;
         break Situation::from_scan(&beams, sectors, max_range, goal);
     };
-    retrieval::<6>("random", &mut noise, &random);
-    retrieval::<8>("random", &mut noise, &random);
-    retrieval::<10>("random", &mut noise, &random);
-    retrieval::<8>("scanned in the map", &mut noise, &scanned);
-    retrieval::<10>("scanned in the map", &mut noise, &scanned);
+    let mut summary = Vec::new();
+    let random_case = |noise: &mut Noise, sectors: usize| {
+        let situation = random(noise, sectors);
+        Case { situation, command: Command { speed: noise.uniform(), turn_rate: noise.uniform() - 0.5 } }
+    };
+    let scanned_case = |noise: &mut Noise, sectors: usize| {
+        let situation = scanned(noise, sectors);
+        Case { situation, command: Command { speed: noise.uniform(), turn_rate: noise.uniform() - 0.5 } }
+    };
+    println!("uniform situations (worst case for an exact k-d tree), random commands:");
+    for cases in [10_000, 100_000] {
+        summary.push(retrieval::<10>("uniform", cases, &mut noise, &mut { random_case }, &mut { random }));
+    }
+    retrieval::<6>("uniform", 100_000, &mut noise, &mut { random_case }, &mut { random });
+    retrieval::<8>("uniform", 100_000, &mut noise, &mut { random_case }, &mut { random });
+    println!("situations scanned in the 512 x 512 map above, random commands:");
+    retrieval::<8>("scanned in the map", 100_000, &mut noise, &mut { scanned_case }, &mut { scanned });
+    summary.push(retrieval::<10>("scanned in the map", 100_000, &mut noise, &mut { scanned_case }, &mut { scanned }));
+
+    println!("situations met in random obstacle fields, the scripted driver's commands:");
+    for cases in [10_000, 100_000] {
+        // Separate generators: the queries come from other fields than the cases.
+        let mut train = Fields::new(FIELD_SITUATIONS);
+        let mut test = Fields::new(FIELD_SITUATIONS);
+        let driver = DriverParams::default();
+        summary.push(retrieval::<10>(
+            "obstacle fields",
+            cases,
+            &mut noise,
+            &mut |noise, sectors| {
+                let situation = train.situation(noise, sectors);
+                let command = drive(&situation, MAX_RANGE, &driver);
+                Case { situation, command }
+            },
+            &mut |noise, sectors| test.situation(noise, sectors),
+        ));
+    }
+    println!();
+    println!("nearest case, 8 sectors (D = 10), mean over 100,000 queries, median of 5 runs (target < 5 µs):");
+    println!("  {:<20} {:>9} {:>12} {:>16}", "case base", "cases", "µs/query", "mean distance");
+    for r in &summary {
+        println!("  {:<20} {:>9} {:>12.2} {:>16.3}", r.what, r.cases, r.us, r.mean_distance);
+    }
 }
 
-/// Builds a base of 100,000 cases of `D − 2` sectors drawn by `draw` and
-/// prints the mean time of a retrieval over 100,000 queries drawn alike
-/// (median of 5 runs).
-fn retrieval<const D: usize>(what: &str, noise: &mut Noise, draw: &dyn Fn(&mut Noise, usize) -> Situation) {
-    const CASES: usize = 100_000;
+/// The figures of one retrieval measurement.
+struct Retrieval {
+    what: &'static str,
+    cases: usize,
+    us: f64,
+    mean_distance: f64,
+}
+
+/// Builds a base of `cases` cases of `D − 2` sectors drawn by `case`
+/// (inserted with [`CaseBase::insert`]: duplicates are refused and counted,
+/// drawing goes on until `cases` went in) and prints the mean time of a
+/// retrieval over 100,000 queries drawn by `query` (median of 5 runs), and
+/// the mean distance from a query to its nearest case. A sample of the
+/// queries is checked against a brute-force search.
+fn retrieval<const D: usize>(
+    what: &'static str,
+    cases: usize,
+    noise: &mut Noise,
+    case: &mut dyn FnMut(&mut Noise, usize) -> Case,
+    query: &mut dyn FnMut(&mut Noise, usize) -> Situation,
+) -> Retrieval {
     const QUERIES: usize = 100_000;
     let sectors = CaseBase::<D>::SECTORS;
-    let mut base: CaseBase<D> = CaseBase::new(4.0, 0.0);
+    let mut base: CaseBase<D> = CaseBase::new(MAX_RANGE, 0.0);
     let t = Instant::now();
-    while base.len() < CASES {
-        let situation = draw(noise, sectors);
-        let command = Command { speed: noise.uniform(), turn_rate: noise.uniform() - 0.5 };
-        base.insert(Case { situation, command }).expect("valid case");
+    let mut drawn = 0usize;
+    while base.len() < cases {
+        drawn += 1;
+        base.insert(case(noise, sectors)).expect("valid case");
     }
     let build = t.elapsed();
-    let queries: Vec<Situation> = (0..QUERIES).map(|_| draw(noise, sectors)).collect();
+    let queries: Vec<Situation> = (0..QUERIES).map(|_| query(noise, sectors)).collect();
     let mut per_query = Vec::new();
     for _ in 0..5 {
         let t = Instant::now();
@@ -202,8 +269,179 @@ fn retrieval<const D: usize>(what: &str, noise: &mut Noise, draw: &dyn Fn(&mut N
         per_query.push(t.elapsed() / QUERIES as u32);
     }
     let us = median(per_query).as_secs_f64() * 1e6;
+    let mean_distance =
+        queries.iter().map(|q| base.nearest(q).expect("valid").expect("not empty").1).sum::<f64>() / QUERIES as f64;
+    // The k-d tree's answer is the nearest case (to single precision).
+    let keys: Vec<[f64; D]> = base.cases().iter().map(|c| base.key(&c.situation).expect("valid")).collect();
+    for q in queries.iter().step_by(QUERIES / 50) {
+        let k = base.key(q).expect("valid");
+        let brute = keys
+            .iter()
+            .map(|c| c.iter().zip(&k).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt())
+            .fold(f64::INFINITY, f64::min);
+        let (_, d) = base.nearest(q).expect("valid").expect("not empty");
+        assert!(d <= brute + 1e-5, "the k-d tree missed the nearest case: {d} > {brute}");
+    }
     println!(
-        "cases ({what}, {sectors} sectors): {CASES} inserted in {:.0} ms; nearest case: {us:.2} µs per query (target < 5 µs)",
+        "  cases ({what}, {sectors} sectors): {} inserted of {drawn} drawn ({} duplicates refused) in {:.0} ms; \
+         nearest case: {us:.2} µs per query (target < 5 µs), mean distance {mean_distance:.3}",
+        base.len(),
+        drawn - base.len(),
         build.as_secs_f64() * 1e3
     );
+    Retrieval { what, cases, us, mean_distance }
+}
+
+/// The maximum range of the simulated sensor (m).
+const MAX_RANGE: f64 = 4.0;
+/// Side of the walled square area of an obstacle field (m).
+const FIELD: f64 = 20.0;
+/// Beams of the simulated range scan (one per degree).
+const BEAMS: usize = 360;
+/// Situations drawn in one obstacle field before a new field is made.
+const FIELD_SITUATIONS: usize = 50;
+/// The clearance (m) of a pose from the obstacles: the robot's radius.
+const CLEARANCE: f64 = 0.25;
+
+/// An obstacle of a field.
+#[derive(Clone, Copy)]
+enum Obstacle {
+    /// Centre and radius (m).
+    Disc { x: f64, y: f64, r: f64 },
+    /// Corners (m), `x0 < x1`, `y0 < y1`.
+    Box { x0: f64, y0: f64, x1: f64, y1: f64 },
+}
+
+impl Obstacle {
+    /// The centre and radius of a circle around the obstacle.
+    fn bounds(&self) -> (f64, f64, f64) {
+        match *self {
+            Obstacle::Disc { x, y, r } => (x, y, r),
+            Obstacle::Box { x0, y0, x1, y1 } => ((x0 + x1) / 2.0, (y0 + y1) / 2.0, (x1 - x0).hypot(y1 - y0) / 2.0),
+        }
+    }
+    /// The distance from point `(px, py)` to the obstacle (0 inside).
+    fn distance(&self, px: f64, py: f64) -> f64 {
+        match *self {
+            Obstacle::Disc { x, y, r } => ((px - x).hypot(py - y) - r).max(0.0),
+            Obstacle::Box { x0, y0, x1, y1 } => {
+                let dx = (x0 - px).max(px - x1).max(0.0);
+                let dy = (y0 - py).max(py - y1).max(0.0);
+                dx.hypot(dy)
+            }
+        }
+    }
+    /// The distance along the ray from `(px, py)` in unit direction
+    /// `(dx, dy)` to the obstacle, if it is hit.
+    fn ray(&self, px: f64, py: f64, dx: f64, dy: f64) -> Option<f64> {
+        match *self {
+            Obstacle::Disc { x, y, r } => {
+                let (mx, my) = (px - x, py - y);
+                let b = mx * dx + my * dy;
+                let c = mx * mx + my * my - r * r;
+                if c > 0.0 && b > 0.0 {
+                    return None;
+                }
+                let disc = b * b - c;
+                (disc >= 0.0).then(|| (-b - disc.sqrt()).max(0.0))
+            }
+            Obstacle::Box { x0, y0, x1, y1 } => {
+                let (mut near, mut far) = (0.0f64, f64::INFINITY);
+                for (p, d, lo, hi) in [(px, dx, x0, x1), (py, dy, y0, y1)] {
+                    if d.abs() < 1e-12 {
+                        if p < lo || p > hi {
+                            return None;
+                        }
+                    } else {
+                        let (a, b) = ((lo - p) / d, (hi - p) / d);
+                        near = near.max(a.min(b));
+                        far = far.min(a.max(b));
+                    }
+                }
+                (near <= far).then_some(near)
+            }
+        }
+    }
+}
+
+/// Random obstacle fields, a new one every `per_field` situations, and the
+/// situations a robot meets in them.
+struct Fields {
+    per_field: usize,
+    left: usize,
+    obstacles: Vec<Obstacle>,
+}
+
+impl Fields {
+    fn new(per_field: usize) -> Self {
+        Fields { per_field, left: 0, obstacles: Vec::new() }
+    }
+
+    /// A new field: 5 to 30 discs (radius 0.15–0.8 m) and 5 to 30 boxes
+    /// (sides 0.3–3 m), anywhere in the area.
+    fn renew(&mut self, noise: &mut Noise) {
+        self.obstacles.clear();
+        let discs = 5 + (noise.uniform() * 26.0) as usize;
+        let boxes = 5 + (noise.uniform() * 26.0) as usize;
+        for _ in 0..discs {
+            let (x, y) = (noise.uniform() * FIELD, noise.uniform() * FIELD);
+            self.obstacles.push(Obstacle::Disc { x, y, r: 0.15 + noise.uniform() * 0.65 });
+        }
+        for _ in 0..boxes {
+            let (x, y) = (noise.uniform() * FIELD, noise.uniform() * FIELD);
+            let (w, h) = (0.3 + noise.uniform() * 2.7, 0.3 + noise.uniform() * 2.7);
+            self.obstacles.push(Obstacle::Box { x0: x, y0: y, x1: x + w, y1: y + h });
+        }
+        self.left = self.per_field;
+    }
+
+    /// A situation: a random pose at least [`CLEARANCE`] from the obstacles
+    /// and walls, the sector minima of a scan from it, a random goal.
+    fn situation(&mut self, noise: &mut Noise, sectors: usize) -> Situation {
+        if self.left == 0 {
+            self.renew(noise);
+        }
+        self.left -= 1;
+        let (x, y) = loop {
+            let x = CLEARANCE + noise.uniform() * (FIELD - 2.0 * CLEARANCE);
+            let y = CLEARANCE + noise.uniform() * (FIELD - 2.0 * CLEARANCE);
+            if self.obstacles.iter().all(|o| o.distance(x, y) >= CLEARANCE) {
+                break (x, y);
+            }
+        };
+        let theta = noise.uniform() * std::f64::consts::TAU;
+        // Only the obstacles within reach.
+        let near: Vec<Obstacle> = self
+            .obstacles
+            .iter()
+            .filter(|o| {
+                let (cx, cy, r) = o.bounds();
+                (cx - x).hypot(cy - y) <= MAX_RANGE + r
+            })
+            .copied()
+            .collect();
+        let beams: Vec<Beam> = (0..BEAMS)
+            .map(|k| {
+                let a = (k as f64 + 0.5) * std::f64::consts::TAU / BEAMS as f64 - std::f64::consts::PI;
+                let (dx, dy) = ((theta + a).cos(), (theta + a).sin());
+                // The walls of the area.
+                let wall = |p: f64, d: f64| match d {
+                    d if d > 1e-12 => (FIELD - p) / d,
+                    d if d < -1e-12 => -p / d,
+                    _ => f64::INFINITY,
+                };
+                let mut r = wall(x, dx).min(wall(y, dy));
+                for o in &near {
+                    if let Some(t) = o.ray(x, y, dx, dy) {
+                        r = r.min(t);
+                    }
+                }
+                let range = if r >= MAX_RANGE { MAX_RANGE } else { (r + noise.normal(0.01)).clamp(0.0, MAX_RANGE) };
+                Beam { angle: a, range, max_range: MAX_RANGE }
+            })
+            .collect();
+        let (gx, gy) = (noise.uniform() * FIELD, noise.uniform() * FIELD);
+        let goal = (gy - y).atan2(gx - x) - theta;
+        Situation::from_scan(&beams, sectors, MAX_RANGE, goal)
+    }
 }

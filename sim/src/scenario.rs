@@ -2,7 +2,7 @@
 //!
 //! ```toml
 //! name = "example"
-//! vehicle = "outdoor"            # or "urban" (Dafflon et al.'s UGV)
+//! vehicle = "outdoor"            # or "urban" (Dafflon et al.'s UGV), "indoor" (DLA's robot)
 //!
 //! [road]
 //! lane_width = 3.5
@@ -58,6 +58,9 @@ use std::path::Path;
 pub const OUTDOOR_DEFAULT: &str = include_str!("../scenarios/outdoor-default.toml");
 /// Dafflon et al.'s four-obstacle scene (`sim/scenarios/dafflon-4.toml`).
 pub const DAFFLON_4: &str = include_str!("../scenarios/dafflon-4.toml");
+/// DLA's offices: rooms the robot has not seen, a dead end on the straight
+/// line to the goal, a person walking (`sim/scenarios/dla-offices.toml`).
+pub const DLA_OFFICES: &str = include_str!("../scenarios/dla-offices.toml");
 
 /// Why a scenario was refused. Each variant names the field or the place.
 #[derive(Debug, Clone, PartialEq)]
@@ -179,6 +182,7 @@ enum VehicleKind {
     #[default]
     Outdoor,
     Urban,
+    Indoor,
 }
 
 #[derive(Debug, Deserialize)]
@@ -328,6 +332,7 @@ pub fn builtin(name: &str) -> Option<Scenario> {
     let text = match name {
         "outdoor-default" => OUTDOOR_DEFAULT,
         "dafflon-4" => DAFFLON_4,
+        "dla-offices" => DLA_OFFICES,
         _ => return None,
     };
     parse(text).ok()
@@ -411,6 +416,7 @@ fn build(f: ScenarioFile) -> Result<Scenario, ScenarioError> {
     let vehicle = match f.vehicle {
         VehicleKind::Outdoor => VehicleParams::outdoor(),
         VehicleKind::Urban => VehicleParams::urban(),
+        VehicleKind::Indoor => VehicleParams::indoor(),
     };
     positive("road.lane_width", f.road.lane_width)?;
     if f.road.lanes == 0 {

@@ -31,6 +31,8 @@ use serde::Serialize;
 pub enum Value {
     /// An `f64` field.
     F64(f64),
+    /// An `i64` field.
+    I64(i64),
     /// A symbol field (`side: {left, right}`, `reason: {…}`).
     Symbol(&'static str),
 }

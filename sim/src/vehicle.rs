@@ -77,6 +77,25 @@ impl VehicleParams {
         }
     }
 
+    /// DLA's small indoor robot (Pérez 2006 ran a Pioneer-like platform):
+    /// 0.4 m square, 0.6 m/s, its pose (and its laser) at its centre; a
+    /// tricycle with a short wheelbase and a wide steering range turns
+    /// nearly on the spot.
+    pub fn indoor() -> Self {
+        VehicleParams {
+            wheelbase: 0.2,
+            width: 0.36,
+            front: 0.2,
+            rear: 0.2,
+            max_steer: 1.2,
+            max_steer_rate: 4.0,
+            max_speed: 0.6,
+            max_accel: 0.8,
+            max_decel: 1.5,
+            clearance: 0.02,
+        }
+    }
+
     /// The footprint rectangle at a pose, counter-clockwise.
     pub fn footprint(&self, pose: &Pose) -> Vec<Vec2> {
         let h = self.width / 2.0;

@@ -579,3 +579,109 @@ fn pyramid_of_random_grids_is_a_partition_into_homogeneous_connected_regions() {
         assert_eq!(total, g.len());
     }
 }
+
+/// The `points` attribute of the polyline of class `class` in `svg`.
+fn polyline_points<'a>(svg: &'a str, class: &str) -> &'a str {
+    let at = svg.find(&format!(r#"<polyline class="{class}""#)).expect("the polyline");
+    let rest = &svg[at..];
+    let from = rest.find(r#"points=""#).expect("points") + r#"points=""#.len();
+    let to = rest[from..].find('"').expect("closing quote");
+    &rest[from..from + to]
+}
+
+/// A well-formedness check short of an XML parser: one root `<svg>`,
+/// balanced groups, every element closed.
+fn check_svg(svg: &str) {
+    assert!(svg.starts_with("<svg "), "starts with <svg");
+    assert!(svg.trim_end().ends_with("</svg>"), "ends with </svg>");
+    assert_eq!(svg.matches("<svg").count(), 1);
+    assert_eq!(svg.matches("<g ").count() + svg.matches("<g>").count(), svg.matches("</g>").count());
+    assert_eq!(svg.matches("<text").count(), svg.matches("</text>").count());
+    assert_eq!(svg.matches('<').count(), svg.matches('>').count());
+    // Every opened tag is closed, in order.
+    let mut stack: Vec<&str> = Vec::new();
+    for tag in svg.split('<').skip(1) {
+        let tag = &tag[..tag.find('>').expect("a tag is closed")];
+        let name = tag.trim_start_matches('/').split([' ', '\n']).next().unwrap();
+        if tag.starts_with('/') {
+            assert_eq!(stack.pop(), Some(name), "closing </{name}>");
+        } else if !tag.ends_with('/') {
+            stack.push(name);
+        }
+    }
+    assert!(stack.is_empty(), "unclosed {stack:?}");
+}
+
+#[test]
+fn drawing_of_two_rooms_shows_route_labels_and_path() {
+    use situ_sim::dla::draw::draw;
+    let g = two_rooms(true);
+    let p = Pyramid::build(&g, &params(16));
+    let (start, goal) = (cell_center(&g, 3, 3), cell_center(&g, 27, 12));
+    let route = plan_route(&p, &g, start, goal, &RouteParams::default()).unwrap();
+    let path = plan_path(&g, &p, &route, start, goal, &PathParams::default()).unwrap();
+    let trajectory: Vec<(f64, f64)> = path.iter().map(|q| (q.x + 0.02, q.y - 0.01)).collect();
+    let svg =
+        draw(&g, Some(&p), &route, &path, &trajectory, (start.x, start.y), (goal.x, goal.y), "two <rooms> & a door");
+    check_svg(&svg);
+    assert!(svg.contains("two &lt;rooms&gt; &amp; a door"));
+    // One label per route region, numbered in order.
+    assert_eq!(svg.matches(r#"class="route-label""#).count(), route.len());
+    for (k, r) in route.iter().enumerate() {
+        assert!(svg.contains(&format!(r#"class="route-label" data-region="{r}""#)), "label of region {r}");
+        assert!(svg.contains(&format!(">{}</text>", k + 1)));
+    }
+    // Every region outlined.
+    for r in p.regions() {
+        assert!(svg.contains(&format!(r#"<path data-region="{}" "#, r.id)), "outline of region {}", r.id);
+    }
+    // The path's points, in metres, in order.
+    let expected: Vec<String> = path.iter().map(|q| format!("{:.3},{:.3}", q.x, q.y)).collect();
+    assert_eq!(polyline_points(&svg, "path"), expected.join(" "));
+    let expected: Vec<String> = trajectory.iter().map(|q| format!("{:.3},{:.3}", q.0, q.1)).collect();
+    assert_eq!(polyline_points(&svg, "trajectory"), expected.join(" "));
+    assert!(svg.contains(r#"<circle class="start""#) && svg.contains(r#"<polygon class="goal""#));
+    // Deterministic.
+    let again =
+        draw(&g, Some(&p), &route, &path, &trajectory, (start.x, start.y), (goal.x, goal.y), "two <rooms> & a door");
+    assert_eq!(svg, again);
+    // Without a pyramid: the grid, the path, no region, no label.
+    let bare = draw(&g, None, &route, &path, &[], (start.x, start.y), (goal.x, goal.y), "grid only");
+    check_svg(&bare);
+    assert!(!bare.contains("route-label") && !bare.contains("data-region") && !bare.contains(r#"class="trajectory""#));
+    assert_eq!(polyline_points(&bare, "path"), polyline_points(&svg, "path"));
+}
+
+#[test]
+fn drawing_of_a_200_by_200_grid_stays_small() {
+    use situ_sim::dla::draw::draw;
+    // Two rooms of 10 × 20 m in walls, a door, boxes, an unexplored strip,
+    // and some noise on the free cells' probabilities.
+    let mut g = empty(200, 200);
+    g.fill(0, 0, 200, 200, OCC);
+    g.fill(2, 2, 99, 198, FREE);
+    g.fill(101, 2, 198, 198, FREE);
+    g.fill(99, 90, 101, 110, FREE);
+    g.fill(160, 2, 198, 198, 0.5);
+    for (x, y, w, h) in [(20, 30, 10, 15), (60, 120, 20, 8), (120, 40, 12, 12), (130, 150, 6, 25)] {
+        g.fill(x, y, x + w, y + h, OCC);
+    }
+    let mut noise = Noise::new(3, 0);
+    for y in 2..198 {
+        for x in 2..160 {
+            if g.is_free(x, y) && noise.uniform() < 0.01 {
+                g.set_probability(x, y, 0.2);
+            }
+        }
+    }
+    let p = Pyramid::build(&g, &PyramidParams::default());
+    let (start, goal) = (g.center(10, 10), g.center(150, 180));
+    let route = plan_route(&p, &g, start, goal, &RouteParams::default()).expect("a route");
+    let path = plan_path(&g, &p, &route, start, goal, &PathParams::default()).expect("a path");
+    let svg = draw(&g, Some(&p), &route, &path, &[], (start.x, start.y), (goal.x, goal.y), "200 x 200");
+    check_svg(&svg);
+    assert_eq!(svg.matches(r#"class="route-label""#).count(), route.len());
+    assert!(svg.len() < 200_000, "{} bytes", svg.len());
+    assert!(svg.matches("<rect").count() < 2_000, "{} rects", svg.matches("<rect").count());
+    assert_eq!(svg, draw(&g, Some(&p), &route, &path, &[], (start.x, start.y), (goal.x, goal.y), "200 x 200"));
+}

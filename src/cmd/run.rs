@@ -39,6 +39,28 @@ pub struct Args {
     pub foxglove: Option<String>,
     /// Serve the Supervisor's page of the run live at this address.
     pub serve: Option<String>,
+    pub dla: DlaArgs,
+}
+
+/// DLA's options (`rules/dla.situ`).
+#[derive(Debug, Clone, Default)]
+pub struct DlaArgs {
+    /// The case base file: read before, written after the run.
+    pub cases: Option<PathBuf>,
+    /// Whether the reactive layer learns on line.
+    pub learn: bool,
+}
+
+/// The case base of a DLA run: the file's, or a new one trained by the
+/// scripted driver when the file does not exist (or none was given). A file
+/// that cannot be used is an error (exit 2), and it is left as it was.
+fn dla_cases(args: &DlaArgs, seed: u64) -> Result<(stack::dla::Cases, bool), String> {
+    match &args.cases {
+        Some(path) if path.exists() => stack::dla::Cases::read(path)
+            .map(|c| (c, true))
+            .map_err(|e| format!("--cases `{}`: {e} (the file is left as it was)", path.display())),
+        _ => Ok((stack::dla::train(seed, stack::dla::TRAINING_SECONDS, stack::dla::NOVELTY), false)),
+    }
 }
 
 /// A built-in scenario by name, or a TOML file; the error names the field
@@ -132,7 +154,22 @@ pub fn run(args: Args) -> u8 {
         Err(code) => return code,
     };
     let mcap = watchers.recorder(mcap, &content).map(|m| Arc::new(Mutex::new(m)));
-    let cfg = StackConfig { seed: args.seed, until, ..StackConfig::default() };
+    let mut cfg = StackConfig { seed: args.seed, until, learn: args.dla.learn, ..StackConfig::default() };
+    let mut cases_read = None;
+    if kind == StackKind::Dla {
+        match dla_cases(&args.dla, args.seed) {
+            Ok((cases, read)) => {
+                let n = cases.len();
+                let handle = stack::dla::CasesHandle(Arc::new(Mutex::new(cases)));
+                cases_read = Some((handle.clone(), n, read));
+                cfg.cases = Some(handle);
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                return USAGE;
+            }
+        }
+    }
     let physics_step = cfg.physics_step;
     let mut run =
         match StackRun::new(content.clone(), kind, &scenario.world, cfg, Recording { mcap, sinks: Vec::new() }) {
@@ -165,6 +202,7 @@ pub fn run(args: Args) -> u8 {
         false => run.run(&mut |r| line.draw(|| r.progress().line())),
     }
     line.clear();
+    let run_plans = run.plans().cloned();
     let finished = run.finish();
     watchers.end();
     let report = match finished {
@@ -177,10 +215,41 @@ pub fn run(args: Args) -> u8 {
     println!("{} on {} (seed {})\n", content.source, scenario.name, args.seed);
     print!("{}", report.runtime.table());
     println!("\n{}", report.table());
+    if let (Some((handle, before, read)), Some(plans)) = (&cases_read, run_plans.as_ref()) {
+        let p = plans.lock().unwrap_or_else(|e| e.into_inner());
+        let cases = handle.0.lock().unwrap_or_else(|e| e.into_inner());
+        println!(
+            "  DLA               {} route(s), {} after a blocked path; {} case(s) {}, {} learnt on line",
+            p.routes,
+            p.replans,
+            before,
+            if *read { "read" } else { "trained" },
+            p.learnt
+        );
+        if let Some(explored) = p.no_route {
+            println!(
+                "  no route          the goal cannot be reached from here, even through unexplored regions ({:.0} % of the map explored)",
+                100.0 * explored
+            );
+        }
+        if let Some(path) = &args.dla.cases {
+            if let Err(e) = cases.write(path) {
+                eprintln!("error: cannot write the case base `{}`: {e}", path.display());
+                return USAGE;
+            }
+            println!("  case base         {} cases written to {}", cases.len(), path.display());
+        }
+    }
     if let Some(out) = &args.out {
         if let Err(e) = write_out(out, &scenario, &report, args.record.as_deref()) {
             eprintln!("error: {e}");
             return USAGE;
+        }
+        for (name, svg) in run_plans.iter().flat_map(|p| dla_pictures(p, &scenario, &report)) {
+            if let Err(e) = super::write_atomically(&out.join(name), svg.as_bytes()) {
+                eprintln!("error: cannot write `{}`: {e}", out.join(name).display());
+                return USAGE;
+            }
         }
         println!("wrote {}", out.display());
     }
@@ -192,6 +261,44 @@ pub fn run(args: Args) -> u8 {
     } else {
         FAILED
     }
+}
+
+/// DLA's pictures: `dla.svg`, the last occupancy grid and the regions of
+/// its pyramid, with the last path and the trajectory; `dla-route.svg`, the
+/// map the last route was planned on, its regions numbered along the route.
+fn dla_pictures(
+    plans: &stack::dla::SharedPlans,
+    scenario: &Scenario,
+    report: &stack::RunReport,
+) -> Vec<(&'static str, String)> {
+    let p = plans.lock().unwrap_or_else(|e| e.into_inner());
+    let world = &scenario.world;
+    let trajectory: Vec<(f64, f64)> = report.metrics.samples.iter().map(|s| (s.x, s.y)).collect();
+    let start = (world.start.x, world.start.y);
+    let goal = (world.goal.position.x, world.goal.position.y);
+    let mut out = Vec::new();
+    if let Some(map) = &p.map {
+        let title = format!("{} — {}: the last map, its regions, the last path", scenario.name, report.rules);
+        let svg =
+            situ_sim::dla::draw::draw(&map.grid, Some(&map.pyramid), &[], &p.path, &trajectory, start, goal, &title);
+        out.push(("dla.svg", svg));
+    }
+    if let Some(route) = &p.route {
+        let title =
+            format!("{} — {}: route {} on the map it was planned on", scenario.name, report.rules, route.number);
+        let svg = situ_sim::dla::draw::draw(
+            &route.map.grid,
+            Some(&route.map.pyramid),
+            &route.regions,
+            &p.path,
+            &trajectory,
+            start,
+            goal,
+            &title,
+        );
+        out.push(("dla-route.svg", svg));
+    }
+    out
 }
 
 /// `trajectory.svg`, `timeline.svg`, `metrics.json` (and `recording.mcap`,
@@ -266,7 +373,7 @@ fn compare(args: &Args, content: Arc<Content>, kind: StackKind, scenario: &Scena
             programs.merge = Some(content);
             wants(Strategy::HardSwitch).then_some((&mut programs.hard_switch, "ugv.situ", Strategy::HardSwitch))
         }
-        StackKind::Outdoor => {
+        StackKind::Outdoor | StackKind::Dla => {
             eprintln!(
                 "error: --compare needs the UGV's rules (rules/ugv.situ or rules/ugv-merge.situ): hard-switch and merge are its controllers"
             );

@@ -6,9 +6,12 @@
 //! - [`route`]: the route planner over the regions and the potential-field
 //!   path planner between consecutive regions;
 //! - [`cases`]: the reactive layer learnt by cases (Urdiales et al. 2006):
-//!   a k-d tree case base, on-line learning, its file, a scripted driver.
+//!   a k-d tree case base, on-line learning, its file, a scripted driver;
+//! - [`draw`]: an SVG picture of a grid, its regions, a route, a path and a
+//!   trajectory.
 
 pub mod cases;
+pub mod draw;
 pub mod grid;
 pub mod pyramid;
 pub mod route;

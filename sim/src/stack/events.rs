@@ -18,6 +18,7 @@ pub fn payload(content: &Content, event: &dyn Event) -> Option<Vec<Value>> {
             let (_, v) = fields.iter().find(|(n, _)| *n == f.name)?;
             match (&f.ty, v) {
                 (FieldType::F64, SimValue::F64(x)) => Some(Value::F64(*x)),
+                (FieldType::I64, SimValue::I64(x)) => Some(Value::I64(*x)),
                 (FieldType::Symbols(names), SimValue::Symbol(s)) => {
                     names.iter().position(|n| n == s).map(|i| Value::Symbol(i as u32))
                 }

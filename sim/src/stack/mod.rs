@@ -21,6 +21,7 @@
 //!   Nothing in it reads a clock: the same scenario and seed give the same
 //!   bytes.
 
+pub mod dla;
 pub mod events;
 pub mod merge;
 
@@ -81,6 +82,8 @@ pub enum StackKind {
     /// Dafflon et al.'s urban UGV with the multi-agent merge
     /// (`rules/ugv-merge.situ`): the agents of `rules/ugv.situ` and a Merger.
     UgvMerge,
+    /// Pérez's DLA (`rules/dla.situ`): deliberative and case-based reactive layers.
+    Dla,
 }
 
 impl StackKind {
@@ -90,6 +93,7 @@ impl StackKind {
             StackKind::Outdoor => outdoor::AGENTS,
             StackKind::Ugv => ugv::AGENTS,
             StackKind::UgvMerge => merge::AGENTS,
+            StackKind::Dla => dla::AGENTS,
         }
     }
 
@@ -97,16 +101,17 @@ impl StackKind {
     pub fn of(content: &Content) -> Result<StackKind, String> {
         let names: BTreeSet<&str> = content.agents.iter().map(|a| a.name.as_str()).collect();
         // The merge's agents include the hard switch's: it is tried first.
-        for kind in [StackKind::Outdoor, StackKind::UgvMerge, StackKind::Ugv] {
+        for kind in [StackKind::Outdoor, StackKind::UgvMerge, StackKind::Ugv, StackKind::Dla] {
             if kind.agents().iter().all(|a| names.contains(a)) {
                 return Ok(kind);
             }
         }
         Err(format!(
-            "no simulated stack for these agents ({}): `situ run` knows the agents of rules/outdoor.situ ({}), of rules/ugv.situ ({}) and of rules/ugv-merge.situ (those and Merger)",
+            "no simulated stack for these agents ({}): `situ run` knows the agents of rules/outdoor.situ ({}), of rules/ugv.situ ({}), of rules/ugv-merge.situ (those and Merger) and of rules/dla.situ ({})",
             names.into_iter().collect::<Vec<_>>().join(", "),
             outdoor::AGENTS.join(", "),
-            ugv::AGENTS.join(", ")
+            ugv::AGENTS.join(", "),
+            dla::AGENTS.join(", ")
         ))
     }
 
@@ -115,6 +120,7 @@ impl StackKind {
         match self {
             StackKind::Outdoor => "outdoor-default",
             StackKind::Ugv | StackKind::UgvMerge => "dafflon-4",
+            StackKind::Dla => "dla-offices",
         }
     }
 
@@ -123,6 +129,7 @@ impl StackKind {
         match self {
             StackKind::Outdoor => "GL",
             StackKind::Ugv | StackKind::UgvMerge => "Reached",
+            StackKind::Dla => "Arrived",
         }
     }
 
@@ -133,7 +140,7 @@ impl StackKind {
             // with no function): its heartbeat TCHB comes at 10 Hz, the
             // rate the rules' `stale after 1s` ("10 heartbeats") assumes.
             StackKind::Outdoor => [("TeleControl".to_string(), 10.0)].into(),
-            StackKind::Ugv | StackKind::UgvMerge => BTreeMap::new(),
+            StackKind::Ugv | StackKind::UgvMerge | StackKind::Dla => BTreeMap::new(),
         }
     }
 
@@ -146,6 +153,8 @@ impl StackKind {
         match self {
             StackKind::Outdoor => 2,
             StackKind::Ugv | StackKind::UgvMerge => 5,
+            // The reactive layer's 10 Hz.
+            StackKind::Dla => 10,
         }
     }
 
@@ -154,6 +163,7 @@ impl StackKind {
         match self {
             StackKind::Outdoor => 600.0,
             StackKind::Ugv | StackKind::UgvMerge => 120.0,
+            StackKind::Dla => 300.0,
         }
     }
 }
@@ -174,6 +184,11 @@ pub struct StackConfig {
     pub samples: bool,
     /// Rates (Hz) over the rules file and the stack's own ([`StackKind::rates`]).
     pub rates: BTreeMap<String, f64>,
+    /// DLA: the reactive layer's case base (`None`: one trained before the
+    /// run by the scripted driver, [`dla::train`]).
+    pub cases: Option<dla::CasesHandle>,
+    /// DLA: whether the reactive layer learns novel situations on line.
+    pub learn: bool,
 }
 
 impl Default for StackConfig {
@@ -185,6 +200,8 @@ impl Default for StackConfig {
             sample_every: 0,
             samples: true,
             rates: BTreeMap::new(),
+            cases: None,
+            learn: true,
         }
     }
 }
@@ -495,6 +512,7 @@ pub struct StackRun {
     running: BTreeMap<String, BTreeSet<String>>,
     per_state: BTreeMap<String, (f64, f64, f64, f64, u64)>,
     final_since: Option<u64>,
+    plans: Option<dla::SharedPlans>,
 }
 
 impl StackRun {
@@ -516,10 +534,20 @@ impl StackRun {
             command: Command::default(),
             views,
         }));
+        let mut plans = None;
         let agents = match kind {
             StackKind::Outdoor => outdoor::agents(&content, &physics, world, cfg.seed),
             StackKind::Ugv => ugv::agents(&content, &physics, world, cfg.seed),
             StackKind::UgvMerge => ugv::build(&content, &physics, world, cfg.seed, true),
+            StackKind::Dla => {
+                let cases = match &cfg.cases {
+                    Some(c) => c.0.clone(),
+                    None => Arc::new(Mutex::new(dla::train(cfg.seed, dla::TRAINING_SECONDS, dla::NOVELTY))),
+                };
+                let shared: dla::SharedPlans = Arc::default();
+                plans = Some(shared.clone());
+                dla::agents(&content, &physics, world, cfg.seed, cases, cfg.learn, shared)
+            }
         };
         let bound = agent::bind(&content, agents, true).map_err(|e| e.to_string())?;
         let counts = Arc::new(Mutex::new(StreamCounts::default()));
@@ -561,7 +589,13 @@ impl StackRun {
             running: BTreeMap::new(),
             per_state: BTreeMap::new(),
             final_since: None,
+            plans,
         })
+    }
+
+    /// DLA: the map, route and path of the run, and its counts.
+    pub fn plans(&self) -> Option<&dla::SharedPlans> {
+        self.plans.as_ref()
     }
 
     /// Simulated time (s).

@@ -1,0 +1,120 @@
+//! DLA (Pérez 2006) on the real rules (`rules/dla.situ`) through the
+//! runtime, in `dla-offices`: three rooms the robot has not seen, doors at
+//! opposite ends, a person walking. The paper's claims, asserted on what
+//! the run recorded:
+//! - the deliberative and reactive layers together reach the goal with no
+//!   collision, re-planning as the walls are discovered;
+//! - while a new route is computed the reactive layer keeps the robot moving;
+//! - with the topological route the mission is shorter than with the
+//!   reactive layer alone (which does not find the doors);
+//! - a goal that cannot be reached ends in `Unreachable`, not in a hang.
+
+use situ_compiler::bundle::Content;
+use situ_sim::scenario::{self, Scenario};
+use situ_sim::stack::{Outcome, Recording, RunReport, StackConfig, StackKind, StackRun};
+use std::path::Path;
+use std::sync::Arc;
+
+fn source() -> String {
+    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../rules/dla.situ")).unwrap()
+}
+
+fn compile(name: &str, text: &str) -> Arc<Content> {
+    let checked = situ_compiler::check_source(name, text);
+    assert_eq!(checked.errors(), 0, "{name}: {:?}", checked.diagnostics);
+    Arc::new(situ_compiler::bundle::build(&checked))
+}
+
+fn offices() -> Scenario {
+    scenario::builtin("dla-offices").expect("built in")
+}
+
+/// A run, with the DLA counts (routes, re-plans).
+fn run(content: Arc<Content>, scenario: &Scenario, seed: u64, until: f64) -> (RunReport, u64, u64) {
+    let kind = StackKind::of(&content).expect("the DLA stack");
+    assert_eq!(kind, StackKind::Dla);
+    let cfg = StackConfig { seed, until, ..StackConfig::default() };
+    let mut run = StackRun::new(content, kind, &scenario.world, cfg, Recording { mcap: None, sinks: Vec::new() })
+        .expect("every agent bound");
+    run.run(&mut |_| {});
+    let plans = run.plans().cloned().expect("DLA's plans");
+    let report = run.finish().expect("finished");
+    let p = plans.lock().unwrap();
+    (report, p.routes, p.replans)
+}
+
+#[test]
+fn the_layers_reach_the_goal_and_replan_without_stopping() {
+    let (report, routes, replans) = run(compile("dla.situ", &source()), &offices(), 1, 200.0);
+    println!("{}\n{}", report.runtime.table(), report.table());
+    assert!(matches!(report.outcome, Outcome::GoalReached { .. }), "{:?}", report.outcome);
+    assert!(report.metrics.summary.collisions.is_empty(), "{:?}", report.metrics.summary.collisions);
+    // The walls are discovered on the way: the first route (through the
+    // unexplored rooms) is blocked, and new ones are computed.
+    assert!(routes >= 2 && replans >= 1, "{routes} routes, {replans} re-plans");
+    let samples = &report.metrics.samples;
+    let replanning: Vec<_> = samples.iter().filter(|s| s.label == "Replanning").collect();
+    assert!(!replanning.is_empty(), "some time re-planning");
+    // The reactive layer keeps the robot moving while the route is computed:
+    // never a second at a standstill in Replanning.
+    let dt = samples[1].t - samples[0].t;
+    let mut still = 0.0f64;
+    let mut longest = 0.0f64;
+    for s in samples {
+        if s.label == "Replanning" && s.v < 0.02 {
+            still += dt;
+            longest = longest.max(still);
+        } else {
+            still = 0.0;
+        }
+    }
+    assert!(longest < 1.0, "stood still {longest:.1} s while re-planning");
+    let mean = |label: &str| {
+        let v: Vec<f64> = samples.iter().filter(|s| s.label == label).map(|s| s.v).collect();
+        v.iter().sum::<f64>() / v.len().max(1) as f64
+    };
+    assert!(mean("Replanning") > 0.5 * mean("Following"), "{} against {}", mean("Replanning"), mean("Following"));
+}
+
+/// rules/dla.situ with its route planner asleep in every state: the
+/// reactive layer alone, heading for the goal.
+fn reactive_only() -> String {
+    let text = source();
+    let start = text.find("agent RoutePlanner").unwrap();
+    let table = start + text[start..].find("    table {").unwrap();
+    let end = table + text[table..].find("    }\n").unwrap() + "    }\n".len();
+    format!("{}    table {{\n        _ => sleep\n    }}\n{}", &text[..table], &text[end..])
+}
+
+#[test]
+fn the_route_makes_the_mission_shorter_than_the_reactive_layer_alone() {
+    let (with_route, _, _) = run(compile("dla.situ", &source()), &offices(), 1, 200.0);
+    let Outcome::GoalReached { time } = with_route.outcome else { panic!("{:?}", with_route.outcome) };
+    // Alone, given half as long again as the layers needed, it has not arrived.
+    let until = 1.5 * time;
+    let (alone, routes, _) = run(compile("reactive-only.situ", &reactive_only()), &offices(), 1, until);
+    println!("with the route: {time:.1} s; the reactive layer alone: {}", alone.outcome.describe());
+    assert_eq!(routes, 0, "no route was computed");
+    assert!(matches!(alone.outcome, Outcome::Timeout { .. }), "{:?}", alone.outcome);
+    // Safely: no collision either way.
+    assert!(alone.metrics.summary.collisions.is_empty(), "{:?}", alone.metrics.summary.collisions);
+}
+
+#[test]
+fn an_unreachable_goal_ends_in_unreachable() {
+    // The second door walled up: the goal's room is closed.
+    let text = scenario::DLA_OFFICES.replace(
+        "[[10.8, 0.0], [11.0, 0.0], [11.0, 1.0], [10.8, 1.0]]",
+        "[[10.8, 0.0], [11.0, 0.0], [11.0, 2.5], [10.8, 2.5]]",
+    );
+    assert_ne!(text, scenario::DLA_OFFICES, "the door's wall is in the scenario");
+    let closed = scenario::parse(&text).expect("a valid scenario");
+    let (report, routes, _) = run(compile("dla.situ", &source()), &closed, 1, 200.0);
+    assert!(
+        matches!(&report.outcome, Outcome::Stopped { state, .. } if state == "Unreachable"),
+        "{:?}",
+        report.outcome
+    );
+    assert!(routes >= 1, "routes were tried through the unexplored rooms first");
+    assert!(report.metrics.summary.collisions.is_empty());
+}
