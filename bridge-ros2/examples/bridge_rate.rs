@@ -15,11 +15,11 @@
 
 use ros2_client::service::ServiceMapping;
 use ros2_client::{Context, ContextOptions, MessageTypeName, Name, NodeName, NodeOptions, QosProfile, ServiceTypeName};
-use serde::Serialize;
 use situ_bridge_ros2::core::Core;
 use situ_bridge_ros2::dds::{self, Options, Rmw};
 use situ_bridge_ros2::msgs::{
-    ChangeStateRequest, ChangeStateResponse, GetStateRequest, GetStateResponse, Header, State,
+    ChangeStateRequest, ChangeStateResponse, GetStateRequest, GetStateResponse, Header, LaserScan, Point, Pose,
+    PoseStamped, Quaternion, State,
 };
 use situ_compiler::{bundle, check_source};
 use situ_grammar::diag::FileId;
@@ -31,26 +31,6 @@ const DOMAIN: u16 = 77;
 const RULES: &str = include_str!("../../tests/ros2/amr.situ");
 const MAP: &str = include_str!("../../tests/ros2/amr.toml");
 const NODES: [&str; 4] = ["costmap", "planner", "recovery", "controller"];
-
-#[derive(Serialize, Clone)]
-struct LaserScan {
-    header: Header,
-    angle_min: f32,
-    angle_max: f32,
-    angle_increment: f32,
-    time_increment: f32,
-    scan_time: f32,
-    range_min: f32,
-    range_max: f32,
-    ranges: Vec<f32>,
-    intensities: Vec<f32>,
-}
-
-#[derive(Serialize, Clone)]
-struct PoseStamped {
-    header: Header,
-    pose: ([f64; 3], [f64; 4]),
-}
 
 fn scan(nearest: f32) -> LaserScan {
     let mut ranges = vec![3.0f32; 360];
@@ -172,7 +152,11 @@ fn main() {
         }
     };
     wait(&|| (0..4).all(|n| requests(n, 1) == 1), 20);
-    let goal = PoseStamped { header: Header::default(), pose: ([4.0, 2.0, 0.0], [0.0, 0.0, 0.0, 1.0]) };
+    let pose = Pose {
+        position: Point { x: 4.0, y: 2.0, z: 0.0 },
+        orientation: Quaternion { w: 1.0, ..Quaternion::default() },
+    };
+    let goal = PoseStamped { header: Header::default(), pose };
     let navigating = || requests(3, 3) >= 1;
     let end = Instant::now() + Duration::from_secs(20);
     // Messages published before the rate phase (the bridge may have missed

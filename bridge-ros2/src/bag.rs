@@ -166,11 +166,7 @@ impl Bag {
 
     /// A message the bridge publishes, serialized as ROS 2 does (CDR, little endian).
     pub fn write_serde<T: Serialize>(&mut self, topic: &str, time: u64, msg: &T) -> io::Result<()> {
-        let mut bytes = vec![0, 1, 0, 0];
-        bytes.extend(
-            rustdds::cdr_encoding::to_vec::<T, byteorder::LittleEndian>(msg)
-                .map_err(|e| io::Error::other(e.to_string()))?,
-        );
+        let bytes = crate::msgs::to_cdr(msg).map_err(io::Error::other)?;
         self.write(topic, time, &bytes)
     }
 

@@ -2,6 +2,7 @@
 //! the state and the lifecycle requests out, nodes answering or not.
 
 use super::*;
+use crate::msgs::{LaserScan, Point, Pose, PoseStamped, Quaternion};
 use serde::Serialize;
 use situ_compiler::{bundle, check_source};
 
@@ -25,23 +26,7 @@ fn core() -> Core {
 }
 
 fn cdr<T: Serialize>(msg: &T) -> Vec<u8> {
-    let mut out = vec![0, 1, 0, 0];
-    out.extend(rustdds::cdr_encoding::to_vec::<T, byteorder::LittleEndian>(msg).unwrap());
-    out
-}
-
-#[derive(Serialize)]
-struct LaserScan {
-    header: Header,
-    angle_min: f32,
-    angle_max: f32,
-    angle_increment: f32,
-    time_increment: f32,
-    scan_time: f32,
-    range_min: f32,
-    range_max: f32,
-    ranges: Vec<f32>,
-    intensities: Vec<f32>,
+    crate::msgs::to_cdr(msg).unwrap()
 }
 
 fn scan(nearest: f32) -> Vec<u8> {
@@ -61,14 +46,9 @@ fn scan(nearest: f32) -> Vec<u8> {
     })
 }
 
-#[derive(Serialize)]
-struct PoseStamped {
-    header: Header,
-    pose: ([f64; 3], [f64; 4]),
-}
-
 fn goal(x: f64, y: f64) -> Vec<u8> {
-    cdr(&PoseStamped { header: Header::default(), pose: ([x, y, 0.0], [0.0, 0.0, 0.0, 1.0]) })
+    let pose = Pose { position: Point { x, y, z: 0.0 }, orientation: Quaternion { w: 1.0, ..Quaternion::default() } };
+    cdr(&PoseStamped { header: Header::default(), pose })
 }
 
 fn requests(out: &[Output]) -> Vec<(usize, &'static str)> {
