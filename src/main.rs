@@ -131,6 +131,14 @@ enum Command {
         /// DLA: the reactive layer does not learn on line (the case base is used as it is).
         #[arg(long)]
         no_learning: bool,
+        /// DLA: N successive missions (seeds --seed, --seed + 1, …), one case base learning
+        /// through them: a line per mission, the curve in --out (experience.svg).
+        #[arg(long, value_name = "N", conflicts_with_all = ["compare", "record", "foxglove", "serve"])]
+        missions: Option<u64>,
+        /// DLA, with --missions: held-out missions (learning off) per evaluation of the case base,
+        /// before the first learning mission, after the last and about every N/6 between (0: none).
+        #[arg(long, value_name = "M", default_value_t = 8, requires = "missions")]
+        evaluate: u64,
         /// Serve the run live over Foxglove's WebSocket protocol at this address (the
         /// recording's channels and messages; waits for a client, then runs in real time).
         #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8765",
@@ -421,6 +429,8 @@ fn main() -> ExitCode {
             compare,
             cases,
             no_learning,
+            missions,
+            evaluate,
             foxglove,
             serve,
             script,
@@ -452,6 +462,8 @@ fn main() -> ExitCode {
                     foxglove,
                     serve,
                     dla,
+                    missions,
+                    evaluate,
                 })
             } else {
                 cmd::distributed::run(cmd::distributed::Args {

@@ -184,3 +184,38 @@ fn dla_reads_and_writes_its_case_base_and_refuses_a_bad_one_untouched() {
         assert_eq!(std::fs::read_to_string(&cases).unwrap(), bad, "left as it was");
     }
 }
+
+#[test]
+fn dla_missions_print_the_experience_and_draw_its_curve() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = dir.path().join("cases.txt");
+    let out = dir.path().join("out");
+    let o =
+        situ(&["run", "rules/dla.situ", "--missions", "2", "--evaluate", "1", "--cases", s(&cases), "--out", s(&out)]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    assert!(stdout.contains("2 learning mission(s), seeds 1–2"), "{stdout}");
+    // A line per learning mission, and evaluations after 0, 1 and 2.
+    assert!(stdout.contains("        1     1  goal at ") && stdout.contains("        2     2  goal at "), "{stdout}");
+    assert!(stdout.contains("held-out mission(s) (seeds 1000000–1000000), learning off"), "{stdout}");
+    let evaluations = stdout.lines().filter(|l| l.contains("1/1 100 %") || l.contains("0/1   0 %")).count();
+    assert_eq!(evaluations, 3, "{stdout}");
+    assert!(stdout.contains("× real time"), "{stdout}");
+    let svg = std::fs::read_to_string(out.join("experience.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.contains("held-out missions done"), "{}", &svg[..100.min(svg.len())]);
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("experience.json")).unwrap()).unwrap();
+    assert_eq!(json["missions"].as_array().unwrap().len(), 2);
+    assert_eq!(json["evaluations"].as_array().unwrap().len(), 3);
+    // The base grew, and was written.
+    let written = std::fs::read_to_string(&cases).unwrap();
+    let n: usize = written.lines().nth(4).and_then(|l| l.strip_prefix("cases ")).unwrap().parse().unwrap();
+    assert!(n > 343, "{n} cases");
+    // Not a DLA stack, or no mission: usage.
+    for args in
+        [&["run", "rules/outdoor.situ", "--missions", "2"][..], &["run", "rules/dla.situ", "--missions", "0"][..]]
+    {
+        let o = situ(args);
+        assert_eq!(code(&o), 2, "{args:?}: {}", text(&o));
+        assert!(String::from_utf8_lossy(&o.stderr).contains("--missions"), "{}", text(&o));
+    }
+}

@@ -61,6 +61,8 @@ pub const DAFFLON_4: &str = include_str!("../scenarios/dafflon-4.toml");
 /// DLA's offices: rooms the robot has not seen, a dead end on the straight
 /// line to the goal, a person walking (`sim/scenarios/dla-offices.toml`).
 pub const DLA_OFFICES: &str = include_str!("../scenarios/dla-offices.toml");
+/// DLA's unseen obstacle field for the reactive layer alone (`sim/scenarios/dla-field.toml`).
+pub const DLA_FIELD: &str = include_str!("../scenarios/dla-field.toml");
 
 /// Why a scenario was refused. Each variant names the field or the place.
 #[derive(Debug, Clone, PartialEq)]
@@ -333,6 +335,7 @@ pub fn builtin(name: &str) -> Option<Scenario> {
         "outdoor-default" => OUTDOOR_DEFAULT,
         "dafflon-4" => DAFFLON_4,
         "dla-offices" => DLA_OFFICES,
+        "dla-field" => DLA_FIELD,
         _ => return None,
     };
     parse(text).ok()

@@ -7,7 +7,12 @@
 //! - while a new route is computed the reactive layer keeps the robot moving;
 //! - with the topological route the mission is shorter than with the
 //!   reactive layer alone (which does not find the doors);
-//! - a goal that cannot be reached ends in `Unreachable`, not in a hang.
+//! - a goal that cannot be reached ends in `Unreachable`, not in a hang;
+//! - experience: after missions learning on line, the cases alone (no
+//!   teacher) do held-out missions the trained base failed, and the teacher
+//!   is needed less and less;
+//! - in `dla-field` (an obstacle field it has not seen) the layers reach the
+//!   goal, and the reactive layer alone touches nothing.
 
 use situ_compiler::bundle::Content;
 use situ_sim::scenario::{self, Scenario};
@@ -117,4 +122,52 @@ fn an_unreachable_goal_ends_in_unreachable() {
     );
     assert!(routes >= 1, "routes were tried through the unexplored rooms first");
     assert!(report.metrics.summary.collisions.is_empty());
+}
+
+/// The held-out missions' counts: (done, collisions).
+fn counts(e: &situ_sim::dla::experience::Evaluation) -> (usize, usize) {
+    (e.share().done, e.collisions())
+}
+
+#[test]
+fn experience_lets_the_cases_alone_do_what_the_trained_base_could_not() {
+    // Urdiales et al.: the reactive layer improves with experience. The
+    // base trained by the scripted driver, then 4 missions learning on line
+    // (the teacher correcting novel, unsafe and standstill cases), each
+    // base tried on the same 8 held-out missions with learning off.
+    use situ_sim::stack::{dla, experience};
+    use std::sync::Mutex;
+    let content = compile("dla.situ", &source());
+    let world = offices().world;
+    let cases = dla::CasesHandle(Arc::new(Mutex::new(dla::train(1, dla::TRAINING_SECONDS, dla::NOVELTY))));
+    let before = experience::evaluate(&content, &world, 0, 8, 300.0, &cases, &mut |_, _| {}).unwrap();
+    let mut learnt = Vec::new();
+    for k in 0..4 {
+        let m = experience::mission(&content, &world, k + 1, 1 + k as u64, 300.0, true, &cases, &mut |_| {}).unwrap();
+        assert!(m.done, "learning mission {}: {}", k + 1, m.outcome);
+        learnt.push(m.learnt);
+    }
+    let after = experience::evaluate(&content, &world, 4, 8, 300.0, &cases, &mut |_, _| {}).unwrap();
+    println!("before: {:?}; learnt on line: {learnt:?}; after: {:?}", counts(&before), counts(&after));
+    // Before, the cases alone fail some held-out missions; after, none,
+    // and none ends in a collision.
+    assert!(counts(&before).0 < 8, "the trained base alone already did every mission: {:?}", counts(&before));
+    assert_eq!(counts(&after), (8, 0), "{:#?}", after.missions);
+    // The teacher is needed less and less.
+    assert!(learnt[3] < learnt[0] / 2, "cases learnt on line per mission: {learnt:?}");
+}
+
+#[test]
+fn the_layers_cross_an_unseen_obstacle_field_and_the_reactive_layer_alone_hits_nothing() {
+    let field = scenario::builtin("dla-field").expect("built in");
+    let (report, routes, _) = run(compile("dla.situ", &source()), &field, 1, 200.0);
+    assert!(report.outcome.success(), "{:?}", report.outcome);
+    assert!(routes >= 1);
+    // Alone, the reactive layer gets caught in front of a box square across
+    // its line to the goal (the local minimum the route is for), but it
+    // never touches anything: its sweep check turns it on the spot.
+    let (alone, routes, _) = run(compile("reactive-only.situ", &reactive_only()), &field, 1, 120.0);
+    assert_eq!(routes, 0);
+    assert!(alone.metrics.summary.collisions.is_empty(), "{:?}", alone.metrics.summary.collisions);
+    assert!(!matches!(alone.outcome, Outcome::Collision { .. }), "{:?}", alone.outcome);
 }

@@ -4,6 +4,7 @@ pub mod bench;
 pub mod build;
 pub mod check;
 pub mod distributed;
+pub mod experience;
 pub mod explain;
 pub mod export;
 pub mod fmt;

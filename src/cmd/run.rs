@@ -40,6 +40,11 @@ pub struct Args {
     /// Serve the Supervisor's page of the run live at this address.
     pub serve: Option<String>,
     pub dla: DlaArgs,
+    /// DLA: successive missions, one case base learning through them
+    /// ([`super::experience`]).
+    pub missions: Option<u64>,
+    /// DLA: held-out missions per evaluation of the experience.
+    pub evaluate: u64,
 }
 
 /// DLA's options (`rules/dla.situ`).
@@ -54,7 +59,7 @@ pub struct DlaArgs {
 /// The case base of a DLA run: the file's, or a new one trained by the
 /// scripted driver when the file does not exist (or none was given). A file
 /// that cannot be used is an error (exit 2), and it is left as it was.
-fn dla_cases(args: &DlaArgs, seed: u64) -> Result<(stack::dla::Cases, bool), String> {
+pub(super) fn dla_cases(args: &DlaArgs, seed: u64) -> Result<(stack::dla::Cases, bool), String> {
     match &args.cases {
         Some(path) if path.exists() => stack::dla::Cases::read(path)
             .map(|c| (c, true))
@@ -71,7 +76,9 @@ fn load_scenario(name: &str) -> Result<Scenario, String> {
     }
     let path = Path::new(name);
     if !path.exists() && !name.ends_with(".toml") {
-        return Err(format!("no built-in scenario `{name}` (outdoor-default, dafflon-4) and no such file"));
+        return Err(format!(
+            "no built-in scenario `{name}` (outdoor-default, dafflon-4, dla-offices, dla-field) and no such file"
+        ));
     }
     scenario::load(path).map_err(|e| format!("scenario `{name}`: {e}"))
 }
@@ -91,7 +98,7 @@ pub fn run(args: Args) -> u8 {
     let file_bytes = program.bytes.clone();
     let kind = match StackKind::of(&content) {
         Ok(k) => k,
-        Err(_) if args.scenario.is_none() && args.compare.is_none() => {
+        Err(_) if args.scenario.is_none() && args.compare.is_none() && args.missions.is_none() => {
             // Any other robot: its first script, every agent a stand-in.
             let Args { file, until, out, record, foxglove, serve, .. } = args;
             return super::scripted::run(super::scripted::Args {
@@ -131,6 +138,9 @@ pub fn run(args: Args) -> u8 {
     }
     if let Some(list) = &args.compare {
         return compare(&args, content, kind, &scenario, list);
+    }
+    if let Some(n) = args.missions {
+        return super::experience::run(&args, content, kind, &scenario, n, args.evaluate, until);
     }
 
     // The recording: at --record, else in --out.
@@ -280,7 +290,7 @@ fn dla_pictures(
     if let Some(map) = &p.map {
         let title = format!("{} — {}: the last map, its regions, the last path", scenario.name, report.rules);
         let svg =
-            situ_sim::dla::draw::draw(&map.grid, Some(&map.pyramid), &[], &p.path, &trajectory, start, goal, &title);
+            situ_sim::dla::draw::draw(&map.grid, Some(map.pyramid()), &[], &p.path, &trajectory, start, goal, &title);
         out.push(("dla.svg", svg));
     }
     if let Some(route) = &p.route {
@@ -288,7 +298,7 @@ fn dla_pictures(
             format!("{} — {}: route {} on the map it was planned on", scenario.name, report.rules, route.number);
         let svg = situ_sim::dla::draw::draw(
             &route.map.grid,
-            Some(&route.map.pyramid),
+            Some(route.map.pyramid()),
             &route.regions,
             &p.path,
             &trajectory,

@@ -213,17 +213,23 @@ impl OccupancyGrid {
         self.class(x, y) == CellClass::Unknown
     }
 
-    /// Adds `delta` to the log-odds of the cell at index `i`, clamped.
-    fn add(&mut self, i: usize, delta: f32) {
-        let l = &mut self.logodds[i];
-        *l = (*l + delta).clamp(self.params.l_min, self.params.l_max);
+    /// Adds `delta` to the log-odds of the cell at index `i`, clamped;
+    /// whether the cell changed class.
+    fn add(&mut self, i: usize, delta: f32) -> bool {
+        let before = self.logodds[i];
+        let after = (before + delta).clamp(self.params.l_min, self.params.l_max);
+        self.logodds[i] = after;
+        before.to_bits() != after.to_bits() && self.classify(probability(before)) != self.classify(probability(after))
     }
 
     /// Updates the grid with one scan taken at `pose`: for each beam, the
     /// cells it crossed become freer and, when it hit something before its
     /// maximum range, the cell of the hit more occupied. Beams with a
-    /// non-finite or negative range are ignored.
-    pub fn update(&mut self, pose: &Pose, beams: &[Beam]) {
+    /// non-finite or negative range are ignored. Returns how many cell
+    /// updates changed a cell's class (free, occupied, unknown): 0 when the
+    /// classes are as they were.
+    pub fn update(&mut self, pose: &Pose, beams: &[Beam]) -> usize {
+        let mut changed = 0;
         let mut cells = Vec::new();
         for beam in beams {
             if !(beam.range.is_finite() && beam.max_range.is_finite() && beam.range >= 0.0) {
@@ -238,13 +244,14 @@ impl OccupancyGrid {
             let hit_cell = if hit { self.cell_of(end).map(|(x, y)| self.index(x, y)) } else { None };
             for &i in &cells {
                 if Some(i) != hit_cell {
-                    self.add(i, self.params.l_free);
+                    changed += usize::from(self.add(i, self.params.l_free));
                 }
             }
             if let Some(i) = hit_cell {
-                self.add(i, self.params.l_occupied);
+                changed += usize::from(self.add(i, self.params.l_occupied));
             }
         }
+        changed
     }
 
     /// The indices of the cells the segment `a → b` crosses, in order, from

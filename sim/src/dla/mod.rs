@@ -8,10 +8,13 @@
 //! - [`cases`]: the reactive layer learnt by cases (Urdiales et al. 2006):
 //!   a k-d tree case base, on-line learning, its file, a scripted driver;
 //! - [`draw`]: an SVG picture of a grid, its regions, a route, a path and a
-//!   trajectory.
+//!   trajectory;
+//! - [`experience`]: successive missions learning on line, their table and
+//!   their curve.
 
 pub mod cases;
 pub mod draw;
+pub mod experience;
 pub mod grid;
 pub mod pyramid;
 pub mod route;

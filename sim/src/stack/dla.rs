@@ -27,11 +27,11 @@ use crate::dla::route::{plan_path, plan_route, PathParams, RouteParams};
 use crate::geom::{edges, unit, v2, wrap_angle, Pose, Vec2};
 use crate::noise::Noise;
 use crate::sensors::Value as SimValue;
-use crate::vehicle::{Command, VehicleParams};
+use crate::vehicle::{integrate, Command, VehicleParams};
 use crate::world::{ObstacleView, World};
 use situ_compiler::bundle::{Content, Mode};
 use situ_runtime::agent::{Agent, Body, Context};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// The agents `rules/dla.situ` declares.
 pub const AGENTS: &[&str] = &["Laser", "Localization", "Mapper", "RoutePlanner", "PathPlanner", "Reactive", "Base"];
@@ -62,9 +62,18 @@ pub const REACTIVE_RANGE: f64 = 2.0;
 pub const CELL: f64 = 0.1;
 /// The route planner's computing time (ns of simulated time).
 pub const PLAN_TIME: u64 = 800_000_000;
-/// The clearance all round that a turn on the spot needs (m): the
-/// corners' 0.27 m and the 0.08 m circle the centre drifts on.
-pub const TURN_CLEARANCE: f64 = 0.36;
+/// How far to the side of the laser (the robot's centre) a turn on the
+/// spot turns about (m): the indoor robot on full lock, 0.2 m / tan 1.2.
+pub const TURN_RADIUS: f64 = 0.078;
+/// The disc a turn on the spot sweeps about its centre (m): the far
+/// corners of the 0.4 m × 0.36 m body, √(0.2² + (0.18 + 0.078)²) = 0.33,
+/// and 0.03 to spare.
+pub const TURN_SWEEP: f64 = 0.36;
+/// How far ahead the body must be clear for the reactive layer to creep
+/// straight on when it can turn neither way (m).
+pub const CREEP: f64 = 0.15;
+/// Below this turn rate (rad/s) a command slower than a crawl is a stop.
+pub const STILL_TURN: f64 = 0.05;
 /// The slowest the Base rolls while it turns (m/s).
 pub const CRAWL: f64 = 0.03;
 /// How far along the path the reactive layer is sent (m).
@@ -88,14 +97,30 @@ pub struct Scan {
 pub struct PoseFix(pub Pose);
 
 /// The Mapper's map: the grid and its pyramid, numbered.
+///
+/// The pyramid is built from the grid the first time someone asks for it
+/// (the route planner when it computes a route, the pictures at the end)
+/// and then shared by every copy of the snapshot: a map the robot only
+/// follows a route on costs a grid copy, not a pyramid.
 #[derive(Debug, Clone)]
 pub struct MapSnapshot {
-    /// Incremented at every rebuild.
+    /// Incremented when a cell changes class.
     pub version: u64,
     /// The occupancy grid.
     pub grid: Arc<OccupancyGrid>,
-    /// Its pyramid: the regions of the topological map.
-    pub pyramid: Arc<Pyramid>,
+    params: PyramidParams,
+    pyramid: Arc<OnceLock<Pyramid>>,
+}
+
+impl MapSnapshot {
+    /// A snapshot of `grid`, its pyramid to be built with `params`.
+    pub fn new(version: u64, grid: Arc<OccupancyGrid>, params: PyramidParams) -> MapSnapshot {
+        MapSnapshot { version, grid, params, pyramid: Arc::new(OnceLock::new()) }
+    }
+    /// Its pyramid: the regions of the topological map (built on first use).
+    pub fn pyramid(&self) -> &Pyramid {
+        self.pyramid.get_or_init(|| Pyramid::build(&self.grid, &self.params))
+    }
 }
 
 /// A route and the map it was planned on.
@@ -322,11 +347,9 @@ struct Mapper {
     grid: OccupancyGrid,
     pyramid: PyramidParams,
     version: u64,
-    changed: bool,
-    /// Scans fused since the pyramid was last built.
+    /// The latest snapshot, replaced when a cell changes class.
     last: Option<MapSnapshot>,
     last_scan: u64,
-    classes: Vec<u8>,
     plans: SharedPlans,
 }
 
@@ -337,15 +360,12 @@ impl Mapper {
         let w = ((hi.x - lo.x + 2.0) / CELL).ceil() as usize;
         let h = ((hi.y - lo.y + 2.0) / CELL).ceil() as usize;
         let grid = OccupancyGrid::new(w.clamp(8, 1024), h.clamp(8, 1024), CELL, origin, GridParams::default());
-        let classes = vec![2; grid.len()];
         Mapper {
             grid,
             pyramid: PyramidParams { max_extent: 24, ..PyramidParams::default() },
             version: 0,
-            changed: true,
             last: None,
             last_scan: 0,
-            classes,
             plans,
         }
     }
@@ -359,31 +379,21 @@ impl Agent for Mapper {
         names(&["map"])
     }
     fn step(&mut self, cx: &mut Context<'_>) {
+        let mut changed = 0;
         for d in cx.inputs() {
             if let Some(s) = d.body.get::<Scan>() {
                 if d.time > self.last_scan {
                     self.last_scan = d.time;
-                    self.grid.update(&s.pose, &s.beams);
+                    changed += self.grid.update(&s.pose, &s.beams);
                 }
             }
         }
-        // Rebuilt when a cell changed class since the last build.
-        let mut changed = self.changed;
-        for i in 0..self.grid.len() {
-            let c = self.grid.class_index(i) as u8;
-            if self.classes[i] != c {
-                self.classes[i] = c;
-                changed = true;
-            }
-        }
-        if changed || self.last.is_none() {
+        // A new snapshot when a cell changed class since the last one.
+        if changed > 0 || self.last.is_none() {
             self.version += 1;
-            let pyramid = Pyramid::build(&self.grid, &self.pyramid);
-            let snap =
-                MapSnapshot { version: self.version, grid: Arc::new(self.grid.clone()), pyramid: Arc::new(pyramid) };
+            let snap = MapSnapshot::new(self.version, Arc::new(self.grid.clone()), self.pyramid);
             lock_plans(&self.plans).map = Some(snap.clone());
             self.last = Some(snap);
-            self.changed = false;
         }
         if let Some(snap) = &self.last {
             cx.send(Body::local(snap.clone()));
@@ -428,7 +438,7 @@ impl Agent for RoutePlanner {
         }
         let (Some((_, map)), Some(fix)) = (&self.map, fresh(&self.pose, now)) else { return };
         let params = RouteParams { allow_unexplored: true, unexplored_cost: 3.0 };
-        match plan_route(&map.pyramid, &map.grid, fix.0.pos(), self.goal, &params) {
+        match plan_route(map.pyramid(), &map.grid, fix.0.pos(), self.goal, &params) {
             Some(regions) => {
                 self.number += 1;
                 let n = regions.len() as i64;
@@ -522,7 +532,7 @@ impl Agent for PathPlanner {
         if self.path.as_ref().is_none_or(|(n, _)| *n != number) {
             let path = plan_path(
                 &route.map.grid,
-                &route.map.pyramid,
+                route.map.pyramid(),
                 &route.regions,
                 fix.0.pos(),
                 self.goal,
@@ -576,6 +586,7 @@ impl Agent for PathPlanner {
 
 struct Reactive {
     goal: Vec2,
+    vehicle: VehicleParams,
     cases: SharedCases,
     learn: bool,
     scan: Option<(u64, Scan)>,
@@ -614,11 +625,10 @@ impl Agent for Reactive {
             .filter(|&i| Situation::sector_angle(i, SECTORS).abs() <= std::f64::consts::FRAC_PI_4 + 1e-9)
             .map(|i| s.ranges[i])
             .fold(f64::INFINITY, f64::min);
-        let unsafe_case = |c: &CaseCommand| c.speed > 0.0 && ahead < driver().safety;
+        // So is a case that leaves the robot standing where it could move.
+        let wrong = |c: &CaseCommand| (c.speed > 0.0 && ahead < driver().safety) || standstill(c);
         let command = match nearest {
-            Some((i, _)) if !(self.learn && (novel || unsafe_case(&cases.cases()[i].command))) => {
-                cases.cases()[i].command
-            }
+            Some((i, _)) if !(self.learn && (novel || wrong(&cases.cases()[i].command))) => cases.cases()[i].command,
             _ => {
                 let c = cases::drive(&s, MAX_RANGE, &driver());
                 let case = Case { situation: s, command: c };
@@ -630,15 +640,107 @@ impl Agent for Reactive {
             }
         };
         drop(cases);
-        // Turning "in place" sweeps the corners all round: not with
-        // something within reach of them on any side.
-        let command = if command.speed < CRAWL && nearest_all < TURN_CLEARANCE {
-            CaseCommand { speed: 0.0, turn_rate: 0.0 }
+        // Never standing still where the body could creep straight on.
+        let command = if standstill(&command) && ahead_clear(&scan.beams, CREEP) {
+            CaseCommand { speed: CRAWL, turn_rate: 0.0 }
         } else {
             command
         };
+        // Turning "in place" sweeps a disc about a centre to the side it
+        // turns to: that way if nothing is within the disc, else the other
+        // way if nothing is within that one, else straight on at a crawl if
+        // nothing is in the body's way, else not at all.
+        let command = if command.speed < CRAWL && nearest_all < TURN_RADIUS + TURN_SWEEP {
+            let side = if command.turn_rate < 0.0 { -1.0 } else { 1.0 };
+            if turn_clear(&scan.beams, side) {
+                command
+            } else if turn_clear(&scan.beams, -side) {
+                CaseCommand { speed: command.speed, turn_rate: -command.turn_rate }
+            } else if ahead_clear(&scan.beams, CREEP) {
+                CaseCommand { speed: CRAWL, turn_rate: 0.0 }
+            } else {
+                CaseCommand { speed: 0.0, turn_rate: 0.0 }
+            }
+        } else {
+            command
+        };
+        // Last, the body's sweep over the next half second: a command that
+        // would bring a reading within it becomes a turn on the spot (the
+        // way it turned, else the other), or a stop.
+        let command = if sweep_clear(&scan.beams, &command, &self.vehicle) {
+            command
+        } else {
+            let side = if command.turn_rate < 0.0 { -1.0 } else { 1.0 };
+            let turn = driver().max_turn_rate;
+            if turn_clear(&scan.beams, side) {
+                CaseCommand { speed: 0.0, turn_rate: side * turn }
+            } else if turn_clear(&scan.beams, -side) {
+                CaseCommand { speed: 0.0, turn_rate: -side * turn }
+            } else {
+                CaseCommand { speed: 0.0, turn_rate: 0.0 }
+            }
+        };
         cx.send(Body::local(DriveCommand(command)));
     }
+}
+
+/// Whether the Base stops on a command: slower than a crawl and turning
+/// less than [`STILL_TURN`].
+fn standstill(c: &CaseCommand) -> bool {
+    c.speed < CRAWL && c.turn_rate.abs() < STILL_TURN
+}
+
+/// Whether a turn on the spot to `side` (1 left, −1 right) keeps the body
+/// clear of every reading: nothing within [`TURN_SWEEP`] of the centre it
+/// turns about, [`TURN_RADIUS`] to that side.
+fn turn_clear(beams: &[Beam], side: f64) -> bool {
+    let centre = v2(0.0, side * TURN_RADIUS);
+    beams.iter().filter(|b| b.range.is_finite() && b.range < b.max_range).all(|b| {
+        let p = v2(b.range * b.angle.cos(), b.range * b.angle.sin());
+        (p - centre).norm() > TURN_SWEEP
+    })
+}
+
+/// How far ahead (s) [`sweep_clear`] follows a command.
+pub const SWEEP_TIME: f64 = 0.5;
+/// What the body keeps from every reading in [`sweep_clear`] (m).
+pub const SWEEP_MARGIN: f64 = 0.04;
+
+/// Whether the Base driving `c` (as [`Base`] turns it into a speed and a
+/// steering angle, held) for [`SWEEP_TIME`] keeps the body, grown by
+/// [`SWEEP_MARGIN`], clear of every reading of the scan.
+fn sweep_clear(beams: &[Beam], c: &CaseCommand, vehicle: &VehicleParams) -> bool {
+    if standstill(c) {
+        return true;
+    }
+    let v = c.speed.clamp(CRAWL, vehicle.max_speed);
+    let steer = (c.turn_rate * vehicle.wheelbase / v).atan().clamp(-vehicle.max_steer, vehicle.max_steer);
+    let kappa = steer.tan() / vehicle.wheelbase;
+    let reach = v * SWEEP_TIME + vehicle.front.max(vehicle.rear).hypot(vehicle.width / 2.0) + SWEEP_MARGIN;
+    let points: Vec<Vec2> = beams
+        .iter()
+        .filter(|b| b.range.is_finite() && b.range < b.max_range && b.range <= reach)
+        .map(|b| v2(b.range * b.angle.cos(), b.range * b.angle.sin()))
+        .collect();
+    let (front, rear, half) =
+        (vehicle.front + SWEEP_MARGIN, vehicle.rear + SWEEP_MARGIN, vehicle.width / 2.0 + SWEEP_MARGIN);
+    (1..=5).all(|k| {
+        let pose = integrate(Pose::new(0.0, 0.0, 0.0), v, kappa, SWEEP_TIME * k as f64 / 5.0);
+        points.iter().all(|&p| {
+            let q = pose.to_local(p);
+            !(q.x <= front && q.x >= -rear && q.y.abs() <= half)
+        })
+    })
+}
+
+/// Whether moving straight ahead by `reach` (m) keeps the body clear: no
+/// reading in the strip the body sweeps (0.2 m ahead of the centre, 0.18 m
+/// to each side, and 0.02 m to spare).
+fn ahead_clear(beams: &[Beam], reach: f64) -> bool {
+    beams.iter().filter(|b| b.range.is_finite() && b.range < b.max_range).all(|b| {
+        let p = v2(b.range * b.angle.cos(), b.range * b.angle.sin());
+        !(p.x > 0.0 && p.x < 0.22 + reach && p.y.abs() < 0.2)
+    })
 }
 
 struct Base {
@@ -660,7 +762,7 @@ impl Agent for Base {
         let steer = p.vehicle.state.steer;
         p.command = match fresh(&self.input, cx.now()) {
             Some(DriveCommand(c)) if cx.mode() == Mode::Running && cx.function() == Some("drive") => {
-                if c.speed < CRAWL && c.turn_rate.abs() < 0.05 {
+                if standstill(c) {
                     Command { v: 0.0, steer }
                 } else {
                     // A tricycle turns only while it rolls: "turn in place" is a crawl on full lock.
@@ -711,7 +813,7 @@ pub fn agents(
             plans: plans.clone(),
             content: c(),
         }),
-        Box::new(Reactive { goal, cases, learn, scan: None, pose: None, subgoal: None, plans }),
+        Box::new(Reactive { goal, vehicle: world.vehicle, cases, learn, scan: None, pose: None, subgoal: None, plans }),
         Box::new(Base { params: world.vehicle, input: None, physics: physics.clone() }),
     ]
 }

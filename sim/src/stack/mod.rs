@@ -23,6 +23,7 @@
 
 pub mod dla;
 pub mod events;
+pub mod experience;
 pub mod merge;
 
 pub use merge::{compare, UgvPrograms};

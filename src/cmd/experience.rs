@@ -1,0 +1,154 @@
+//! `situ run RULES --missions N [--evaluate M]`: DLA's experience. N
+//! successive learning missions on the scenario, seeds `--seed`, `--seed +
+//! 1`, …, one case base carried from each mission to the next and learning
+//! on line (unless `--no-learning`); before the first, after the last and
+//! about every N/6 between, a copy of the base as it stands is tried on M
+//! held-out missions (seeds [`HELD_OUT`]…, default 8) with learning off:
+//! the teacher is gone, the cases alone drive. Prints a line per learning
+//! mission, the halves, the evaluations (the curve: held-out missions done
+//! against experience), and how much simulated time took how much wall
+//! time; with `--out DIR` writes `experience.svg` and `experience.json`;
+//! with `--cases FILE` reads the base before the first mission and writes
+//! it after the last. Exit 0 when the last learning mission and every
+//! held-out mission of the last evaluation are done, 1 otherwise, 2 on
+//! usage or I/O.
+
+use super::run::{dla_cases, Args};
+use super::{FAILED, OK, USAGE};
+use situ_compiler::bundle::Content;
+use situ_sim::dla::experience::{evaluation_points, Experience};
+use situ_sim::scenario::Scenario;
+use situ_sim::stack::experience::{evaluate, mission, HELD_OUT};
+use situ_sim::stack::{self, StackKind, StackRun};
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+/// At most this many missions in one call.
+pub const MAX_MISSIONS: u64 = 10_000;
+
+pub fn run(
+    args: &Args,
+    content: Arc<Content>,
+    kind: StackKind,
+    scenario: &Scenario,
+    missions: u64,
+    held_out: u64,
+    until: f64,
+) -> u8 {
+    if kind != StackKind::Dla {
+        eprintln!(
+            "error: --missions runs successive missions of a DLA stack (agents of rules/dla.situ, whose reactive \
+             layer learns); `{}` runs on the {kind:?} stack",
+            args.file.display()
+        );
+        return USAGE;
+    }
+    if !(1..=MAX_MISSIONS).contains(&missions) || held_out > MAX_MISSIONS {
+        eprintln!("error: --missions must be between 1 and {MAX_MISSIONS}, --evaluate at most {MAX_MISSIONS}");
+        return USAGE;
+    }
+    let (cases, read) = match dla_cases(&args.dla, args.seed) {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return USAGE;
+        }
+    };
+    let before = cases.len();
+    let handle = stack::dla::CasesHandle(Arc::new(Mutex::new(cases)));
+    let mut experience = Experience::default();
+    let mut line = super::LiveLine::new();
+    let start = Instant::now();
+    let points = if held_out > 0 { evaluation_points(missions as usize) } else { Vec::new() };
+    let mut ran = || -> Result<(), String> {
+        for k in 0..=missions as usize {
+            if points.contains(&k) {
+                let mut progress = |j: u64, r: &StackRun| {
+                    line.draw(|| format!("after {k}: held-out {}/{held_out}: {}", j + 1, r.progress().line()))
+                };
+                let e = evaluate(&content, &scenario.world, k, held_out, until, &handle, &mut progress)?;
+                experience.evaluations.push(e);
+            }
+            if k == missions as usize {
+                break;
+            }
+            let seed = args.seed.wrapping_add(k as u64);
+            let mut progress =
+                |r: &StackRun| line.draw(|| format!("mission {}/{missions}: {}", k + 1, r.progress().line()));
+            experience.missions.push(mission(
+                &content,
+                &scenario.world,
+                k + 1,
+                seed,
+                until,
+                args.dla.learn,
+                &handle,
+                &mut progress,
+            )?);
+        }
+        Ok(())
+    };
+    let result = ran();
+    line.clear();
+    if let Err(e) = result {
+        eprintln!("error: `{}`: {e}", args.file.display());
+        return USAGE;
+    }
+    let wall = start.elapsed().as_secs_f64();
+    println!(
+        "{} on {}: {missions} learning mission(s), seeds {}–{}; {before} case(s) {}, {}\n",
+        content.source,
+        scenario.name,
+        args.seed,
+        args.seed.wrapping_add(missions - 1),
+        if read { "read" } else { "trained" },
+        if args.dla.learn { "learning on line" } else { "no learning" }
+    );
+    print!("{}", experience.table());
+    if held_out > 0 {
+        println!(
+            "\n  the case base on {held_out} held-out mission(s) (seeds {HELD_OUT}–{}), learning off:\n",
+            HELD_OUT + held_out - 1
+        );
+        print!("{}", experience.evaluation_table());
+    }
+    let simulated = experience.simulated();
+    println!(
+        "\n  simulated {simulated:.0} s ({:.2} h) in {wall:.2} s of wall time: {:.0}× real time",
+        simulated / 3600.0,
+        simulated / wall.max(1e-9)
+    );
+    if let Some(path) = &args.dla.cases {
+        let cases = handle.0.lock().unwrap_or_else(|e| e.into_inner());
+        if let Err(e) = cases.write(path) {
+            eprintln!("error: cannot write the case base `{}`: {e}", path.display());
+            return USAGE;
+        }
+        println!("  case base         {} cases written to {}", cases.len(), path.display());
+    }
+    if let Some(out) = &args.out {
+        let title = format!("{} on {}: experience over {missions} missions", content.source, scenario.name);
+        let svg = match experience.svg(&title) {
+            Ok(s) => s,
+            Err(e) => {
+                eprintln!("error: {e}");
+                return USAGE;
+            }
+        };
+        let json = serde_json::to_string_pretty(&experience).unwrap_or_default();
+        for (name, bytes) in [("experience.svg", svg.as_bytes()), ("experience.json", json.as_bytes())] {
+            if let Err(e) = super::write_atomically(&out.join(name), bytes) {
+                eprintln!("error: cannot write `{}`: {e}", out.join(name).display());
+                return USAGE;
+            }
+        }
+        println!("wrote {}", out.display());
+    }
+    let last_done = experience.missions.last().is_some_and(|m| m.done);
+    let held_out_done = experience.evaluations.last().is_none_or(|e| e.missions.iter().all(|m| m.done));
+    if last_done && held_out_done {
+        OK
+    } else {
+        FAILED
+    }
+}
