@@ -8,9 +8,10 @@
 //! - with the topological route the mission is shorter than with the
 //!   reactive layer alone (which does not find the doors);
 //! - a goal that cannot be reached ends in `Unreachable`, not in a hang;
-//! - experience: after missions learning on line, the cases alone (no
-//!   teacher) do held-out missions the trained base failed, and the teacher
-//!   is needed less and less;
+//! - experience: after missions learning on line, the reactive layer
+//!   alone (no teacher, no route) crosses an obstacle field it has not seen
+//!   more often than the trained base did, and the teacher is needed less
+//!   and less;
 //! - in `dla-field` (an obstacle field it has not seen) the layers reach the
 //!   goal, and the reactive layer alone touches nothing.
 
@@ -124,37 +125,54 @@ fn an_unreachable_goal_ends_in_unreachable() {
     assert!(report.metrics.summary.collisions.is_empty());
 }
 
-/// The held-out missions' counts: (done, collisions).
-fn counts(e: &situ_sim::dla::experience::Evaluation) -> (usize, usize) {
-    (e.share().done, e.collisions())
+/// The reactive layer alone (no route), learning off, across `dla-field`
+/// (an obstacle field none of the cases was learnt in) on seeds 1 to 6:
+/// how many crossed, and how many touched something.
+fn crossings(cases: &situ_sim::stack::dla::CasesHandle) -> (usize, usize) {
+    use situ_sim::stack::{dla, experience};
+    use std::sync::Mutex;
+    let content = compile("reactive-only.situ", &reactive_only());
+    let field = scenario::builtin("dla-field").expect("built in").world;
+    let (mut done, mut hit) = (0, 0);
+    for seed in 1..=6 {
+        // A copy each time: nothing is learnt, but the base is not shared.
+        let copy = dla::CasesHandle(Arc::new(Mutex::new(cases.0.lock().unwrap().clone())));
+        let m = experience::mission(&content, &field, 1, seed, 200.0, false, &copy, &mut |_| {}).unwrap();
+        done += usize::from(m.done);
+        hit += usize::from(m.collision);
+    }
+    (done, hit)
 }
 
 #[test]
-fn experience_lets_the_cases_alone_do_what_the_trained_base_could_not() {
+fn with_experience_the_reactive_layer_alone_crosses_an_unseen_field_more_often() {
     // Urdiales et al.: the reactive layer improves with experience. The
-    // base trained by the scripted driver, then 4 missions learning on line
-    // (the teacher correcting novel, unsafe and standstill cases), each
-    // base tried on the same 8 held-out missions with learning off.
+    // base trained by the scripted driver (in a field of its own), then 8
+    // missions of the whole stack in the offices learning on line (the
+    // teacher correcting novel, unsafe and standstill cases); each base,
+    // alone and learning nothing, tried across the unseen field.
     use situ_sim::stack::{dla, experience};
     use std::sync::Mutex;
     let content = compile("dla.situ", &source());
     let world = offices().world;
     let cases = dla::CasesHandle(Arc::new(Mutex::new(dla::train(1, dla::TRAINING_SECONDS, dla::NOVELTY))));
-    let before = experience::evaluate(&content, &world, 0, 8, 300.0, &cases, &mut |_, _| {}).unwrap();
+    let before = crossings(&cases);
     let mut learnt = Vec::new();
-    for k in 0..4 {
+    for k in 0..8 {
         let m = experience::mission(&content, &world, k + 1, 1 + k as u64, 300.0, true, &cases, &mut |_| {}).unwrap();
         assert!(m.done, "learning mission {}: {}", k + 1, m.outcome);
         learnt.push(m.learnt);
     }
-    let after = experience::evaluate(&content, &world, 4, 8, 300.0, &cases, &mut |_, _| {}).unwrap();
-    println!("before: {:?}; learnt on line: {learnt:?}; after: {:?}", counts(&before), counts(&after));
-    // Before, the cases alone fail some held-out missions; after, none,
-    // and none ends in a collision.
-    assert!(counts(&before).0 < 8, "the trained base alone already did every mission: {:?}", counts(&before));
-    assert_eq!(counts(&after), (8, 0), "{:#?}", after.missions);
+    let after = crossings(&cases);
+    println!("crossed (of 6), touched: before {before:?}, after {after:?}; learnt on line per mission: {learnt:?}");
+    // Crossing the field alone is hard for a purely reactive layer (a box
+    // square across the line to the goal is a local minimum); experience
+    // makes it cross more often, and it never touches anything.
+    assert!(after.0 > before.0, "crossings before {before:?}, after {after:?}");
+    assert_eq!(after.1, 0, "collisions after experience");
     // The teacher is needed less and less.
-    assert!(learnt[3] < learnt[0] / 2, "cases learnt on line per mission: {learnt:?}");
+    let (first, last) = (learnt[0] + learnt[1], learnt[6] + learnt[7]);
+    assert!(2 * last < first, "cases learnt on line per mission: {learnt:?}");
 }
 
 #[test]

@@ -690,15 +690,25 @@ fn standstill(c: &CaseCommand) -> bool {
     c.speed < CRAWL && c.turn_rate.abs() < STILL_TURN
 }
 
-/// Whether a turn on the spot to `side` (1 left, −1 right) keeps the body
-/// clear of every reading: nothing within [`TURN_SWEEP`] of the centre it
-/// turns about, [`TURN_RADIUS`] to that side.
+/// The readings of a scan as points in the robot's frame (m).
+fn points(beams: &[Beam]) -> impl Iterator<Item = Vec2> + '_ {
+    beams
+        .iter()
+        .filter(|b| b.range.is_finite() && b.range < b.max_range)
+        .map(|b| v2(b.range * b.angle.cos(), b.range * b.angle.sin()))
+}
+
+/// Whether a turn on the spot to `side` (1 left, −1 right) from `pose`
+/// (in the frame of `points`) keeps the body clear of them: nothing within
+/// [`TURN_SWEEP`] of the centre it turns about, [`TURN_RADIUS`] to that side.
+fn turn_clear_at(points: &[Vec2], pose: &Pose, side: f64) -> bool {
+    points.iter().all(|&p| (pose.to_local(p) - v2(0.0, side * TURN_RADIUS)).norm() > TURN_SWEEP)
+}
+
+/// [`turn_clear_at`] from where the robot is.
 fn turn_clear(beams: &[Beam], side: f64) -> bool {
-    let centre = v2(0.0, side * TURN_RADIUS);
-    beams.iter().filter(|b| b.range.is_finite() && b.range < b.max_range).all(|b| {
-        let p = v2(b.range * b.angle.cos(), b.range * b.angle.sin());
-        (p - centre).norm() > TURN_SWEEP
-    })
+    let points: Vec<Vec2> = points(beams).collect();
+    turn_clear_at(&points, &Pose::new(0.0, 0.0, 0.0), side)
 }
 
 /// How far ahead (s) [`sweep_clear`] follows a command.
@@ -708,7 +718,9 @@ pub const SWEEP_MARGIN: f64 = 0.04;
 
 /// Whether the Base driving `c` (as [`Base`] turns it into a speed and a
 /// steering angle, held) for [`SWEEP_TIME`] keeps the body, grown by
-/// [`SWEEP_MARGIN`], clear of every reading of the scan.
+/// [`SWEEP_MARGIN`], clear of every reading of the scan, and, when the
+/// robot could turn on the spot where it is, leaves it where it still can
+/// (so it never drives into a corner it cannot turn out of).
 fn sweep_clear(beams: &[Beam], c: &CaseCommand, vehicle: &VehicleParams) -> bool {
     if standstill(c) {
         return true;
@@ -716,31 +728,29 @@ fn sweep_clear(beams: &[Beam], c: &CaseCommand, vehicle: &VehicleParams) -> bool
     let v = c.speed.clamp(CRAWL, vehicle.max_speed);
     let steer = (c.turn_rate * vehicle.wheelbase / v).atan().clamp(-vehicle.max_steer, vehicle.max_steer);
     let kappa = steer.tan() / vehicle.wheelbase;
-    let reach = v * SWEEP_TIME + vehicle.front.max(vehicle.rear).hypot(vehicle.width / 2.0) + SWEEP_MARGIN;
-    let points: Vec<Vec2> = beams
-        .iter()
-        .filter(|b| b.range.is_finite() && b.range < b.max_range && b.range <= reach)
-        .map(|b| v2(b.range * b.angle.cos(), b.range * b.angle.sin()))
-        .collect();
+    let body = vehicle.front.max(vehicle.rear).hypot(vehicle.width / 2.0) + SWEEP_MARGIN;
+    let reach = v * SWEEP_TIME + body.max(TURN_RADIUS + TURN_SWEEP);
+    let points: Vec<Vec2> = points(beams).filter(|p| p.norm() <= reach).collect();
     let (front, rear, half) =
         (vehicle.front + SWEEP_MARGIN, vehicle.rear + SWEEP_MARGIN, vehicle.width / 2.0 + SWEEP_MARGIN);
-    (1..=5).all(|k| {
-        let pose = integrate(Pose::new(0.0, 0.0, 0.0), v, kappa, SWEEP_TIME * k as f64 / 5.0);
+    let here = Pose::new(0.0, 0.0, 0.0);
+    let poses: Vec<Pose> = (1..=5).map(|k| integrate(here, v, kappa, SWEEP_TIME * k as f64 / 5.0)).collect();
+    let body_clear = poses.iter().all(|pose| {
         points.iter().all(|&p| {
             let q = pose.to_local(p);
             !(q.x <= front && q.x >= -rear && q.y.abs() <= half)
         })
-    })
+    });
+    let can_turn = |pose: &Pose| turn_clear_at(&points, pose, 1.0) || turn_clear_at(&points, pose, -1.0);
+    let last = poses.last().copied().unwrap_or(here);
+    body_clear && (!can_turn(&here) || can_turn(&last))
 }
 
 /// Whether moving straight ahead by `reach` (m) keeps the body clear: no
 /// reading in the strip the body sweeps (0.2 m ahead of the centre, 0.18 m
 /// to each side, and 0.02 m to spare).
 fn ahead_clear(beams: &[Beam], reach: f64) -> bool {
-    beams.iter().filter(|b| b.range.is_finite() && b.range < b.max_range).all(|b| {
-        let p = v2(b.range * b.angle.cos(), b.range * b.angle.sin());
-        !(p.x > 0.0 && p.x < 0.22 + reach && p.y.abs() < 0.2)
-    })
+    points(beams).all(|p| !(p.x > 0.0 && p.x < 0.22 + reach && p.y.abs() < 0.2))
 }
 
 struct Base {
