@@ -73,6 +73,18 @@ pub fn style() -> situ_compiler::render::Style {
     situ_compiler::render::Style { colour, width }
 }
 
+/// The host and port of a listening address given as `PORT` (on
+/// 127.0.0.1) or `HOST:PORT` (an IPv6 host in brackets); `None` when it is
+/// neither (`--foxglove`, `--serve`).
+pub fn host_port(addr: &str) -> Option<(&str, u16)> {
+    let (host, port) = match addr.rsplit_once(':') {
+        Some((h, p)) => (h.trim_start_matches('[').trim_end_matches(']'), p),
+        None => ("127.0.0.1", addr),
+    };
+    (!host.is_empty()).then_some(())?;
+    Some((host, port.parse().ok()?))
+}
+
 /// Writes a file so that it is never half written: a temporary file next to
 /// it, then a rename (keeping the permissions of a file it replaces).
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
@@ -89,4 +101,20 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         let _ = std::fs::remove_file(&tmp);
     }
     result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::host_port;
+
+    #[test]
+    fn an_address_is_a_port_or_a_host_and_a_port() {
+        assert_eq!(host_port("8080"), Some(("127.0.0.1", 8080)));
+        assert_eq!(host_port("0.0.0.0:8765"), Some(("0.0.0.0", 8765)));
+        assert_eq!(host_port("[::1]:9"), Some(("::1", 9)));
+        assert_eq!(host_port("localhost:http"), None);
+        assert_eq!(host_port(":8080"), None);
+        assert_eq!(host_port("nowhere"), None);
+        assert_eq!(host_port("1:70000"), None);
+    }
 }

@@ -118,12 +118,10 @@ impl foxglove::websocket::ServerListener for Subscriptions {
 }
 
 impl LiveServer {
-    /// Listens on `addr` (HOST:PORT); the error names the address.
+    /// Listens on `addr` (HOST:PORT, or PORT on 127.0.0.1); the error
+    /// names the address.
     fn start(addr: &str) -> Result<LiveServer, String> {
-        let (host, port) = addr
-            .rsplit_once(':')
-            .and_then(|(h, p)| Some((h.trim_start_matches('[').trim_end_matches(']'), p.parse::<u16>().ok()?)))
-            .filter(|(h, _)| !h.is_empty())
+        let (host, port) = super::host_port(addr)
             .ok_or_else(|| format!("`{addr}` is not an address (HOST:PORT, say 127.0.0.1:8765)"))?;
         // The port must be free: the error names it (the server's own error
         // does not always).

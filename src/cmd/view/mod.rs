@@ -57,11 +57,7 @@ pub fn run(file: &Path, rules: Option<&Path>, port: Option<u16>) -> u8 {
 /// its own: the page's URL, and the log the run's [`live::PageTap`] fills.
 /// `addr` is `PORT` or `HOST:PORT` (default host 127.0.0.1).
 pub fn serve_live(site: data::Site, addr: &str) -> Result<(String, Arc<Live>), u8> {
-    let (host, port) = match addr.rsplit_once(':') {
-        Some((h, p)) => (h.trim_start_matches('[').trim_end_matches(']'), p),
-        None => ("127.0.0.1", addr),
-    };
-    let Ok(port) = port.parse::<u16>() else {
+    let Some((host, port)) = super::host_port(addr) else {
         eprintln!("error: --serve `{addr}` is not a port or an address (PORT or HOST:PORT, say 127.0.0.1:8080)");
         return Err(USAGE);
     };
