@@ -69,12 +69,60 @@ pub struct OccupancyGrid {
     origin: Vec2,
     params: GridParams,
     logodds: Vec<f32>,
+    /// The smallest log-odds that is not free, and the smallest that is
+    /// occupied, by [`OccupancyGrid::classify`]: a cell's class from its
+    /// log-odds without an exponential, and the same class.
+    not_free_from: f32,
+    occupied_from: f32,
+}
+
+/// The smallest `f32` log-odds (within ±1000) for which `holds`, a
+/// property that once true stays true as the log-odds grow; by bisection
+/// over the floats in order.
+fn first_where(holds: impl Fn(f32) -> bool) -> f32 {
+    // Floats in order as integers: negative ones reversed.
+    let key = |x: f32| -> i64 {
+        let b = x.to_bits() as i32;
+        i64::from(if b < 0 { i32::MIN - b } else { b })
+    };
+    let float = |k: i64| -> f32 {
+        let k = k as i32;
+        f32::from_bits(if k < 0 { (i32::MIN - k) as u32 } else { k as u32 })
+    };
+    let (mut lo, mut hi) = (key(-1000.0), key(1000.0));
+    if holds(float(lo)) {
+        return f32::NEG_INFINITY;
+    }
+    if !holds(float(hi)) {
+        return f32::INFINITY;
+    }
+    // holds(lo) is false, holds(hi) true.
+    while hi - lo > 1 {
+        let mid = lo + (hi - lo) / 2;
+        if holds(float(mid)) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    float(hi)
 }
 
 /// The log-odds of a probability (clamped away from 0 and 1).
 pub fn logodds(p: f64) -> f32 {
     let p = p.clamp(1e-6, 1.0 - 1e-6);
     (p / (1.0 - p)).ln() as f32
+}
+
+/// The class of a probability by `params`' thresholds.
+fn classify(params: &GridParams, p: f64) -> CellClass {
+    if p < params.free_below {
+        CellClass::Free
+    } else if p > params.occupied_above {
+        CellClass::Occupied
+    } else {
+        CellClass::Unknown
+    }
 }
 
 /// The probability of a log-odds.
@@ -91,7 +139,19 @@ impl OccupancyGrid {
     pub fn new(width: usize, height: usize, cell: f64, origin: Vec2, params: GridParams) -> Self {
         assert!(width > 0 && height > 0, "a grid has at least one cell");
         assert!(cell.is_finite() && cell > 0.0, "the cell size is positive");
-        OccupancyGrid { width, height, cell, origin, params, logodds: vec![0.0; width * height] }
+        let class = |l: f32| classify(&params, probability(l));
+        let not_free_from = first_where(|l| class(l) != CellClass::Free);
+        let occupied_from = first_where(|l| class(l) == CellClass::Occupied);
+        OccupancyGrid {
+            width,
+            height,
+            cell,
+            origin,
+            params,
+            logodds: vec![0.0; width * height],
+            not_free_from,
+            occupied_from,
+        }
     }
 
     /// Number of columns.
@@ -184,9 +244,13 @@ impl OccupancyGrid {
     }
     /// The class of a probability by this grid's thresholds.
     pub fn classify(&self, p: f64) -> CellClass {
-        if p < self.params.free_below {
+        classify(&self.params, p)
+    }
+    /// The class of a log-odds: that of its probability.
+    pub fn class_of_logodds(&self, l: f32) -> CellClass {
+        if l < self.not_free_from {
             CellClass::Free
-        } else if p > self.params.occupied_above {
+        } else if l >= self.occupied_from {
             CellClass::Occupied
         } else {
             CellClass::Unknown
@@ -194,11 +258,11 @@ impl OccupancyGrid {
     }
     /// The class of cell `(x, y)`.
     pub fn class(&self, x: usize, y: usize) -> CellClass {
-        self.classify(self.probability(x, y))
+        self.class_of_logodds(self.logodds_at(x, y))
     }
     /// The class of the cell at index `i`.
     pub fn class_index(&self, i: usize) -> CellClass {
-        self.classify(self.probability_index(i))
+        self.class_of_logodds(self.logodds[i])
     }
     /// Whether cell `(x, y)` is free.
     pub fn is_free(&self, x: usize, y: usize) -> bool {
@@ -219,7 +283,7 @@ impl OccupancyGrid {
         let before = self.logodds[i];
         let after = (before + delta).clamp(self.params.l_min, self.params.l_max);
         self.logodds[i] = after;
-        before.to_bits() != after.to_bits() && self.classify(probability(before)) != self.classify(probability(after))
+        before.to_bits() != after.to_bits() && self.class_of_logodds(before) != self.class_of_logodds(after)
     }
 
     /// Updates the grid with one scan taken at `pose`: for each beam, the
@@ -296,6 +360,38 @@ impl OccupancyGrid {
                 y = ny as usize;
                 t_max_y += t_dy;
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_class_of_a_logodds_is_that_of_its_probability() {
+        for params in [
+            GridParams::default(),
+            GridParams { free_below: 0.5, occupied_above: 0.5, ..GridParams::default() },
+            GridParams { free_below: 0.01, occupied_above: 0.999, ..GridParams::default() },
+        ] {
+            let g = OccupancyGrid::new(1, 1, 0.1, v2(0.0, 0.0), params);
+            let slow = |l: f32| g.classify(probability(l));
+            // A sweep, and every float within 2,000 of each boundary.
+            let mut ls: Vec<f32> = (-6000..=6000).map(|k| k as f32 * 1e-3).collect();
+            for b in [g.not_free_from, g.occupied_from] {
+                let mut up = b;
+                let mut down = b;
+                for _ in 0..2000 {
+                    ls.extend([up, down]);
+                    up = f32::from_bits(up.to_bits().wrapping_add(if up >= 0.0 { 1 } else { u32::MAX }));
+                    down = f32::from_bits(down.to_bits().wrapping_add(if down > 0.0 { u32::MAX } else { 1 }));
+                }
+            }
+            for l in ls {
+                assert_eq!(g.class_of_logodds(l), slow(l), "log-odds {l} ({:#x}), {params:?}", l.to_bits());
+            }
+            assert!(g.not_free_from <= g.occupied_from);
         }
     }
 }
