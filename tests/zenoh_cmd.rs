@@ -34,6 +34,36 @@ fn deployment(dir: &Path) -> String {
 }
 
 #[test]
+fn up_runs_figure_5_through_a_router_process_and_stops_it_last() {
+    let dir = tempfile::tempdir().unwrap();
+    let r = port();
+    let client = |name: &str, extra: &str| {
+        format!("[[process]]\nname = \"{name}\"\n{extra}mode = \"client\"\nconnect = [\"tcp/127.0.0.1:{r}\"]\n")
+    };
+    let text = format!(
+        "robot = \"t{r}\"\n[[process]]\nname = \"router\"\nmode = \"router\"\nlisten = [\"tcp/127.0.0.1:{r}\"]\n{}{}{}",
+        client("board", "board = true\n"),
+        client("sensors", "agents = [\"RFCCD\", \"LADAR\"]\n"),
+        client("pipeline", "agents = [\"Fusion\", \"LPL\", \"Drive\"]\n"),
+    );
+    let deploy = dir.path().join("deploy.toml");
+    std::fs::write(&deploy, text).unwrap();
+    let deploy = deploy.display().to_string();
+    let o =
+        situ().args(["up", &deploy, "examples/fig5/fig5.situ", "--stack", "demo", "--duration", "4"]).output().unwrap();
+    let (out, err) = (String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+    assert!(o.status.success(), "{out}\n{err}");
+    assert_eq!(
+        out.matches("path: RS → RO").count(),
+        3,
+        "every process followed RS -> RO through the router:\n{out}\n{err}"
+    );
+    assert!(err.contains(&format!("router: routes situ/t{r}/… (Zenoh router on tcp/127.0.0.1:{r}")), "{err}");
+    let ended = |p: &str| err.find(&format!("`{p}` ended (exit status: 0)")).unwrap_or_else(|| panic!("{p}: {err}"));
+    assert!(["board", "sensors", "pipeline"].iter().all(|p| ended(p) < ended("router")), "the router ends last: {err}");
+}
+
+#[test]
 fn up_starts_the_three_processes_of_figure_5() {
     let dir = tempfile::tempdir().unwrap();
     let deploy = deployment(dir.path());

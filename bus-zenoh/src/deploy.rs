@@ -21,9 +21,13 @@
 //! name = "sensors"
 //! agents = ["RFCCD", "LADAR"]
 //! connect = ["tcp/127.0.0.1:7447"]
+//! # mode = "peer"                    # or "client" (through a router), "router"
 //! ```
 //!
-//! Peers, multicast scouting off, explicit endpoints only. With `[tls]`
+//! Peers by default, multicast scouting off, explicit endpoints only. A
+//! process may be a Zenoh router (`mode = "router"`), with or without
+//! agents: the others then connect to it alone (as `client`s), and it
+//! carries their messages. With `[tls]`
 //! every process presents its certificate and checks the others' against
 //! the CA; Zenoh's access control then lets only the process marked `board`
 //! put on `situ/<robot>/status`, and only the processes of the table put
@@ -55,10 +59,50 @@ pub struct Tls {
     pub ca: PathBuf,
 }
 
+/// How a process joins Zenoh (`mode` in the file; `peer` when not given).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Mode {
+    /// Meets the processes it listens for or connects to, and no others'
+    /// messages go through it: every pair that exchanges data must meet.
+    #[default]
+    Peer,
+    /// Talks only through the router (or peer) it connects to.
+    Client,
+    /// Carries the messages of every process connected to it.
+    Router,
+}
+
+impl Mode {
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Peer => "peer",
+            Mode::Client => "client",
+            Mode::Router => "router",
+        }
+    }
+}
+
+impl std::str::FromStr for Mode {
+    type Err = ();
+    fn from_str(s: &str) -> Result<Mode, ()> {
+        match s {
+            "peer" => Ok(Mode::Peer),
+            "client" => Ok(Mode::Client),
+            "router" => Ok(Mode::Router),
+            _ => Err(()),
+        }
+    }
+}
+
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Process {
     pub name: String,
+    /// How it joins Zenoh: `mode` of the file, checked by [`Deployment::parse`].
+    #[serde(skip)]
+    pub mode: Mode,
+    #[serde(rename = "mode", default)]
+    mode_text: Option<String>,
     #[serde(default)]
     pub board: bool,
     #[serde(default)]
@@ -85,6 +129,12 @@ impl Process {
             None | Some("localhost") | Some("127.0.0.1") => true,
             Some(h) => std::fs::read_to_string("/etc/hostname").is_ok_and(|n| n.trim() == h),
         }
+    }
+
+    /// A router and nothing else (no agent, no Bulletinboard): its process
+    /// only carries the others' messages.
+    pub fn routes_only(&self) -> bool {
+        self.mode == Mode::Router && self.agents.is_empty() && !self.board
     }
 }
 
@@ -125,7 +175,14 @@ impl Deployment {
     }
 
     pub fn parse(text: &str, agents: &[String]) -> Result<Deployment, DeployError> {
-        let d: Deployment = toml::from_str(text).map_err(|e| DeployError(e.to_string()))?;
+        let mut d: Deployment = toml::from_str(text).map_err(|e| DeployError(e.to_string()))?;
+        for p in &mut d.processes {
+            if let Some(m) = &p.mode_text {
+                p.mode = m.parse().map_err(|()| {
+                    DeployError(format!("process `{}`: `mode = \"{m}\"`: `peer`, `client` or `router`", p.name))
+                })?;
+            }
+        }
         if d.robot.is_empty() || !d.robot.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
             return Err(DeployError(format!("`robot = \"{}\"`: letters, digits, `_` and `-` only", d.robot)));
         }
@@ -177,6 +234,28 @@ impl Deployment {
             if d.tls.is_some() && (p.cert.is_none() || p.key.is_none()) {
                 return Err(DeployError(format!("process `{}` needs `cert` and `key` with `[tls]`", p.name)));
             }
+            if p.mode == Mode::Client && p.connect.is_empty() {
+                return Err(DeployError(format!(
+                    "process `{}`: a client talks through what it connects to: give it `connect` (the router)",
+                    p.name
+                )));
+            }
+            if p.mode == Mode::Router && p.listen.is_empty() && p.connect.is_empty() {
+                return Err(DeployError(format!(
+                    "process `{}`: a router needs `listen` endpoints (the others connect to it)",
+                    p.name
+                )));
+            }
+            // Access control is by the certificate at the other end of a
+            // link: through a router, the status would come from the router.
+            if d.tls.is_some() && p.mode != Mode::Peer {
+                return Err(DeployError(format!(
+                    "process `{}`: `mode = \"{}\"` with `[tls]`: not supported (access control is by the certificate \
+                     at the other end of a link, and through a router that is the router's); use peers",
+                    p.name,
+                    p.mode.name()
+                )));
+            }
         }
         Ok(d)
     }
@@ -208,7 +287,7 @@ impl Deployment {
     pub fn zenoh_config(&self, process: &Process) -> String {
         let q = |v: &[String]| serde_json::to_string(v).expect("strings serialize");
         let mut cfg = serde_json::json!({
-            "mode": "peer",
+            "mode": process.mode.name(),
             "listen": { "endpoints": serde_json::from_str::<serde_json::Value>(&q(&process.listen)).unwrap_or_default() },
             // A process that comes back (a restarted Bulletinboard) is met again
             // within half a second.
@@ -218,6 +297,12 @@ impl Deployment {
             },
             "scouting": { "multicast": { "enabled": false }, "gossip": { "enabled": true } },
         });
+        if process.mode == Mode::Client {
+            // Zenoh's client gives up at once when its router is not there
+            // yet; here it waits for it, as peers and routers do.
+            cfg["connect"]["timeout_ms"] = (-1).into();
+            cfg["connect"]["exit_on_failure"] = false.into();
+        }
         if let (Some(tls), Some(cert), Some(key)) = (&self.tls, &process.cert, &process.key) {
             cfg["transport"] = serde_json::json!({ "link": { "tls": {
                 "root_ca_certificate": self.path(&tls.ca),

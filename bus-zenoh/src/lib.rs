@@ -38,6 +38,15 @@ pub struct Placement {
     pub board: bool,
 }
 
+impl Placement {
+    /// What the deployment `d` places in its process `p`: its agents (of
+    /// `content`'s), and the Bulletinboard if it is marked `board`.
+    pub fn of(d: &deploy::Deployment, p: &deploy::Process, content: &Content) -> Placement {
+        let local = content.agents.iter().map(|a| p.agents.contains(&a.name)).collect();
+        Placement { robot: d.robot.clone(), local, board: p.board }
+    }
+}
+
 #[derive(Default)]
 struct Counters {
     rejected: AtomicU64,
@@ -207,6 +216,12 @@ impl ZenohBus {
         Ok(ZenohBus { local, session, content, placement, counters, refusals, limits, _subscribers: subscribers })
     }
 
+    /// The Zenoh session under the bus, for a tool that puts or subscribes
+    /// beside the three streams on the same links (a benchmark's reports).
+    pub fn session(&self) -> &zenoh::Session {
+        &self.session
+    }
+
     /// Publishes; `express` messages skip Zenoh's batching (status,
     /// events, urgent data: latency first), the rest is batched (throughput).
     fn put(&self, key: String, bytes: Vec<u8>, congestion: CongestionControl, priority: Priority, express: bool) {
@@ -329,6 +344,28 @@ impl Bus for ZenohBus {
         c.rejected = self.counters.rejected.load(Ordering::Relaxed);
         c.unsendable = self.counters.unsendable.load(Ordering::Relaxed);
         c
+    }
+}
+
+/// A process that only routes (`mode = "router"`, no agent, no
+/// Bulletinboard): a Zenoh session in router mode that carries the other
+/// processes' messages and keeps none. Closed when dropped.
+pub struct Router {
+    session: zenoh::Session,
+}
+
+impl Router {
+    /// Opens the router's session with `config` (JSON5, `"mode": "router"`).
+    pub fn open(config: &str) -> Result<Router, BusError> {
+        let config = zenoh::Config::from_json5(config).map_err(|e| BusError(format!("Zenoh configuration: {e}")))?;
+        let session = zenoh::open(config).wait().map_err(|e| BusError(format!("cannot open the Zenoh router: {e}")))?;
+        Ok(Router { session })
+    }
+}
+
+impl Drop for Router {
+    fn drop(&mut self) {
+        let _ = self.session.close().wait();
     }
 }
 

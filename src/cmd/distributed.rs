@@ -10,6 +10,11 @@
 //! `examples/python/ladar.py`). The simulated vehicle of `situ run`'s
 //! default stack needs all its agents and its physics in one process, in
 //! simulated time: it does not run over Zenoh.
+//!
+//! A process of the deployment that only routes (`mode = "router"`, no
+//! agents, no Bulletinboard) runs a Zenoh router and nothing else, until
+//! Ctrl-C, SIGTERM or `--duration`; `situ up` stops it once every other
+//! process has ended.
 
 use super::view::data::Site;
 use super::watchers::Watchers;
@@ -220,6 +225,9 @@ fn zenoh(args: &Args, content: Arc<Content>, file: Option<&[u8]>, checked: Optio
             return USAGE;
         }
     };
+    if process.routes_only() {
+        return route(args, &d, &process);
+    }
     let here: Vec<String> = args.only.clone().unwrap_or_else(|| process.agents.clone());
     let bound = match bound_agents(args.stack, &content, &here) {
         Ok(b) => b,
@@ -266,6 +274,38 @@ fn zenoh(args: &Args, content: Arc<Content>, file: Option<&[u8]>, checked: Optio
     finish(summary)
 }
 
+/// A process that only routes (`mode = "router"`, no agent, no
+/// Bulletinboard): its Zenoh session carries the others' messages until
+/// Ctrl-C, SIGTERM or `--duration`.
+#[cfg(feature = "zenoh")]
+fn route(args: &Args, d: &situ_bus_zenoh::deploy::Deployment, process: &situ_bus_zenoh::deploy::Process) -> u8 {
+    let name = &process.name;
+    if args.serve.is_some() || args.foxglove.is_some() || args.record.is_some() {
+        eprintln!(
+            "error: process `{name}` only routes: --serve, --foxglove and --record belong to the process of the \
+             Bulletinboard"
+        );
+        return USAGE;
+    }
+    let router = match situ_bus_zenoh::Router::open(&d.zenoh_config(process)) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: process `{name}`: {e}");
+            return USAGE;
+        }
+    };
+    let stop = stop_flag();
+    let endpoints: Vec<&str> = process.listen.iter().chain(&process.connect).map(String::as_str).collect();
+    eprintln!("{name}: routes situ/{}/… (Zenoh router on {}; no agents here)", d.robot, endpoints.join(", "));
+    let end = std::time::Instant::now() + Duration::from_secs_f64(args.duration);
+    while !stop.load(Ordering::Acquire) && std::time::Instant::now() < end {
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    drop(router);
+    eprintln!("{name}: stopped routing");
+    OK
+}
+
 #[cfg(not(feature = "zenoh"))]
 const NO_ZENOH: &str =
     "this situ was built without the Zenoh transport; build it with `cargo build --release --features zenoh`";
@@ -283,15 +323,16 @@ fn open_deployment_warning(deploy: &Path, robot: &str) -> String {
     )
 }
 
-/// The processes of the deployment that run on this host.
+/// The processes of the deployment that run on this host, each with
+/// whether it only routes.
 #[cfg(feature = "zenoh")]
-fn local_processes(deploy: &Path, agents: &[String]) -> Result<Vec<String>, String> {
+fn local_processes(deploy: &Path, agents: &[String]) -> Result<Vec<(String, bool)>, String> {
     let d = situ_bus_zenoh::deploy::Deployment::load(deploy, agents).map_err(|e| e.to_string())?;
-    Ok(d.processes.iter().filter(|p| p.is_local()).map(|p| p.name.clone()).collect())
+    Ok(d.processes.iter().filter(|p| p.is_local()).map(|p| (p.name.clone(), p.routes_only())).collect())
 }
 
 #[cfg(not(feature = "zenoh"))]
-fn local_processes(_deploy: &Path, _agents: &[String]) -> Result<Vec<String>, String> {
+fn local_processes(_deploy: &Path, _agents: &[String]) -> Result<Vec<(String, bool)>, String> {
     Err(NO_ZENOH.into())
 }
 
@@ -327,7 +368,12 @@ pub fn up(deploy: &Path, file: &Path, stack: Stack, duration: f64, trust: &[Path
     // Each process checks the bundle against the same keys.
     let trust_args: Vec<&std::ffi::OsStr> = trust.iter().flat_map(|k| ["--trust".as_ref(), k.as_os_str()]).collect();
     let mut children = Vec::new();
+    // The processes that only route: stopped once every other has ended.
+    let routers: Vec<&str> = processes.iter().filter(|p| p.1).map(|p| p.0.as_str()).collect();
+    let processes: Vec<String> = processes.iter().map(|p| p.0.clone()).collect();
     for p in &processes {
+        // A router outlives the others (it is stopped when they have ended).
+        let duration = if routers.contains(&p.as_str()) { duration + 60.0 } else { duration };
         let child = std::process::Command::new(&exe)
             .arg("run")
             .arg(file)
@@ -347,6 +393,7 @@ pub fn up(deploy: &Path, file: &Path, stack: Stack, duration: f64, trust: &[Path
     eprintln!("up: {} process(es): {}", children.len(), processes.join(", "));
     let mut status = OK;
     let mut running: Vec<(String, std::process::Child)> = children;
+    let mut routers_asked = routers.is_empty() || routers.len() == processes.len();
     while !running.is_empty() {
         if stop.load(Ordering::Acquire) {
             // Ask each to stop as it would on Ctrl-C (SIGTERM), then wait.
@@ -354,6 +401,11 @@ pub fn up(deploy: &Path, file: &Path, stack: Stack, duration: f64, trust: &[Path
                 let _ = std::process::Command::new("kill").args(["-TERM", &c.id().to_string()]).status();
             }
             stop.store(false, Ordering::Release);
+        }
+        if !routers_asked && running.iter().all(|(name, _)| routers.contains(&name.as_str())) {
+            // Every other process has ended: nothing left to carry.
+            routers_asked = true;
+            stop.store(true, Ordering::Release);
         }
         let mut still = Vec::new();
         for (name, mut c) in running {
