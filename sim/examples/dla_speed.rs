@@ -16,7 +16,15 @@
 //!
 //! The retrieval is also measured at 10,000 cases to show how it scales.
 //!
+//! On-line learning is measured too: a base growing to 2,000 cases by
+//! [`CaseBase::learn`] over obstacle-field situations, one learn and one
+//! retrieval per step, as the running stack does.
+//!
 //! `cargo run --release -p situ-sim --example dla_speed`
+//! `cargo run --release -p situ-sim --example dla_speed -- --retrieval`
+//! (only the 8-sector retrieval and the on-line learning: no pyramid, no
+//! 4- and 6-sector runs; ~1/3 of the time); `--kiddo` also measures
+//! kiddo 5's incremental and immutable k-d trees on the same cases.
 //! Targets: pyramid < 20 ms, retrieval < 5 µs per query.
 
 use situ_sim::dla::cases::{drive, Case, CaseBase, Command, DriverParams, Situation};
@@ -112,9 +120,19 @@ fn scanned_grid(truth: &[bool], noise: &mut Noise) -> OccupancyGrid {
 }
 
 fn main() {
+    let retrieval_only = std::env::args().skip(1).any(|a| a == "--retrieval");
+    KIDDO.store(std::env::args().skip(1).any(|a| a == "--kiddo"), std::sync::atomic::Ordering::Relaxed);
     let mut noise = Noise::new(7, 0);
     let truth = truth(&mut noise);
-    let grid = scanned_grid(&truth, &mut noise);
+    if !retrieval_only {
+        pyramid(&truth, &mut noise);
+    }
+    cases(&truth, retrieval_only);
+}
+
+/// Builds the grid scanned in `truth` and measures its pyramid.
+fn pyramid(truth: &[bool], noise: &mut Noise) {
+    let grid = scanned_grid(truth, noise);
     let (mut free, mut occupied, mut unknown) = (0, 0, 0);
     for y in 0..N {
         for x in 0..N {
@@ -146,7 +164,13 @@ fn main() {
         p.regions().len(),
         free_regions,
     );
+}
 
+/// Measures the retrieval of the nearest case and the on-line learning;
+/// `short`: only the 8-sector retrievals.
+fn cases(truth: &[bool], short: bool) {
+    // Its own generator: the same cases with and without the pyramid.
+    let mut noise = Noise::new(7, 1);
     let max_range = MAX_RANGE;
     let random = |noise: &mut Noise, sectors: usize| {
         let ranges = (0..sectors).map(|_| noise.uniform() * max_range).collect();
@@ -194,10 +218,14 @@ fn main() {
     for cases in [10_000, 100_000] {
         summary.push(retrieval::<10>("uniform", cases, &mut noise, &mut { random_case }, &mut { random }));
     }
-    retrieval::<6>("uniform", 100_000, &mut noise, &mut { random_case }, &mut { random });
-    retrieval::<8>("uniform", 100_000, &mut noise, &mut { random_case }, &mut { random });
+    if !short {
+        retrieval::<6>("uniform", 100_000, &mut noise, &mut { random_case }, &mut { random });
+        retrieval::<8>("uniform", 100_000, &mut noise, &mut { random_case }, &mut { random });
+    }
     println!("situations scanned in the 512 x 512 map above, random commands:");
-    retrieval::<8>("scanned in the map", 100_000, &mut noise, &mut { scanned_case }, &mut { scanned });
+    if !short {
+        retrieval::<8>("scanned in the map", 100_000, &mut noise, &mut { scanned_case }, &mut { scanned });
+    }
     summary.push(retrieval::<10>("scanned in the map", 100_000, &mut noise, &mut { scanned_case }, &mut { scanned }));
 
     println!("situations met in random obstacle fields, the scripted driver's commands:");
@@ -220,10 +248,72 @@ fn main() {
     }
     println!();
     println!("nearest case, 8 sectors (D = 10), mean over 100,000 queries, median of 5 runs (target < 5 µs):");
-    println!("  {:<20} {:>9} {:>12} {:>16}", "case base", "cases", "µs/query", "mean distance");
+    println!(
+        "  {:<20} {:>9} {:>10} {:>12} {:>14} {:>10}",
+        "case base", "cases", "µs/query", "read: µs/q", "mean distance", "insert ms"
+    );
     for r in &summary {
-        println!("  {:<20} {:>9} {:>12.2} {:>16.3}", r.what, r.cases, r.us, r.mean_distance);
+        println!(
+            "  {:<20} {:>9} {:>10.2} {:>12.2} {:>14.3} {:>10.0}",
+            r.what, r.cases, r.us, r.loaded_us, r.mean_distance, r.insert_ms
+        );
     }
+    learning();
+}
+
+/// On-line learning as the running stack does it: per step the nearest
+/// case to a situation (obstacle fields, 8 sectors), then
+/// [`CaseBase::learn`] of the situation with the scripted driver's command
+/// (novelty 0.05), from an empty base until it holds 2,000 cases. Prints the
+/// mean and the largest time of a step (median of 5 runs), and the mean over
+/// the steps from 1,500 cases on.
+fn learning() {
+    const TARGET: usize = 2_000;
+    let mut noise = Noise::new(7, 2);
+    let mut fields = Fields::new(FIELD_SITUATIONS);
+    let driver = DriverParams::default();
+    let cases: Vec<Case> = (0..4 * TARGET)
+        .map(|_| {
+            let situation = fields.situation(&mut noise, 8);
+            let command = drive(&situation, MAX_RANGE, &driver);
+            Case { situation, command }
+        })
+        .collect();
+    let (mut means, mut maxima, mut lates, mut steps) = (Vec::new(), Vec::new(), Vec::new(), 0);
+    for _ in 0..5 {
+        let run = cases.clone();
+        let mut base: CaseBase<10> = CaseBase::new(MAX_RANGE, 0.05);
+        let mut times = Vec::with_capacity(run.len());
+        let mut late = Vec::new();
+        let mut acc = 0usize;
+        for c in run {
+            if base.len() >= TARGET {
+                break;
+            }
+            let t = Instant::now();
+            acc += base.nearest(black_box(&c.situation)).expect("valid").map_or(0, |(i, _)| i);
+            let big = base.len() >= 1_500;
+            base.learn(c).expect("valid");
+            let dt = t.elapsed();
+            times.push(dt);
+            if big {
+                late.push(dt);
+            }
+        }
+        black_box(acc);
+        assert_eq!(base.len(), TARGET, "the base reached its size");
+        steps = times.len();
+        means.push(times.iter().sum::<Duration>() / times.len() as u32);
+        maxima.push(*times.iter().max().expect("steps"));
+        lates.push(late.iter().sum::<Duration>() / late.len() as u32);
+    }
+    println!(
+        "on-line learning, 8 sectors, novelty 0.05, empty to {TARGET} cases in {steps} steps (nearest + learn), \
+         median of 5 runs: {:.2} µs per step, {:.2} µs from 1,500 cases on, largest step {:.0} µs",
+        median(means).as_secs_f64() * 1e6,
+        median(lates).as_secs_f64() * 1e6,
+        median(maxima).as_secs_f64() * 1e6,
+    );
 }
 
 /// The figures of one retrieval measurement.
@@ -231,15 +321,20 @@ struct Retrieval {
     what: &'static str,
     cases: usize,
     us: f64,
+    loaded_us: f64,
     mean_distance: f64,
+    insert_ms: f64,
 }
 
 /// Builds a base of `cases` cases of `D − 2` sectors drawn by `case`
-/// (inserted with [`CaseBase::insert`]: duplicates are refused and counted,
-/// drawing goes on until `cases` went in) and prints the mean time of a
-/// retrieval over 100,000 queries drawn by `query` (median of 5 runs), and
-/// the mean distance from a query to its nearest case. A sample of the
-/// queries is checked against a brute-force search.
+/// (inserted one by one with [`CaseBase::insert`], the insertion alone
+/// timed: duplicates are refused and counted, drawing goes on until `cases`
+/// went in) and prints the mean time of a retrieval over 100,000 queries
+/// drawn by `query` (median of 5 runs), and the mean distance from a query
+/// to its nearest case; then the same for the base written and read back
+/// (its index then one tree, not the few trees and the buffer that
+/// insertion one by one leaves). A sample of the queries is checked
+/// against a brute-force search.
 fn retrieval<const D: usize>(
     what: &'static str,
     cases: usize,
@@ -250,13 +345,18 @@ fn retrieval<const D: usize>(
     const QUERIES: usize = 100_000;
     let sectors = CaseBase::<D>::SECTORS;
     let mut base: CaseBase<D> = CaseBase::new(MAX_RANGE, 0.0);
+    // Drawn first, so that the insertion alone is timed.
+    let first: Vec<Case> = (0..cases).map(|_| case(noise, sectors)).collect();
     let t = Instant::now();
-    let mut drawn = 0usize;
+    for c in first {
+        base.insert(c).expect("valid case");
+    }
+    let build = t.elapsed();
+    let mut drawn = cases;
     while base.len() < cases {
         drawn += 1;
         base.insert(case(noise, sectors)).expect("valid case");
     }
-    let build = t.elapsed();
     let queries: Vec<Situation> = (0..QUERIES).map(|_| query(noise, sectors)).collect();
     let mut per_query = Vec::new();
     for _ in 0..5 {
@@ -269,6 +369,24 @@ fn retrieval<const D: usize>(
         per_query.push(t.elapsed() / QUERIES as u32);
     }
     let us = median(per_query).as_secs_f64() * 1e6;
+    // The same base read from its file: all its cases in one tree.
+    let t = Instant::now();
+    let loaded: CaseBase<D> = CaseBase::from_text(&base.to_text()).expect("its own text");
+    let load = t.elapsed();
+    let mut per_query = Vec::new();
+    for _ in 0..5 {
+        let t = Instant::now();
+        let mut acc = 0usize;
+        for q in &queries {
+            acc += loaded.nearest(black_box(q)).expect("valid").expect("not empty").0;
+        }
+        black_box(acc);
+        per_query.push(t.elapsed() / QUERIES as u32);
+    }
+    let loaded_us = median(per_query).as_secs_f64() * 1e6;
+    for q in queries.iter().step_by(QUERIES / 50) {
+        assert_eq!(loaded.nearest(q).expect("valid"), base.nearest(q).expect("valid"), "the same nearest case");
+    }
     let mean_distance =
         queries.iter().map(|q| base.nearest(q).expect("valid").expect("not empty").1).sum::<f64>() / QUERIES as f64;
     // The k-d tree's answer is the nearest case (to single precision).
@@ -282,14 +400,64 @@ fn retrieval<const D: usize>(
         let (_, d) = base.nearest(q).expect("valid").expect("not empty");
         assert!(d <= brute + 1e-5, "the k-d tree missed the nearest case: {d} > {brute}");
     }
+    if KIDDO.load(std::sync::atomic::Ordering::Relaxed) {
+        kiddo_reference(&keys, &queries.iter().map(|q| base.key(q).expect("valid")).collect::<Vec<_>>());
+    }
     println!(
         "  cases ({what}, {sectors} sectors): {} inserted of {drawn} drawn ({} duplicates refused) in {:.0} ms; \
-         nearest case: {us:.2} µs per query (target < 5 µs), mean distance {mean_distance:.3}",
+         nearest case: {us:.2} µs per query (target < 5 µs), mean distance {mean_distance:.3}; \
+         written and read back (one tree) in {:.0} ms: {loaded_us:.2} µs per query",
         base.len(),
         drawn - base.len(),
-        build.as_secs_f64() * 1e3
+        build.as_secs_f64() * 1e3,
+        load.as_secs_f64() * 1e3
     );
-    Retrieval { what, cases, us, mean_distance }
+    Retrieval { what, cases, us, loaded_us, mean_distance, insert_ms: build.as_secs_f64() * 1e3 }
+}
+
+/// Whether to measure kiddo's k-d trees on the same cases (`--kiddo`).
+static KIDDO: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// The reference of `--kiddo`: kiddo 5's incremental k-d tree (what the
+/// case base used before, buckets of 64) and its immutable one (buckets of
+/// 32), single precision, over the same keys and queries: build time and
+/// time per query (median of 3 runs).
+fn kiddo_reference<const D: usize>(keys: &[[f64; D]], queries: &[[f64; D]]) {
+    use kiddo::immutable::float::kdtree::ImmutableKdTree;
+    use kiddo::SquaredEuclidean;
+    let narrow = |k: &[f64; D]| -> [f32; D] { std::array::from_fn(|i| k[i] as f32) };
+    let points: Vec<[f32; D]> = keys.iter().map(narrow).collect();
+    let qs: Vec<[f32; D]> = queries.iter().map(narrow).collect();
+    let t = Instant::now();
+    let mut mutable: kiddo::float::kdtree::KdTree<f32, u64, D, 64, u32> = kiddo::float::kdtree::KdTree::new();
+    for (i, p) in points.iter().enumerate() {
+        mutable.add(p, i as u64);
+    }
+    let mutable_build = t.elapsed();
+    let t = Instant::now();
+    let immutable: ImmutableKdTree<f32, u64, D, 32> = ImmutableKdTree::new_from_slice(&points);
+    let immutable_build = t.elapsed();
+    let time = |f: &dyn Fn(&[f32; D]) -> u64| {
+        let mut runs = Vec::new();
+        for _ in 0..3 {
+            let t = Instant::now();
+            let mut acc = 0u64;
+            for q in &qs {
+                acc = acc.wrapping_add(f(black_box(q)));
+            }
+            black_box(acc);
+            runs.push(t.elapsed() / qs.len() as u32);
+        }
+        median(runs).as_secs_f64() * 1e6
+    };
+    let m = time(&|q| mutable.nearest_one::<SquaredEuclidean>(q).item);
+    let i = time(&|q| immutable.nearest_one::<SquaredEuclidean>(q).item);
+    println!(
+        "    kiddo KdTree (B 64): built in {:.0} ms, {m:.2} µs per query; \
+         kiddo ImmutableKdTree (B 32): built in {:.0} ms, {i:.2} µs per query",
+        mutable_build.as_secs_f64() * 1e3,
+        immutable_build.as_secs_f64() * 1e3
+    );
 }
 
 /// The maximum range of the simulated sensor (m).

@@ -314,6 +314,73 @@ fn nearest_case_equals_brute_force() {
     assert!(matches!(base.nearest(&Situation::new(vec![f64::NAN; 8], 0.0)), Err(CaseError::NotFinite)));
 }
 
+/// The nearest case by brute force: its distance (double precision).
+fn brute_nearest<const D: usize>(keys: &[[f64; D]], k: &[f64; D]) -> f64 {
+    keys.iter()
+        .map(|c| c.iter().zip(k).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt())
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// A situation with its ranges on a coarse grid (many equal coordinates,
+/// ranges beyond the maximum) and its goal in one of 16 directions.
+fn coarse_situation(noise: &mut Noise) -> Situation {
+    let ranges = (0..8).map(|_| (noise.uniform() * 4.4 / 0.5).round() * 0.5).collect();
+    let goal = ((noise.uniform() * 16.0).floor() - 8.0) * std::f64::consts::PI / 8.0;
+    Situation::new(ranges, goal)
+}
+
+#[test]
+fn nearest_case_stays_exact_while_cases_are_added() {
+    // Cases added one at a time, queries between the additions: the
+    // answer must stay the brute-force nearest case across the index's
+    // rebuilds (latest cases scanned, then made trees, trees merged).
+    let mut noise = Noise::new(11, 3);
+    let mut base: CaseBase<10> = CaseBase::new(4.0, 0.0);
+    let mut keys: Vec<[f64; 10]> = Vec::new();
+    let mut snapshot = None;
+    for step in 0..3000 {
+        let case = if step % 3 == 0 {
+            random_case(&mut noise, 8)
+        } else {
+            Case { situation: coarse_situation(&mut noise), command: Command { speed: 0.1, turn_rate: 0.0 } }
+        };
+        let k = base.key(&case.situation).unwrap();
+        let before = brute_nearest(&keys, &k);
+        let situation = case.situation.clone();
+        if base.insert(case).unwrap() {
+            keys.push(k);
+            // The case just added is its own nearest.
+            assert_eq!(base.nearest(&situation).unwrap(), Some((keys.len() - 1, 0.0)), "step {step}");
+        } else {
+            assert_eq!(before, 0.0, "step {step}: a case was refused as a repeat of none");
+        }
+        let q = if step % 2 == 0 { random_situation(&mut noise, 8, 4.0) } else { coarse_situation(&mut noise) };
+        let k = base.key(&q).unwrap();
+        let (i, d) = base.nearest(&q).unwrap().unwrap();
+        let brute = brute_nearest(&keys, &k);
+        assert!((d - brute).abs() < 1e-5, "step {step}: {d} vs {brute}");
+        assert!((brute_nearest(&keys[i..=i], &k) - d).abs() < 1e-12);
+        if step == 1234 {
+            snapshot = Some((base.clone(), keys.len()));
+        }
+    }
+    assert!(keys.len() > 2000, "only {} distinct cases", keys.len());
+    // A clone answers on its own cases, not on those added since.
+    let (clone, n) = snapshot.unwrap();
+    assert_eq!(clone.len(), n);
+    // The base read back from its file (all in one tree) gives the same answers.
+    let read = CaseBase::<10>::from_text(&base.to_text()).unwrap();
+    for _ in 0..300 {
+        let q = random_situation(&mut noise, 8, 4.0);
+        let k = base.key(&q).unwrap();
+        let (i, d) = clone.nearest(&q).unwrap().unwrap();
+        assert!(i < n && (d - brute_nearest(&keys[..n], &k)).abs() < 1e-5);
+        let (i, d) = read.nearest(&q).unwrap().unwrap();
+        assert!((d - brute_nearest(&keys, &k)).abs() < 1e-5);
+        assert_eq!(read.cases()[i], base.cases()[i]);
+    }
+}
+
 #[test]
 fn learning_adds_only_novel_cases() {
     let mut base: CaseBase<6> = CaseBase::new(4.0, 0.1);

@@ -4,16 +4,19 @@
 //! A case is a [`Situation`] (the smallest range seen in each of N sectors
 //! around the robot, and the direction to the next subgoal) and the
 //! [`Command`] a driver chose in it. A [`CaseBase`] keeps its cases in a k-d
-//! tree (kiddo) over a normalised key: the N ranges divided by the robot's
+//! tree index over a normalised key: the N ranges divided by the robot's
 //! maximum range (each in [0, 1]) followed by the subgoal direction as
 //! `(cos, sin)`; the distance between situations is the Euclidean distance
 //! between keys. The reactive layer retrieves the nearest case and applies
 //! its command; [`CaseBase::learn`] adds a case on line only when it is
 //! novel (farther than the novelty threshold from every case kept).
 //!
-//! The search is exact, and its cost grows steeply with the number of
-//! sectors (the key's dimension): `examples/dla_speed.rs` measures it for
-//! 4, 6 and 8 sectors over 100,000 cases.
+//! The search is exact (to single precision); its cost grows steeply with
+//! the number of sectors (the key's dimension): `examples/dla_speed.rs`
+//! measures it for 4, 6 and 8 sectors over 100,000 cases. The index is
+//! described in `dla/nearest.rs`: static k-d trees split where the keys
+//! spread most, with leaves laid out for vector scans, and a small buffer
+//! of the latest cases, so that learning on line stays cheap.
 //!
 //! The training is supervised: [`drive`] is a scripted driver that steers
 //! to the freest sector near the subgoal direction and slows near obstacles.
@@ -37,8 +40,8 @@
 //! and gives a [`CaseError`] for any damage.
 
 use super::grid::Beam;
+use super::nearest::Index;
 use crate::geom::wrap_angle;
-use kiddo::SquaredEuclidean;
 use std::collections::HashSet;
 use std::f64::consts::{PI, TAU};
 use std::fmt;
@@ -192,15 +195,13 @@ pub struct CaseBase<const D: usize> {
     novelty: f64,
     cases: Vec<Case>,
     keys: Vec<[f64; D]>,
-    /// The single-precision keys held, bit for bit (the tree cannot hold
-    /// many copies of one point).
+    /// The single-precision keys held, bit for bit (a case repeating the
+    /// key of another is refused).
     held: HashSet<[u32; D]>,
-    tree: Tree<D>,
+    /// The nearest-neighbour index over the single-precision keys (half
+    /// the memory traffic of double precision); ids are case indices.
+    index: Index<D>,
 }
-
-/// The k-d tree: single-precision keys (half the memory traffic of double
-/// precision, the retrieval's bottleneck), buckets of 64 cases.
-type Tree<const D: usize> = kiddo::float::kdtree::KdTree<f32, u64, D, 64, u32>;
 
 fn narrow<const D: usize>(key: &[f64; D]) -> [f32; D] {
     std::array::from_fn(|i| key[i] as f32)
@@ -269,7 +270,14 @@ impl<const D: usize> CaseBase<D> {
     pub fn new(max_range: f64, novelty: f64) -> Self {
         assert!(D >= 3, "a situation has at least one sector");
         assert!(max_range.is_finite() && max_range > 0.0, "the maximum range is positive");
-        CaseBase { max_range, novelty, cases: Vec::new(), keys: Vec::new(), held: HashSet::new(), tree: Tree::new() }
+        CaseBase {
+            max_range,
+            novelty,
+            cases: Vec::new(),
+            keys: Vec::new(),
+            held: HashSet::new(),
+            index: Index::default(),
+        }
     }
     /// The robot's maximum range (m).
     pub fn max_range(&self) -> f64 {
@@ -323,11 +331,7 @@ impl<const D: usize> CaseBase<D> {
     /// by less than that precision either may be returned; the distance is
     /// that of the case returned, in double precision.
     pub fn nearest_key(&self, key: &[f64; D]) -> Option<(usize, f64)> {
-        if self.cases.is_empty() {
-            return None;
-        }
-        let n = self.tree.nearest_one::<SquaredEuclidean>(&narrow(key));
-        let i = n.item as usize;
+        let i = self.index.nearest(&narrow(key))?;
         Some((i, distance(key, &self.keys[i])))
     }
 
@@ -353,7 +357,7 @@ impl<const D: usize> CaseBase<D> {
         if !self.held.insert(narrow.map(|k| (k + 0.0).to_bits())) {
             return Ok(false);
         }
-        self.tree.add(&narrow, self.cases.len() as u64);
+        self.index.add(narrow);
         self.keys.push(key);
         self.cases.push(case);
         Ok(true)
@@ -461,6 +465,7 @@ impl<const D: usize> CaseBase<D> {
         if r.pos < text.len() {
             return Err(damaged(r.line + 1, "text after the checksum"));
         }
+        base.index.compact();
         Ok(base)
     }
 

@@ -16,5 +16,6 @@ pub mod cases;
 pub mod draw;
 pub mod experience;
 pub mod grid;
+mod nearest;
 pub mod pyramid;
 pub mod route;
