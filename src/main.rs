@@ -450,7 +450,7 @@ fn main() -> ExitCode {
             if local && (script.is_some() || random.is_some()) {
                 cmd::scripted::run(cmd::scripted::Args { file, script, random, until, out, record, foxglove, serve })
             } else if local {
-                let dla = cmd::run::DlaArgs { cases, learn: !no_learning };
+                let dla = cmd::run::DlaArgs { cases, learn: !no_learning, missions, evaluate };
                 cmd::run::run(cmd::run::Args {
                     file,
                     scenario,
@@ -462,8 +462,6 @@ fn main() -> ExitCode {
                     foxglove,
                     serve,
                     dla,
-                    missions,
-                    evaluate,
                 })
             } else {
                 cmd::distributed::run(cmd::distributed::Args {

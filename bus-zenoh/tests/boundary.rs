@@ -110,8 +110,7 @@ fn run<T: Send>(intrude: impl FnOnce(u16) -> T + Send) -> (Process, Process, T) 
         for p in &d.processes {
             let (c, d, log, summaries, stop) = (c.clone(), &d, log.clone(), summaries.clone(), stop.clone());
             scope.spawn(move || {
-                let local: Vec<bool> = c.agents.iter().map(|a| p.agents.contains(&a.name)).collect();
-                let placement = Placement { robot: d.robot.clone(), local, board: p.board };
+                let placement = Placement::of(d, p, &c);
                 let bus = ZenohBus::open(c.clone(), placement, &d.zenoh_config(p), Capacity::default()).unwrap();
                 let bus: Arc<dyn Bus> = Arc::new(bus);
                 // No obstacle ever: the stack stays in RS unless something

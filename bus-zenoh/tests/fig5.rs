@@ -64,8 +64,7 @@ pub fn node(
 ) -> (situ_runtime::summary::Summary, situ_runtime::record::Memory) {
     std::thread::sleep(Duration::from_secs_f64(delay));
     let p = d.process(name).unwrap();
-    let local: Vec<bool> = c.agents.iter().map(|a| p.agents.contains(&a.name)).collect();
-    let placement = Placement { robot: d.robot.clone(), local, board: p.board };
+    let placement = Placement::of(d, p, c);
     let bus = ZenohBus::open(c.clone(), placement, &d.zenoh_config(p), Capacity::default()).unwrap();
     let bus: Arc<dyn Bus> = Arc::new(bus);
     let mine: Vec<Box<dyn agent::Agent>> = demo::fig5(Duration::from_millis(1500), log.clone())
@@ -119,8 +118,7 @@ fn figure_5_across_three_nodes() {
         for p in &d.processes {
             let (c, d, log, states) = (c.clone(), &d, log.clone(), states.clone());
             scope.spawn(move || {
-                let local: Vec<bool> = c.agents.iter().map(|a| p.agents.contains(&a.name)).collect();
-                let placement = Placement { robot: d.robot.clone(), local: local.clone(), board: p.board };
+                let placement = Placement::of(d, p, &c);
                 let bus = ZenohBus::open(c.clone(), placement, &d.zenoh_config(p), Capacity::default()).unwrap();
                 let bus: Arc<dyn Bus> = Arc::new(bus);
                 let mine: Vec<Box<dyn agent::Agent>> = demo::fig5(Duration::from_millis(1500), log)

@@ -171,8 +171,7 @@ fn run_with_rogues(rogue_cert: &'static str) -> Vec<(String, Vec<String>, u64)> 
         for p in &d.processes {
             let (c, d, log, paths, stop) = (c.clone(), &d, log.clone(), paths.clone(), stop.clone());
             scope.spawn(move || {
-                let local: Vec<bool> = c.agents.iter().map(|a| p.agents.contains(&a.name)).collect();
-                let placement = Placement { robot: d.robot.clone(), local, board: p.board };
+                let placement = Placement::of(d, p, &c);
                 let bus = ZenohBus::open(c.clone(), placement, &d.zenoh_config(p), Capacity::default()).unwrap();
                 let bus: Arc<dyn Bus> = Arc::new(bus);
                 // No obstacle ever: only a rogue could take the state to RO or EM.

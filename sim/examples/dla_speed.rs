@@ -358,32 +358,26 @@ fn retrieval<const D: usize>(
         base.insert(case(noise, sectors)).expect("valid case");
     }
     let queries: Vec<Situation> = (0..QUERIES).map(|_| query(noise, sectors)).collect();
-    let mut per_query = Vec::new();
-    for _ in 0..5 {
-        let t = Instant::now();
-        let mut acc = 0usize;
-        for q in &queries {
-            acc += base.nearest(black_box(q)).expect("valid").expect("not empty").0;
+    // The median over 5 runs of the queries, per query (µs).
+    let time_queries = |base: &CaseBase<D>| {
+        let mut per_query = Vec::new();
+        for _ in 0..5 {
+            let t = Instant::now();
+            let mut acc = 0usize;
+            for q in &queries {
+                acc += base.nearest(black_box(q)).expect("valid").expect("not empty").0;
+            }
+            black_box(acc);
+            per_query.push(t.elapsed() / QUERIES as u32);
         }
-        black_box(acc);
-        per_query.push(t.elapsed() / QUERIES as u32);
-    }
-    let us = median(per_query).as_secs_f64() * 1e6;
+        median(per_query).as_secs_f64() * 1e6
+    };
+    let us = time_queries(&base);
     // The same base read from its file: all its cases in one tree.
     let t = Instant::now();
     let loaded: CaseBase<D> = CaseBase::from_text(&base.to_text()).expect("its own text");
     let load = t.elapsed();
-    let mut per_query = Vec::new();
-    for _ in 0..5 {
-        let t = Instant::now();
-        let mut acc = 0usize;
-        for q in &queries {
-            acc += loaded.nearest(black_box(q)).expect("valid").expect("not empty").0;
-        }
-        black_box(acc);
-        per_query.push(t.elapsed() / QUERIES as u32);
-    }
-    let loaded_us = median(per_query).as_secs_f64() * 1e6;
+    let loaded_us = time_queries(&loaded);
     for q in queries.iter().step_by(QUERIES / 50) {
         assert_eq!(loaded.nearest(q).expect("valid"), base.nearest(q).expect("valid"), "the same nearest case");
     }

@@ -26,15 +26,10 @@ use std::time::Instant;
 /// At most this many missions in one call.
 pub const MAX_MISSIONS: u64 = 10_000;
 
-pub fn run(
-    args: &Args,
-    content: Arc<Content>,
-    kind: StackKind,
-    scenario: &Scenario,
-    missions: u64,
-    held_out: u64,
-    until: f64,
-) -> u8 {
+/// `missions` learning missions (`--missions`), the evaluations of
+/// `args.dla.evaluate` held-out missions each.
+pub fn run(args: &Args, content: Arc<Content>, kind: StackKind, scenario: &Scenario, missions: u64, until: f64) -> u8 {
+    let held_out = args.dla.evaluate;
     if kind != StackKind::Dla {
         eprintln!(
             "error: --missions runs successive missions of a DLA stack (agents of rules/dla.situ, whose reactive \

@@ -40,11 +40,6 @@ pub struct Args {
     /// Serve the Supervisor's page of the run live at this address.
     pub serve: Option<String>,
     pub dla: DlaArgs,
-    /// DLA: successive missions, one case base learning through them
-    /// ([`super::experience`]).
-    pub missions: Option<u64>,
-    /// DLA: held-out missions per evaluation of the experience.
-    pub evaluate: u64,
 }
 
 /// DLA's options (`rules/dla.situ`).
@@ -54,6 +49,11 @@ pub struct DlaArgs {
     pub cases: Option<PathBuf>,
     /// Whether the reactive layer learns on line.
     pub learn: bool,
+    /// Successive missions, one case base learning through them
+    /// ([`super::experience`]).
+    pub missions: Option<u64>,
+    /// Held-out missions per evaluation of the experience.
+    pub evaluate: u64,
 }
 
 /// The case base of a DLA run: the file's, or a new one trained by the
@@ -98,7 +98,7 @@ pub fn run(args: Args) -> u8 {
     let file_bytes = program.bytes.clone();
     let kind = match StackKind::of(&content) {
         Ok(k) => k,
-        Err(_) if args.scenario.is_none() && args.compare.is_none() && args.missions.is_none() => {
+        Err(_) if args.scenario.is_none() && args.compare.is_none() && args.dla.missions.is_none() => {
             // Any other robot: its first script, every agent a stand-in.
             let Args { file, until, out, record, foxglove, serve, .. } = args;
             return super::scripted::run(super::scripted::Args {
@@ -139,8 +139,8 @@ pub fn run(args: Args) -> u8 {
     if let Some(list) = &args.compare {
         return compare(&args, content, kind, &scenario, list);
     }
-    if let Some(n) = args.missions {
-        return super::experience::run(&args, content, kind, &scenario, n, args.evaluate, until);
+    if let Some(n) = args.dla.missions {
+        return super::experience::run(&args, content, kind, &scenario, n, until);
     }
 
     // The recording: at --record, else in --out.

@@ -8,7 +8,7 @@
 //! The missions are run elsewhere (`situ run --missions N`, or a test);
 //! this module only holds and shows their results.
 
-use crate::plot::PlotError;
+use crate::plot::{err, PlotError};
 use plotters::prelude::*;
 use std::fmt::Write;
 
@@ -179,7 +179,6 @@ impl Experience {
     /// learning off, after so many learning missions (the curve); below,
     /// the cases the teacher had to give in each learning mission.
     pub fn svg(&self, title: &str) -> Result<String, PlotError> {
-        let err = |e: &dyn std::fmt::Debug| PlotError(format!("{e:?}"));
         let n = self.missions.len().max(1) as f64;
         let l_max = self.missions.iter().map(|m| m.learnt).max().unwrap_or(1).max(1) as f64 * 1.15;
         let green = RGBColor(44, 160, 44);
@@ -188,30 +187,30 @@ impl Experience {
         let mut buf = String::new();
         {
             let root = SVGBackend::with_string(&mut buf, (1000, 640)).into_drawing_area();
-            root.fill(&WHITE).map_err(|e| err(&e))?;
-            let root = root.titled(title, ("sans-serif", 20)).map_err(|e| err(&e))?;
+            root.fill(&WHITE).map_err(err)?;
+            let root = root.titled(title, ("sans-serif", 20)).map_err(err)?;
             let (top, bottom) = root.split_vertically(330);
             let mut chart = ChartBuilder::on(&top)
                 .margin(10)
                 .x_label_area_size(25)
                 .y_label_area_size(60)
                 .build_cartesian_2d(-0.5..n + 0.5, 0.0..105.0)
-                .map_err(|e| err(&e))?;
+                .map_err(err)?;
             chart
                 .configure_mesh()
                 .y_desc("held-out missions done (%)")
                 .x_labels(20)
                 .x_label_formatter(&|x| format!("{x:.0}"))
                 .draw()
-                .map_err(|e| err(&e))?;
+                .map_err(err)?;
             let done: Vec<(f64, f64)> =
                 self.evaluations.iter().map(|e| (e.after as f64, 100.0 * e.share().success_rate())).collect();
             chart
                 .draw_series(LineSeries::new(done.clone(), green.stroke_width(2)))
-                .map_err(|e| err(&e))?
+                .map_err(err)?
                 .label("done, learning off")
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], green.stroke_width(2)));
-            chart.draw_series(done.iter().map(|&p| Circle::new(p, 4, green.filled()))).map_err(|e| err(&e))?;
+            chart.draw_series(done.iter().map(|&p| Circle::new(p, 4, green.filled()))).map_err(err)?;
             let hit: Vec<(f64, f64)> = self
                 .evaluations
                 .iter()
@@ -219,7 +218,7 @@ impl Experience {
                 .collect();
             chart
                 .draw_series(LineSeries::new(hit, red.stroke_width(2)))
-                .map_err(|e| err(&e))?
+                .map_err(err)?
                 .label("ended in a collision")
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], red.stroke_width(2)));
             chart
@@ -228,13 +227,13 @@ impl Experience {
                 .background_style(WHITE.mix(0.85))
                 .border_style(BLACK)
                 .draw()
-                .map_err(|e| err(&e))?;
+                .map_err(err)?;
             let mut chart = ChartBuilder::on(&bottom)
                 .margin(10)
                 .x_label_area_size(35)
                 .y_label_area_size(60)
                 .build_cartesian_2d(-0.5..n + 0.5, 0.0..l_max)
-                .map_err(|e| err(&e))?;
+                .map_err(err)?;
             chart
                 .configure_mesh()
                 .x_desc("learning missions")
@@ -242,14 +241,14 @@ impl Experience {
                 .x_labels(20)
                 .x_label_formatter(&|x| format!("{x:.0}"))
                 .draw()
-                .map_err(|e| err(&e))?;
+                .map_err(err)?;
             chart
                 .draw_series(self.missions.iter().map(|m| {
                     let x = m.index as f64 - 0.5;
                     Rectangle::new([(x - 0.3, 0.0), (x + 0.3, m.learnt as f64)], blue.mix(0.7).filled())
                 }))
-                .map_err(|e| err(&e))?;
-            root.present().map_err(|e| err(&e))?;
+                .map_err(err)?;
+            root.present().map_err(err)?;
         }
         Ok(buf)
     }

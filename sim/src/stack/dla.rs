@@ -640,47 +640,54 @@ impl Agent for Reactive {
             }
         };
         drop(cases);
-        // Never standing still where the body could creep straight on.
-        let command = if standstill(&command) && ahead_clear(&scan.beams, CREEP) {
+        let points: Vec<Vec2> = scan_points(&scan.beams).collect();
+        let command = reflexes(command, &points, nearest_all, &self.vehicle);
+        cx.send(Body::local(DriveCommand(command)));
+    }
+}
+
+/// The reactive layer's reflexes on the command it chose, given the scan's
+/// readings as `points` in the robot's frame and the nearest sector range.
+fn reflexes(command: CaseCommand, points: &[Vec2], nearest_all: f64, vehicle: &VehicleParams) -> CaseCommand {
+    // Never standing still where the body could creep straight on.
+    let command = if standstill(&command) && ahead_clear(points, CREEP) {
+        CaseCommand { speed: CRAWL, turn_rate: 0.0 }
+    } else {
+        command
+    };
+    // Turning "in place" sweeps a disc about a centre to the side it
+    // turns to: that way if nothing is within the disc, else the other
+    // way if nothing is within that one, else straight on at a crawl if
+    // nothing is in the body's way, else not at all.
+    let command = if command.speed < CRAWL && nearest_all < TURN_RADIUS + TURN_SWEEP {
+        let side = if command.turn_rate < 0.0 { -1.0 } else { 1.0 };
+        if turn_clear(points, side) {
+            command
+        } else if turn_clear(points, -side) {
+            CaseCommand { speed: command.speed, turn_rate: -command.turn_rate }
+        } else if ahead_clear(points, CREEP) {
             CaseCommand { speed: CRAWL, turn_rate: 0.0 }
         } else {
-            command
-        };
-        // Turning "in place" sweeps a disc about a centre to the side it
-        // turns to: that way if nothing is within the disc, else the other
-        // way if nothing is within that one, else straight on at a crawl if
-        // nothing is in the body's way, else not at all.
-        let command = if command.speed < CRAWL && nearest_all < TURN_RADIUS + TURN_SWEEP {
-            let side = if command.turn_rate < 0.0 { -1.0 } else { 1.0 };
-            if turn_clear(&scan.beams, side) {
-                command
-            } else if turn_clear(&scan.beams, -side) {
-                CaseCommand { speed: command.speed, turn_rate: -command.turn_rate }
-            } else if ahead_clear(&scan.beams, CREEP) {
-                CaseCommand { speed: CRAWL, turn_rate: 0.0 }
-            } else {
-                CaseCommand { speed: 0.0, turn_rate: 0.0 }
-            }
+            CaseCommand { speed: 0.0, turn_rate: 0.0 }
+        }
+    } else {
+        command
+    };
+    // Last, the body's sweep over the next half second: a command that
+    // would bring a reading within it becomes a turn on the spot (the
+    // way it turned, else the other), or a stop.
+    if sweep_clear(points, &command, vehicle) {
+        command
+    } else {
+        let side = if command.turn_rate < 0.0 { -1.0 } else { 1.0 };
+        let turn = driver().max_turn_rate;
+        if turn_clear(points, side) {
+            CaseCommand { speed: 0.0, turn_rate: side * turn }
+        } else if turn_clear(points, -side) {
+            CaseCommand { speed: 0.0, turn_rate: -side * turn }
         } else {
-            command
-        };
-        // Last, the body's sweep over the next half second: a command that
-        // would bring a reading within it becomes a turn on the spot (the
-        // way it turned, else the other), or a stop.
-        let command = if sweep_clear(&scan.beams, &command, &self.vehicle) {
-            command
-        } else {
-            let side = if command.turn_rate < 0.0 { -1.0 } else { 1.0 };
-            let turn = driver().max_turn_rate;
-            if turn_clear(&scan.beams, side) {
-                CaseCommand { speed: 0.0, turn_rate: side * turn }
-            } else if turn_clear(&scan.beams, -side) {
-                CaseCommand { speed: 0.0, turn_rate: -side * turn }
-            } else {
-                CaseCommand { speed: 0.0, turn_rate: 0.0 }
-            }
-        };
-        cx.send(Body::local(DriveCommand(command)));
+            CaseCommand { speed: 0.0, turn_rate: 0.0 }
+        }
     }
 }
 
@@ -691,7 +698,7 @@ fn standstill(c: &CaseCommand) -> bool {
 }
 
 /// The readings of a scan as points in the robot's frame (m).
-fn points(beams: &[Beam]) -> impl Iterator<Item = Vec2> + '_ {
+fn scan_points(beams: &[Beam]) -> impl Iterator<Item = Vec2> + '_ {
     beams
         .iter()
         .filter(|b| b.range.is_finite() && b.range < b.max_range)
@@ -706,9 +713,8 @@ fn turn_clear_at(points: &[Vec2], pose: &Pose, side: f64) -> bool {
 }
 
 /// [`turn_clear_at`] from where the robot is.
-fn turn_clear(beams: &[Beam], side: f64) -> bool {
-    let points: Vec<Vec2> = points(beams).collect();
-    turn_clear_at(&points, &Pose::new(0.0, 0.0, 0.0), side)
+fn turn_clear(points: &[Vec2], side: f64) -> bool {
+    turn_clear_at(points, &Pose::new(0.0, 0.0, 0.0), side)
 }
 
 /// How far ahead (s) [`sweep_clear`] follows a command.
@@ -721,7 +727,7 @@ pub const SWEEP_MARGIN: f64 = 0.04;
 /// [`SWEEP_MARGIN`], clear of every reading of the scan, and, when the
 /// robot could turn on the spot where it is, leaves it where it still can
 /// (so it never drives into a corner it cannot turn out of).
-fn sweep_clear(beams: &[Beam], c: &CaseCommand, vehicle: &VehicleParams) -> bool {
+fn sweep_clear(points: &[Vec2], c: &CaseCommand, vehicle: &VehicleParams) -> bool {
     if standstill(c) {
         return true;
     }
@@ -730,7 +736,7 @@ fn sweep_clear(beams: &[Beam], c: &CaseCommand, vehicle: &VehicleParams) -> bool
     let kappa = steer.tan() / vehicle.wheelbase;
     let body = vehicle.front.max(vehicle.rear).hypot(vehicle.width / 2.0) + SWEEP_MARGIN;
     let reach = v * SWEEP_TIME + body.max(TURN_RADIUS + TURN_SWEEP);
-    let points: Vec<Vec2> = points(beams).filter(|p| p.norm() <= reach).collect();
+    let points: Vec<Vec2> = points.iter().copied().filter(|p| p.norm() <= reach).collect();
     let (front, rear, half) =
         (vehicle.front + SWEEP_MARGIN, vehicle.rear + SWEEP_MARGIN, vehicle.width / 2.0 + SWEEP_MARGIN);
     let here = Pose::new(0.0, 0.0, 0.0);
@@ -749,8 +755,8 @@ fn sweep_clear(beams: &[Beam], c: &CaseCommand, vehicle: &VehicleParams) -> bool
 /// Whether moving straight ahead by `reach` (m) keeps the body clear: no
 /// reading in the strip the body sweeps (0.2 m ahead of the centre, 0.18 m
 /// to each side, and 0.02 m to spare).
-fn ahead_clear(beams: &[Beam], reach: f64) -> bool {
-    points(beams).all(|p| !(p.x > 0.0 && p.x < 0.22 + reach && p.y.abs() < 0.2))
+fn ahead_clear(points: &[Vec2], reach: f64) -> bool {
+    points.iter().all(|p| !(p.x > 0.0 && p.x < 0.22 + reach && p.y.abs() < 0.2))
 }
 
 struct Base {

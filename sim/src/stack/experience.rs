@@ -13,16 +13,6 @@ use std::sync::{Arc, Mutex};
 /// learning missions' (`--seed` onwards).
 pub const HELD_OUT: u64 = 1_000_000;
 
-/// How a mission ended, short (`goal at 84.0 s`), and when (s).
-pub fn short(o: &Outcome) -> (f64, String) {
-    match o {
-        Outcome::GoalReached { time } => (*time, format!("goal at {time:.1} s")),
-        Outcome::Collision { time, obstacle, .. } => (*time, format!("collision with {obstacle} at {time:.1} s")),
-        Outcome::Stopped { time, state } => (*time, format!("stopped in {state} at {time:.1} s")),
-        Outcome::Timeout { time, state } => (*time, format!("still in {state} after {time:.0} s")),
-    }
-}
-
 /// One mission of the DLA stack in `world` with the case base `cases`
 /// (learning into it when `learn`); `progress` is called once a simulated
 /// second.
@@ -47,14 +37,13 @@ pub fn mission(
         let p = p.lock().unwrap_or_else(|e| e.into_inner());
         (p.routes, p.learnt)
     });
-    let (end, outcome) = short(&report.outcome);
     Ok(Mission {
         index,
         seed,
         done: report.outcome.success(),
         collision: matches!(report.outcome, Outcome::Collision { .. }),
-        end,
-        outcome,
+        end: report.outcome.time(),
+        outcome: report.outcome.brief(),
         distance: report.metrics.summary.distance,
         routes,
         learnt,

@@ -247,6 +247,26 @@ impl Outcome {
         matches!(self, Outcome::GoalReached { .. })
     }
 
+    /// When it ended (s): at the goal, the collision, the rest, or the limit.
+    pub fn time(&self) -> f64 {
+        match self {
+            Outcome::GoalReached { time }
+            | Outcome::Collision { time, .. }
+            | Outcome::Stopped { time, .. }
+            | Outcome::Timeout { time, .. } => *time,
+        }
+    }
+
+    /// A few words for a table (`goal at 84.0 s`).
+    pub fn brief(&self) -> String {
+        match self {
+            Outcome::GoalReached { time } => format!("goal at {time:.1} s"),
+            Outcome::Collision { time, obstacle, .. } => format!("collision with {obstacle} at {time:.1} s"),
+            Outcome::Stopped { time, state } => format!("stopped in {state} at {time:.1} s"),
+            Outcome::Timeout { time, state } => format!("still in {state} after {time:.0} s"),
+        }
+    }
+
     /// One line for a person.
     pub fn describe(&self) -> String {
         match self {
