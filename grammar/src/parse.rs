@@ -8,7 +8,7 @@ use crate::lex::{self, Comment};
 use pest::iterators::Pair;
 use pest::Parser as _;
 use std::num::NonZeroUsize;
-use std::sync::Once;
+use std::sync::{Mutex, Once};
 
 mod hints;
 mod report;
@@ -46,10 +46,51 @@ pub struct Parsed {
 fn configure_pest() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
-        pest::set_error_detail(true);
+        // Error detail (what was expected at the furthest place reached) is
+        // collected only when an item is parsed again to report its error:
+        // see `parse_item`.
+        pest::set_error_detail(false);
         // A bound on the work per item, so that no input can make it hang.
         pest::set_call_limit(NonZeroUsize::new(5_000_000));
     });
+}
+
+/// Held while an item is parsed with pest's error detail on: the only code
+/// that turns the flag on, and it turns it off again before letting go.
+static DETAIL: Mutex<()> = Mutex::new(());
+
+/// Parses one item with the `item` rule; a failure comes with the expected
+/// tokens that `syntax_error` reports.
+///
+/// pest's error detail costs a string per literal tried (most of a parse),
+/// and only a failure uses it, so the item is parsed without it first and,
+/// only when that fails, once more with it. Neither the outcome of a parse
+/// nor its error's position and rules depend on the flag: it only turns on
+/// the bookkeeping of `ParseAttempts`, which no decision of the parser reads,
+/// and pest reads it once, when a parse starts. The second parse therefore
+/// fails exactly as the first and yields the error that a parse with the flag
+/// always on gave. The flag is process-wide, and other threads parse at the
+/// same time: it is turned on only here, under `DETAIL`, and off again before
+/// the lock is released, so the detailed parse always sees it on; a parse on
+/// another thread that starts meanwhile also collects the detail, which
+/// changes nothing but its speed.
+fn parse_item(text: &str) -> Result<pest::iterators::Pairs<'_, Rule>, pest::error::Error<Rule>> {
+    match SituParser::parse(Rule::item, text) {
+        Ok(pairs) => Ok(pairs),
+        Err(_) => {
+            /// Turns the flag off on every way out, a panic included.
+            struct Off;
+            impl Drop for Off {
+                fn drop(&mut self) {
+                    pest::set_error_detail(false);
+                }
+            }
+            let _lock = DETAIL.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+            pest::set_error_detail(true);
+            let _off = Off;
+            SituParser::parse(Rule::item, text)
+        }
+    }
 }
 
 /// Parses a whole source, recovering at item boundaries.
@@ -87,7 +128,7 @@ pub fn parse(src: &str, file: FileId) -> Parsed {
             );
             continue;
         }
-        match SituParser::parse(Rule::item, text) {
+        match parse_item(text) {
             Ok(mut pairs) => {
                 let item = pairs.next().and_then(|p| p.into_inner().next());
                 let Some(pair) = item else { continue };
@@ -913,5 +954,27 @@ mod tests {
         }
         // An overflowing number is still an error, not infinity.
         assert!(!parse("test \"t\" { on E(a: 1e999) }", crate::diag::FileId(0)).errors.is_empty());
+    }
+
+    /// `ident` compares a name with the keywords only when it starts with a
+    /// small letter: every keyword must, and `KEYWORDS` must be the grammar's.
+    #[test]
+    fn keywords_start_with_a_small_letter() {
+        let grammar = include_str!("situ.pest");
+        let start = grammar.find("keyword = _{").expect("the keyword rule");
+        let body = &grammar[start..start + grammar[start..].find("~ !ident_char").expect("its end")];
+        let mut words: Vec<&str> = body.split('"').skip(1).step_by(2).collect();
+        let mut listed = KEYWORDS.to_vec();
+        words.sort_unstable();
+        listed.sort_unstable();
+        assert_eq!(words, listed);
+        for w in KEYWORDS {
+            assert!(w.starts_with(|c: char| c.is_ascii_lowercase()), "{w}");
+            let capital = format!("{}{}", w[..1].to_ascii_uppercase(), &w[1..]);
+            let src = format!("rule {w} {{ when A then B }}\nrule {capital} {{ when A then B }}");
+            let parsed = parse(&src, crate::diag::FileId(0));
+            assert_eq!(parsed.errors.len(), 1, "{w}: {:?}", parsed.errors);
+            assert_eq!(parsed.file.items.len(), 1, "{capital} is a name");
+        }
     }
 }
