@@ -20,6 +20,11 @@ use std::collections::BTreeMap;
 /// masks (branches of the falsification search, as for W0303).
 const BUDGET: usize = 20_000;
 
+/// The conflicts reported with one rule (the first of the pair): a state
+/// that fans out to thousands of others with the same condition would
+/// otherwise give a finding per pair of them, millions.
+pub const MAX_PER_RULE: usize = 10;
+
 pub fn check(model: &Model, tr: &Transitions) -> Vec<Diagnostic> {
     // Only rules of equal salience can conflict: group them first.
     let mut groups: BTreeMap<i64, Vec<usize>> = BTreeMap::new();
@@ -30,11 +35,40 @@ pub fn check(model: &Model, tr: &Transitions) -> Vec<Diagnostic> {
     }
     let mut out = Vec::new();
     for rules in groups.values() {
+        // Rules with the same target never conflict: a run of them (in
+        // order) is stepped over at once, so that thousands of rules
+        // leading to one state are not compared pair by pair.
+        let mut run_end = vec![rules.len(); rules.len()];
+        for k in (0..rules.len().saturating_sub(1)).rev() {
+            if model.rules[rules[k]].target == model.rules[rules[k + 1]].target {
+                run_end[k] = run_end[k + 1];
+            } else {
+                run_end[k] = k + 1;
+            }
+        }
         for (k, &a) in rules.iter().enumerate() {
-            for &b in &rules[k + 1..] {
-                if let Some(d) = pair(model, tr, a, b) {
+            let mut found = 0;
+            let mut j = k + 1;
+            while j < rules.len() {
+                let b = rules[j];
+                if model.rules[b].target == model.rules[a].target {
+                    j = run_end[j];
+                    continue;
+                }
+                if let Some(mut d) = pair(model, tr, a, b) {
+                    found += 1;
+                    if found == MAX_PER_RULE {
+                        let more = format!(
+                            "; `{}` is not compared with the rules after `{}`: {MAX_PER_RULE} conflicts with one rule are enough to show",
+                            model.rules[a].name, model.rules[b].name
+                        );
+                        d.help = Some(d.help.unwrap_or_default() + &more);
+                        out.push(d);
+                        break;
+                    }
                     out.push(d);
                 }
+                j += 1;
             }
         }
     }

@@ -26,6 +26,11 @@ pub fn check(model: &Model, tr: &Transitions) -> Vec<Diagnostic> {
     for e in &tr.edges {
         steps.entry((e.from, e.to)).or_default().push(e);
     }
+    // The states with a step into each state, for the walks back below.
+    let mut before: Vec<Vec<StateId>> = vec![Vec::new(); n];
+    for &(from, to) in steps.keys() {
+        before[to.index()].push(from);
+    }
     let mut out = Vec::new();
     let mut reported: BTreeSet<BTreeSet<RuleId>> = BTreeSet::new();
     let mut cycles = 0;
@@ -36,7 +41,7 @@ pub fn check(model: &Model, tr: &Transitions) -> Vec<Diagnostic> {
         dist[start.index()] = 0;
         let mut queue = VecDeque::from([start]);
         while let Some(v) = queue.pop_front() {
-            for &(from, _) in steps.keys().filter(|(_, to)| *to == v) {
+            for &from in &before[v.index()] {
                 if from > start && dist[from.index()] == usize::MAX {
                     dist[from.index()] = dist[v.index()] + 1;
                     queue.push_back(from);
@@ -136,9 +141,10 @@ fn examine(model: &Model, tr: &Transitions, cycle: &[&Edge], mut memory: Situati
     memory.states = BTreeSet::from([cycle[0].from]);
     // In each state of the cycle, no rule of higher salience may take over.
     let mut avoid: Vec<&Rule> = Vec::new();
+    let mut avoided = vec![false; model.rules.len()];
     for e in cycle {
         let r = &model.rules[e.rule.index()];
-        for (h, sit) in model.rules.iter().zip(&tr.situations) {
+        for (i, (h, sit)) in model.rules.iter().zip(&tr.situations).enumerate() {
             let allowed = sit.as_ref().is_ok_and(|s| s.states.contains(&e.from));
             // A rule of higher salience wins; one of equal salience may win on
             // specificity or recency: both must stay inactive for the cycle.
@@ -147,7 +153,8 @@ fn examine(model: &Model, tr: &Transitions, cycle: &[&Edge], mut memory: Situati
                     && !std::ptr::eq(h, r)
                     && h.target != r.target
                     && h.specificity() >= r.specificity());
-            if rival && allowed && h.target != e.from && !avoid.iter().any(|a| std::ptr::eq(*a, h)) {
+            if rival && allowed && h.target != e.from && !avoided[i] {
+                avoided[i] = true;
                 avoid.push(h);
             }
         }

@@ -232,3 +232,35 @@ fn non_finite_literals_are_payloads_not_rule_tests() {
     let c = check_source("t.situ", &format!("{STACK}rule r {{ when state == IT and LAOBS(distance != NaN) then RS }}"));
     assert!(c.diagnostics.iter().any(|d| d.code == "E0203"), "{:?}", c.diagnostics);
 }
+
+#[test]
+fn a_state_that_fans_out_reports_a_bounded_number_of_conflicts() {
+    // One state leading to 60 others on the same condition: every pair of
+    // those rules conflicts (1,770 pairs); each rule is reported with at
+    // most `MAX_PER_RULE` of the rules after it, the last saying so.
+    use super::conflicts::MAX_PER_RULE;
+    let n = 60;
+    let states: Vec<String> = (0..n).map(|i| format!("S{i}")).collect();
+    let mut src = format!("states {{ A initial {} }}\n", states.join(" "));
+    for s in &states {
+        src.push_str(&format!(
+            "rule to_{s} {{ when state == A then {s} }}\nrule back_{s} {{ when state == {s} then A }}\n"
+        ));
+    }
+    // Runs of rules to one state, among them: never compared with each other.
+    for k in 0..200 {
+        src.push_str(&format!("rule again_{k} {{ when state == A then S0 }}\n"));
+    }
+    let c = check_source("fan.situ", &src);
+    let conflicts: Vec<_> = c.diagnostics.iter().filter(|d| d.code == "E0302").collect();
+    // Every `to_*` rule has at least ten partners after it (the later
+    // `to_*`, and for all but `to_S0` the `again_*`): ten findings each,
+    // where all pairs would be 1,770 + 59 × 200. The `back_*` rules are in
+    // other states, and `to_S0` and the `again_*` rules share their target.
+    assert_eq!(conflicts.len(), n * MAX_PER_RULE);
+    let said =
+        |d: &&&situ_grammar::diag::Diagnostic| d.help.as_deref().is_some_and(|h| h.contains("are enough to show"));
+    assert_eq!(conflicts.iter().filter(said).count(), n, "the tenth finding of each rule says so");
+    assert!(conflicts.iter().all(|d| !(d.message.contains("`to_S0`") && d.message.contains("`again_"))));
+    assert!(conflicts.iter().all(|d| d.message.matches("`again_").count() < 2));
+}
