@@ -6,14 +6,14 @@
 //!   collision, re-planning as the walls are discovered;
 //! - while a new route is computed the reactive layer keeps the robot moving;
 //! - with the topological route the mission is shorter than with the
-//!   reactive layer alone (which does not find the doors);
+//!   reactive layer alone (which wanders the rooms for the doors);
 //! - a goal that cannot be reached ends in `Unreachable`, not in a hang;
-//! - experience: after missions learning on line, the reactive layer
-//!   alone (no teacher, no route) crosses an obstacle field it has not seen
-//!   more often than the trained base did, and the teacher is needed less
-//!   and less;
-//! - in `dla-field` (an obstacle field it has not seen) the layers reach the
-//!   goal, and the reactive layer alone touches nothing.
+//! - after training, the reactive layer alone (no teacher, no route)
+//!   crosses an obstacle field it has not seen with no collision; after
+//!   missions learning on line it crosses it sooner, and the teacher is
+//!   needed less and less;
+//! - in `dla-field` the layers reach the goal sooner than the reactive
+//!   layer alone.
 
 use situ_compiler::bundle::Content;
 use situ_sim::scenario::{self, Scenario};
@@ -126,28 +126,43 @@ fn an_unreachable_goal_ends_in_unreachable() {
 }
 
 /// The reactive layer alone (no route), learning off, across `dla-field`
-/// (an obstacle field none of the cases was learnt in) on seeds 1 to 6:
-/// how many crossed, and how many touched something.
-fn crossings(cases: &situ_sim::stack::dla::CasesHandle) -> (usize, usize) {
+/// (an obstacle field none of the cases was learnt in) on seeds 1 to 6.
+#[derive(Debug)]
+struct Crossings {
+    /// How many reached the goal, and how many touched something.
+    done: usize,
+    hit: usize,
+    /// The mean time (s) and path (m) of those that reached it.
+    time: f64,
+    path: f64,
+}
+
+fn crossings(cases: &situ_sim::stack::dla::CasesHandle) -> Crossings {
     use situ_sim::stack::{dla, experience};
     use std::sync::Mutex;
     let content = compile("reactive-only.situ", &reactive_only());
     let field = scenario::builtin("dla-field").expect("built in").world;
-    let (mut done, mut hit) = (0, 0);
+    let (mut done, mut hit, mut time, mut path) = (0, 0, 0.0, 0.0);
     for seed in 1..=6 {
         // A copy each time: nothing is learnt, but the base is not shared.
         let copy = dla::CasesHandle(Arc::new(Mutex::new(cases.0.lock().unwrap().clone())));
         let m = experience::mission(&content, &field, 1, seed, 200.0, false, &copy, &mut |_| {}).unwrap();
         done += usize::from(m.done);
         hit += usize::from(m.collision);
+        if m.done {
+            time += m.end;
+            path += m.distance;
+        }
     }
-    (done, hit)
+    let n = done.max(1) as f64;
+    Crossings { done, hit, time: time / n, path: path / n }
 }
 
 #[test]
-fn with_experience_the_reactive_layer_alone_crosses_an_unseen_field_more_often() {
-    // Urdiales et al.: the reactive layer improves with experience. The
-    // base trained by the scripted driver (in a field of its own), then 8
+fn the_trained_reactive_layer_crosses_an_unseen_field_and_crosses_it_sooner_with_experience() {
+    // Urdiales et al.: the reactive layer, trained by a driver, navigates
+    // where it was not trained, and improves with experience. The base
+    // trained by the scripted driver (in a field of its own), then 8
     // missions of the whole stack in the offices learning on line (the
     // teacher correcting novel, unsafe and standstill cases); each base,
     // alone and learning nothing, tried across the unseen field.
@@ -164,28 +179,36 @@ fn with_experience_the_reactive_layer_alone_crosses_an_unseen_field_more_often()
         learnt.push(m.learnt);
     }
     let after = crossings(&cases);
-    println!("crossed (of 6), touched: before {before:?}, after {after:?}; learnt on line per mission: {learnt:?}");
-    // Crossing the field alone is hard for a purely reactive layer (a box
-    // square across the line to the goal is a local minimum); experience
-    // makes it cross more often, and it never touches anything.
-    assert!(after.0 > before.0, "crossings before {before:?}, after {after:?}");
-    assert_eq!(after.1, 0, "collisions after experience");
+    println!("across the unseen field: trained {before:?}, after experience {after:?}; learnt on line per mission: {learnt:?}");
+    // Trained, it crosses (getting out of the local minimum of a box
+    // square across its line to the goal by its detour) and touches
+    // nothing; so after experience. Measured: 6 of 6 both times.
+    assert!(before.done >= 5 && before.hit == 0, "the trained base: {before:?}");
+    assert!(after.done >= 5 && after.hit == 0, "after experience: {after:?}");
+    // With experience it crosses sooner and by a shorter path (measured:
+    // 96.9 s and 23.6 m, then 81.4 s and 22.5 m; a tenth sooner at least).
+    assert!(after.time < 0.9 * before.time, "trained {before:?}, after experience {after:?}");
+    assert!(after.path < before.path, "trained {before:?}, after experience {after:?}");
     // The teacher is needed less and less.
     let (first, last) = (learnt[0] + learnt[1], learnt[6] + learnt[7]);
     assert!(2 * last < first, "cases learnt on line per mission: {learnt:?}");
 }
 
 #[test]
-fn the_layers_cross_an_unseen_obstacle_field_and_the_reactive_layer_alone_hits_nothing() {
+fn the_layers_cross_an_unseen_obstacle_field_sooner_than_the_reactive_layer_alone() {
     let field = scenario::builtin("dla-field").expect("built in");
     let (report, routes, _) = run(compile("dla.situ", &source()), &field, 1, 200.0);
-    assert!(report.outcome.success(), "{:?}", report.outcome);
+    let Outcome::GoalReached { time } = report.outcome else { panic!("{:?}", report.outcome) };
     assert!(routes >= 1);
-    // Alone, the reactive layer gets caught in front of a box square across
-    // its line to the goal (the local minimum the route is for), but it
-    // never touches anything: its sweep check turns it on the spot.
-    let (alone, routes, _) = run(compile("reactive-only.situ", &reactive_only()), &field, 1, 120.0);
+    // Alone, the reactive layer is caught in front of a box square across
+    // its line to the goal (the local minimum the route is for) until its
+    // detour takes it round; it gets there later, touching nothing.
+    let (alone, routes, _) = run(compile("reactive-only.situ", &reactive_only()), &field, 1, 200.0);
+    println!("the layers: {time:.1} s; the reactive layer alone: {}", alone.outcome.describe());
     assert_eq!(routes, 0);
     assert!(alone.metrics.summary.collisions.is_empty(), "{:?}", alone.metrics.summary.collisions);
-    assert!(!matches!(alone.outcome, Outcome::Collision { .. }), "{:?}", alone.outcome);
+    match alone.outcome {
+        Outcome::GoalReached { time: alone } => assert!(time < alone, "the layers {time} s, alone {alone} s"),
+        other => assert!(matches!(other, Outcome::Timeout { .. }), "{other:?}"),
+    }
 }

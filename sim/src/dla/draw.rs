@@ -141,37 +141,25 @@ fn merge_cells<K: PartialEq + Copy>(w: usize, h: usize, key: impl Fn(usize, usiz
 fn outlines(p: &Pyramid, w: usize, h: usize) -> Vec<Vec<(usize, usize, usize, usize)>> {
     let n = p.regions().len();
     let mut segments: Vec<Vec<(usize, usize, usize, usize)>> = vec![Vec::new(); n];
-    let region = |x: usize, y: usize| p.region_of(x, y);
-    // Horizontal edges on line y (between rows y − 1 and y).
-    for y in 0..=h {
-        for x in 0..w {
-            let below = if y > 0 { Some(region(x, y - 1)) } else { None };
-            let above = if y < h { Some(region(x, y)) } else { None };
-            if below == above {
-                continue;
-            }
-            for r in [below, above].into_iter().flatten() {
-                let s = &mut segments[r];
-                match s.last_mut() {
-                    Some(last) if last.1 == y && last.3 == y && last.2 == x => last.2 = x + 1,
-                    _ => s.push((x, y, x + 1, y)),
+    // The lines between rows (horizontal edges), then between columns
+    // (vertical ones): `line` crosses the grid, `at` runs along it.
+    for vertical in [false, true] {
+        let (lines, along) = if vertical { (w, h) } else { (h, w) };
+        let cell = |line: usize, at: usize| if vertical { p.region_of(line, at) } else { p.region_of(at, line) };
+        for line in 0..=lines {
+            for at in 0..along {
+                let before = (line > 0).then(|| cell(line - 1, at));
+                let after = (line < lines).then(|| cell(line, at));
+                if before == after {
+                    continue;
                 }
-            }
-        }
-    }
-    // Vertical edges on line x (between columns x − 1 and x).
-    for x in 0..=w {
-        for y in 0..h {
-            let left = if x > 0 { Some(region(x - 1, y)) } else { None };
-            let right = if x < w { Some(region(x, y)) } else { None };
-            if left == right {
-                continue;
-            }
-            for r in [left, right].into_iter().flatten() {
-                let s = &mut segments[r];
-                match s.last_mut() {
-                    Some(last) if last.0 == x && last.2 == x && last.3 == y => last.3 = y + 1,
-                    _ => s.push((x, y, x, y + 1)),
+                for r in [before, after].into_iter().flatten() {
+                    let s = &mut segments[r];
+                    match s.last_mut() {
+                        Some(last) if vertical && last.0 == line && last.2 == line && last.3 == at => last.3 = at + 1,
+                        Some(last) if !vertical && last.1 == line && last.3 == line && last.2 == at => last.2 = at + 1,
+                        _ => s.push(if vertical { (line, at, line, at + 1) } else { (at, line, at + 1, line) }),
+                    }
                 }
             }
         }

@@ -7,12 +7,14 @@
 //!   path planner between consecutive regions;
 //! - [`cases`]: the reactive layer learnt by cases (Urdiales et al. 2006):
 //!   a k-d tree case base, on-line learning, its file, a scripted driver;
+//! - [`detour`]: the reactive layer's way out of a local minimum;
 //! - [`draw`]: an SVG picture of a grid, its regions, a route, a path and a
 //!   trajectory;
 //! - [`experience`]: successive missions learning on line, their table and
 //!   their curve.
 
 pub mod cases;
+pub mod detour;
 pub mod draw;
 pub mod experience;
 pub mod grid;

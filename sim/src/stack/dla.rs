@@ -21,17 +21,23 @@ use super::events::{report, Named};
 use super::ugv::{fresh, names, take};
 use super::{lock, SharedPhysics};
 use crate::dla::cases::{self, Case, CaseBase, Command as CaseCommand, DriverParams, Situation};
+use crate::dla::detour::Detour;
 use crate::dla::grid::{Beam, CellClass, GridParams, OccupancyGrid};
 use crate::dla::pyramid::{Pyramid, PyramidParams, RegionClass};
 use crate::dla::route::{plan_path, plan_route, PathParams, RouteParams};
 use crate::geom::{edges, unit, v2, wrap_angle, Pose, Vec2};
 use crate::noise::Noise;
 use crate::sensors::Value as SimValue;
-use crate::vehicle::{integrate, Command, VehicleParams};
+use crate::vehicle::{Command, VehicleParams};
 use crate::world::{ObstacleView, World};
 use situ_compiler::bundle::{Content, Mode};
 use situ_runtime::agent::{Agent, Body, Context};
 use std::sync::{Arc, Mutex, OnceLock};
+
+mod reflexes;
+
+use reflexes::{reflexes, scan_points, standstill};
+pub use reflexes::{CRAWL, CREEP, STILL_TURN, SWEEP_MARGIN, SWEEP_TIME, TURN_RADIUS, TURN_SWEEP, TURN_TIGHT};
 
 /// The agents `rules/dla.situ` declares.
 pub const AGENTS: &[&str] = &["Laser", "Localization", "Mapper", "RoutePlanner", "PathPlanner", "Reactive", "Base"];
@@ -62,20 +68,6 @@ pub const REACTIVE_RANGE: f64 = 2.0;
 pub const CELL: f64 = 0.1;
 /// The route planner's computing time (ns of simulated time).
 pub const PLAN_TIME: u64 = 800_000_000;
-/// How far to the side of the laser (the robot's centre) a turn on the
-/// spot turns about (m): the indoor robot on full lock, 0.2 m / tan 1.2.
-pub const TURN_RADIUS: f64 = 0.078;
-/// The disc a turn on the spot sweeps about its centre (m): the far
-/// corners of the 0.4 m × 0.36 m body, √(0.2² + (0.18 + 0.078)²) = 0.33,
-/// and 0.03 to spare.
-pub const TURN_SWEEP: f64 = 0.36;
-/// How far ahead the body must be clear for the reactive layer to creep
-/// straight on when it can turn neither way (m).
-pub const CREEP: f64 = 0.15;
-/// Below this turn rate (rad/s) a command slower than a crawl is a stop.
-pub const STILL_TURN: f64 = 0.05;
-/// The slowest the Base rolls while it turns (m/s).
-pub const CRAWL: f64 = 0.03;
 /// How far along the path the reactive layer is sent (m).
 pub const LOOKAHEAD: f64 = 0.8;
 /// A path cell closer than this to an occupied cell blocks the path (m).
@@ -593,6 +585,7 @@ struct Reactive {
     pose: Option<(u64, PoseFix)>,
     subgoal: Option<(u64, Subgoal)>,
     plans: SharedPlans,
+    detour: Detour,
 }
 
 impl Agent for Reactive {
@@ -613,7 +606,15 @@ impl Agent for Reactive {
             ("Following", Some(s)) => s.0,
             _ => self.goal,
         };
-        let s = situation(&scan.pose, &scan.beams, target);
+        let mut s = situation(&scan.pose, &scan.beams, target);
+        // Towards the goal (no path to follow), a detour out of a local
+        // minimum when the robot is caught in one.
+        if cx.state() == "Following" {
+            self.detour.reset();
+        } else {
+            let aim = self.detour.aim(now as f64 * 1e-9, &scan.pose, target, &s.ranges);
+            s = Situation::new(s.ranges, aim);
+        }
         let mut cases = self.cases.lock().unwrap_or_else(|e| e.into_inner());
         let nearest = cases.nearest(&s).ok().flatten();
         let novel = nearest.is_none_or(|(_, d)| d > cases.novelty());
@@ -644,119 +645,6 @@ impl Agent for Reactive {
         let command = reflexes(command, &points, nearest_all, &self.vehicle);
         cx.send(Body::local(DriveCommand(command)));
     }
-}
-
-/// The reactive layer's reflexes on the command it chose, given the scan's
-/// readings as `points` in the robot's frame and the nearest sector range.
-fn reflexes(command: CaseCommand, points: &[Vec2], nearest_all: f64, vehicle: &VehicleParams) -> CaseCommand {
-    // Never standing still where the body could creep straight on.
-    let command = if standstill(&command) && ahead_clear(points, CREEP) {
-        CaseCommand { speed: CRAWL, turn_rate: 0.0 }
-    } else {
-        command
-    };
-    // Turning "in place" sweeps a disc about a centre to the side it
-    // turns to: that way if nothing is within the disc, else the other
-    // way if nothing is within that one, else straight on at a crawl if
-    // nothing is in the body's way, else not at all.
-    let command = if command.speed < CRAWL && nearest_all < TURN_RADIUS + TURN_SWEEP {
-        let side = if command.turn_rate < 0.0 { -1.0 } else { 1.0 };
-        if turn_clear(points, side) {
-            command
-        } else if turn_clear(points, -side) {
-            CaseCommand { speed: command.speed, turn_rate: -command.turn_rate }
-        } else if ahead_clear(points, CREEP) {
-            CaseCommand { speed: CRAWL, turn_rate: 0.0 }
-        } else {
-            CaseCommand { speed: 0.0, turn_rate: 0.0 }
-        }
-    } else {
-        command
-    };
-    // Last, the body's sweep over the next half second: a command that
-    // would bring a reading within it becomes a turn on the spot (the
-    // way it turned, else the other), or a stop.
-    if sweep_clear(points, &command, vehicle) {
-        command
-    } else {
-        let side = if command.turn_rate < 0.0 { -1.0 } else { 1.0 };
-        let turn = driver().max_turn_rate;
-        if turn_clear(points, side) {
-            CaseCommand { speed: 0.0, turn_rate: side * turn }
-        } else if turn_clear(points, -side) {
-            CaseCommand { speed: 0.0, turn_rate: -side * turn }
-        } else {
-            CaseCommand { speed: 0.0, turn_rate: 0.0 }
-        }
-    }
-}
-
-/// Whether the Base stops on a command: slower than a crawl and turning
-/// less than [`STILL_TURN`].
-fn standstill(c: &CaseCommand) -> bool {
-    c.speed < CRAWL && c.turn_rate.abs() < STILL_TURN
-}
-
-/// The readings of a scan as points in the robot's frame (m).
-fn scan_points(beams: &[Beam]) -> impl Iterator<Item = Vec2> + '_ {
-    beams
-        .iter()
-        .filter(|b| b.range.is_finite() && b.range < b.max_range)
-        .map(|b| v2(b.range * b.angle.cos(), b.range * b.angle.sin()))
-}
-
-/// Whether a turn on the spot to `side` (1 left, −1 right) from `pose`
-/// (in the frame of `points`) keeps the body clear of them: nothing within
-/// [`TURN_SWEEP`] of the centre it turns about, [`TURN_RADIUS`] to that side.
-fn turn_clear_at(points: &[Vec2], pose: &Pose, side: f64) -> bool {
-    points.iter().all(|&p| (pose.to_local(p) - v2(0.0, side * TURN_RADIUS)).norm() > TURN_SWEEP)
-}
-
-/// [`turn_clear_at`] from where the robot is.
-fn turn_clear(points: &[Vec2], side: f64) -> bool {
-    turn_clear_at(points, &Pose::new(0.0, 0.0, 0.0), side)
-}
-
-/// How far ahead (s) [`sweep_clear`] follows a command.
-pub const SWEEP_TIME: f64 = 0.5;
-/// What the body keeps from every reading in [`sweep_clear`] (m).
-pub const SWEEP_MARGIN: f64 = 0.04;
-
-/// Whether the Base driving `c` (as [`Base`] turns it into a speed and a
-/// steering angle, held) for [`SWEEP_TIME`] keeps the body, grown by
-/// [`SWEEP_MARGIN`], clear of every reading of the scan, and, when the
-/// robot could turn on the spot where it is, leaves it where it still can
-/// (so it never drives into a corner it cannot turn out of).
-fn sweep_clear(points: &[Vec2], c: &CaseCommand, vehicle: &VehicleParams) -> bool {
-    if standstill(c) {
-        return true;
-    }
-    let v = c.speed.clamp(CRAWL, vehicle.max_speed);
-    let steer = (c.turn_rate * vehicle.wheelbase / v).atan().clamp(-vehicle.max_steer, vehicle.max_steer);
-    let kappa = steer.tan() / vehicle.wheelbase;
-    let body = vehicle.front.max(vehicle.rear).hypot(vehicle.width / 2.0) + SWEEP_MARGIN;
-    let reach = v * SWEEP_TIME + body.max(TURN_RADIUS + TURN_SWEEP);
-    let points: Vec<Vec2> = points.iter().copied().filter(|p| p.norm() <= reach).collect();
-    let (front, rear, half) =
-        (vehicle.front + SWEEP_MARGIN, vehicle.rear + SWEEP_MARGIN, vehicle.width / 2.0 + SWEEP_MARGIN);
-    let here = Pose::new(0.0, 0.0, 0.0);
-    let poses: Vec<Pose> = (1..=5).map(|k| integrate(here, v, kappa, SWEEP_TIME * k as f64 / 5.0)).collect();
-    let body_clear = poses.iter().all(|pose| {
-        points.iter().all(|&p| {
-            let q = pose.to_local(p);
-            !(q.x <= front && q.x >= -rear && q.y.abs() <= half)
-        })
-    });
-    let can_turn = |pose: &Pose| turn_clear_at(&points, pose, 1.0) || turn_clear_at(&points, pose, -1.0);
-    let last = poses.last().copied().unwrap_or(here);
-    body_clear && (!can_turn(&here) || can_turn(&last))
-}
-
-/// Whether moving straight ahead by `reach` (m) keeps the body clear: no
-/// reading in the strip the body sweeps (0.2 m ahead of the centre, 0.18 m
-/// to each side, and 0.02 m to spare).
-fn ahead_clear(points: &[Vec2], reach: f64) -> bool {
-    points.iter().all(|p| !(p.x > 0.0 && p.x < 0.22 + reach && p.y.abs() < 0.2))
 }
 
 struct Base {
@@ -829,7 +717,17 @@ pub fn agents(
             plans: plans.clone(),
             content: c(),
         }),
-        Box::new(Reactive { goal, vehicle: world.vehicle, cases, learn, scan: None, pose: None, subgoal: None, plans }),
+        Box::new(Reactive {
+            goal,
+            vehicle: world.vehicle,
+            cases,
+            learn,
+            scan: None,
+            pose: None,
+            subgoal: None,
+            plans,
+            detour: Detour::default(),
+        }),
         Box::new(Base { params: world.vehicle, input: None, physics: physics.clone() }),
     ]
 }
