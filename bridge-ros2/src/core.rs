@@ -109,8 +109,8 @@ impl Core {
     /// A bridge for the compiled rules `content` (whose checked `model` the
     /// map `map_text`, file `map_file`, is read against).
     pub fn new(content: Arc<Content>, model: &Model, map_text: &str, map_file: FileId) -> Result<Core, SetupError> {
-        let translator = Translator::new(model, map_text, map_file).map_err(SetupError::Map)?;
         let parsed = map::parse(map_text, map_file).map_err(|d| SetupError::Map(vec![*d]))?;
+        let translator = Translator::of(model, &parsed, map_file).map_err(SetupError::Map)?;
         let mut nodes = Vec::new();
         let mut node_of = BTreeMap::new();
         for n in &parsed.nodes {

@@ -16,10 +16,14 @@ pub type Check = fn(&Model, &Map, FileId) -> Vec<Diagnostic>;
 /// Every finding of the map `text` (file `file`) against the rules'
 /// `model`, sorted by place. A map that does not parse is one finding.
 pub fn check_map(model: &Model, text: &str, file: FileId) -> Vec<Diagnostic> {
-    let map = match map::parse(text, file) {
-        Ok(map) => map,
-        Err(d) => return vec![*d],
-    };
+    match map::parse(text, file) {
+        Ok(map) => check_parsed(model, &map, file),
+        Err(d) => vec![*d],
+    }
+}
+
+/// [`check_map`] on a map already parsed (from `file`).
+pub fn check_parsed(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
     let checks: [Check; 13] = [
         unknown_types,
         unknown_names,
@@ -35,7 +39,7 @@ pub fn check_map(model: &Model, text: &str, file: FileId) -> Vec<Diagnostic> {
         topic_types,
         bad_nodes,
     ];
-    let mut out: Vec<Diagnostic> = checks.iter().flat_map(|c| c(model, &map, file)).collect();
+    let mut out: Vec<Diagnostic> = checks.iter().flat_map(|c| c(model, map, file)).collect();
     out.sort_by_key(|d| (d.primary.span.start, d.code));
     out
 }

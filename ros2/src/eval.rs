@@ -9,7 +9,7 @@
 //! the entry produces no event for that message.
 
 use crate::cdr::{self, Decoder};
-use crate::check::check_map;
+use crate::check::check_parsed;
 use crate::expr::{self, BinOp, Expr, Range, Reducer, Step};
 use crate::map;
 use situ_compiler::bundle::Value;
@@ -364,12 +364,17 @@ impl Translator {
     /// The translator of the map `text` (file `file`) for the rules'
     /// `model`; the map's error findings when it has any (warnings pass).
     pub fn new(model: &Model, text: &str, file: FileId) -> Result<Translator, Vec<Diagnostic>> {
+        let parsed = map::parse(text, file).map_err(|d| vec![*d])?;
+        Translator::of(model, &parsed, file)
+    }
+
+    /// [`Translator::new`] of a map already parsed (from `file`).
+    pub fn of(model: &Model, parsed: &map::Map, file: FileId) -> Result<Translator, Vec<Diagnostic>> {
         let errors: Vec<Diagnostic> =
-            check_map(model, text, file).into_iter().filter(|d| d.severity == Severity::Error).collect();
+            check_parsed(model, parsed, file).into_iter().filter(|d| d.severity == Severity::Error).collect();
         if !errors.is_empty() {
             return Err(errors);
         }
-        let parsed = map::parse(text, file).map_err(|d| vec![*d])?;
         let mut topics: Vec<Topic> = Vec::new();
         for e in &parsed.events {
             let entry = entry(model, e).ok_or_else(|| {

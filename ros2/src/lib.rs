@@ -24,5 +24,5 @@ pub mod msgs;
 pub mod skeleton;
 pub mod types;
 
-pub use check::check_map;
+pub use check::{check_map, check_parsed};
 pub use eval::Translator;
