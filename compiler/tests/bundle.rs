@@ -162,3 +162,30 @@ proptest! {
         }
     }
 }
+
+/// Found by the `parse_check` fuzz target (`tests/fuzz/`, as found): a
+/// condition may compare with `-inf` or `inf`, which serde_json writes as
+/// `null`; the JSON bundle of a program without errors did not read back.
+#[test]
+fn an_infinite_bound_in_a_condition_reads_back_in_both_encodings() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz");
+    let found = dir.join("parse_check-an-infinite-bound.situ");
+    let written = "states { A initial B }\n\
+                   agent L sensor { event E { d: f64 } }\n\
+                   rule up { when state == A and E(d >= -inf) and not E(d in -inf..inf) then B }\n\
+                   rule down { when state == B and E(d < inf) and E(d != -inf) then A }\n";
+    let loader = situ_compiler::loader::MemLoader::new().with("written.situ", written);
+    for (path, loader) in [
+        (found.as_path(), &situ_compiler::loader::FsLoader as &dyn situ_compiler::loader::Loader),
+        (std::path::Path::new("written.situ"), &loader),
+    ] {
+        let checked = situ_compiler::check(path, loader).expect("readable");
+        assert_eq!(checked.errors(), 0, "{}", path.display());
+        let content = bundle::build(&checked);
+        let json = String::from_utf8(encode(&content, Encoding::Json)).unwrap();
+        assert!(json.contains(r#""f64": "-inf""#), "{json}");
+        for enc in [Encoding::Json, Encoding::Binary] {
+            assert_eq!(decode(&encode(&content, enc)).expect("reads back"), content, "{}: {enc:?}", path.display());
+        }
+    }
+}

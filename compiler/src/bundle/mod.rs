@@ -20,6 +20,7 @@
 
 pub mod build;
 pub mod codec;
+mod float;
 pub mod sign;
 
 use serde::{Deserialize, Serialize};
@@ -240,7 +241,8 @@ impl FieldType {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Value {
-    F64(f64),
+    /// In JSON, NaN and the infinities are `"NaN"`, `"inf"`, `"-inf"`.
+    F64(#[serde(with = "float")] f64),
     I64(i64),
     Bool(bool),
     /// An index into the symbols of the field's type.
