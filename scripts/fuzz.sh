@@ -27,7 +27,8 @@
 # grows three times slower), without the entropic schedule (it keeps a
 # sorted table of rare features per input and moves memory for each one: two
 # thirds of the time here) and without mutations from traced comparisons
-# (-use_cmp=0): 1,700 to 3,600 executions a second instead of 120 to 250
+# (-use_cmp=0): about 1,500 to 3,900 executions a second on a core of their
+# own, instead of 120 to 250
 # (docs/reliability.md). FUZZ_ARGS adds libFuzzer flags to every target.
 #
 # Each target starts from its committed corpus (fuzz/corpus/TARGET, read
