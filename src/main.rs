@@ -289,9 +289,17 @@ enum Command {
         /// The most abstract states the exhaustive exploration makes.
         #[arg(long, default_value_t = 20_000)]
         max_states: usize,
-        /// Seconds IC3 may spend on one property before its verdict stays bounded.
-        #[arg(long, default_value_t = 20.0)]
+        /// IC3's work budget per property, in SAT propagations: the same
+        /// budget gives the same verdict on any machine under any load.
+        #[arg(long, default_value_t = situ_verify::property::DEFAULT_EFFORT)]
+        prove_effort: u64,
+        /// A wall-clock guard on IC3, in seconds per property; a property it
+        /// stops is undecided, and the output says it was the clock.
+        #[arg(long, default_value_t = 600.0)]
         prove_timeout: f64,
+        /// Exit 0 when no property is violated, even if some are undecided.
+        #[arg(long)]
+        allow_undecided: bool,
         /// Print the size and time of the exploration and the random search.
         #[arg(long)]
         stats: bool,
@@ -397,7 +405,9 @@ fn main() -> ExitCode {
             length,
             depth,
             max_states,
+            prove_effort,
             prove_timeout,
+            allow_undecided,
             stats,
         } => cmd::test::run(cmd::test::Args {
             files,
@@ -409,7 +419,9 @@ fn main() -> ExitCode {
             length,
             depth,
             max_states,
+            prove_effort,
             prove_timeout,
+            allow_undecided,
             stats,
         }),
         Command::Gen { what } => cmd::gen::run(what),

@@ -44,7 +44,7 @@ fn a_users_file_is_proved_and_a_deep_counterexample_replays() {
     }
     // Docking is 17 events away: IC3 finds it, the engine replays it.
     assert!(out.contains("property \"never docking\" ... FAILED"), "{out}");
-    assert!(out.contains("counterexample (IC3, replayed on the engine, "), "{out}");
+    assert!(out.contains("counterexample (IC3, replayed on the engine, shrunk, "), "{out}");
     let test = &out[out.find("test \"counterexample: never docking\"").expect("a test block")..];
     let test: String =
         test.lines().take_while(|l| !l.trim().is_empty()).map(|l| format!("{}\n", l.trim_start())).collect();

@@ -26,6 +26,21 @@ property "firing needs arming" { always (state == Ready -> next state != Fired) 
 property "the lamp glows when armed" { always (state == Armed -> Lamp running) }
 "#;
 
+/// The `test` block that `situ test` prints for a counterexample, as printed:
+/// from its first line to the `}` that closes it.
+fn replay_block(out: &str) -> String {
+    let start = out.find("\ntest \"counterexample").expect("a test block at the start of a line") + 1;
+    let mut block = String::new();
+    for line in out[start..].lines() {
+        block.push_str(line);
+        block.push('\n');
+        if line == "}" {
+            return block;
+        }
+    }
+    panic!("an unclosed test block: {block}");
+}
+
 #[test]
 fn the_papers_stacks_pass_their_tests_and_properties() {
     for file in ["rules/outdoor.situ", "rules/ugv.situ", "rules/ugv-merge.situ"] {
@@ -33,7 +48,7 @@ fn the_papers_stacks_pass_their_tests_and_properties() {
         let out = stdout(&o);
         assert_eq!(code(&o), 0, "{file}:\n{out}");
         let last = out.lines().last().unwrap_or_default();
-        assert!(last.ends_with(" passed, 0 failed"), "{last}");
+        assert!(last.ends_with(" passed, 0 failed, 0 undecided"), "{last}");
         assert!(!out.contains("FAILED"), "{out}");
         // Every property is proved for runs of any length, not searched.
         let properties = out.matches("\nproperty \"").count();
@@ -55,11 +70,10 @@ fn failures_name_their_place_and_what_was_found() {
     assert!(out.contains(&format!("{file}:13:12: expected state Ready, found Fired")), "{out}");
     assert!(!out.contains("expected Lamp sleeping"), "the lamp sleeps in Fired: {out}");
     assert!(out.contains("property \"firing needs arming\" ... FAILED"), "{out}");
-    assert!(out.contains("counterexample (exhaustive, shortest, 1 events)"), "{out}");
+    assert!(out.contains("counterexample (exhaustive exploration, shortest, 1 events)"), "{out}");
     assert!(out.contains("Ready -> Fired   fired `fire`"), "{out}");
-    assert!(out.contains("property \"the lamp glows when armed\" ... ok"), "{out}");
-    assert!(out.contains("proved"), "{out}");
-    assert_eq!(out.lines().last(), Some("2 passed, 2 failed"), "{out}");
+    assert!(out.contains("property \"the lamp glows when armed\" ... ok (proved by exhaustive exploration)"), "{out}");
+    assert_eq!(out.lines().last(), Some("2 passed, 2 failed, 0 undecided"), "{out}");
 }
 
 #[test]
@@ -69,14 +83,12 @@ fn a_counterexample_replays_as_a_test() {
     let o = situ(&["test", &file, "--filter", "firing", "--engine", "random", "--cases", "500"]);
     let out = stdout(&o);
     assert_eq!(code(&o), 1, "{out}");
-    let start = out.find("    test \"counterexample").expect("a test block");
-    let block: String =
-        out[start..].lines().take_while(|l| l.starts_with("    ")).map(|l| format!("{}\n", &l[4..])).collect();
+    let block = replay_block(&out);
     assert!(block.trim_end().ends_with('}'), "{block}");
     let replay = write(dir.path(), "replay.situ", format!("{BUGGY}\n{block}"));
     let o = situ(&["test", &replay, "--filter", "counterexample"]);
     assert_eq!(code(&o), 0, "{}\n{block}", stdout(&o));
-    assert_eq!(stdout(&o).lines().last(), Some("1 passed, 0 failed"));
+    assert_eq!(stdout(&o).lines().last(), Some("1 passed, 0 failed, 0 undecided"));
 }
 
 /// A property that only a NaN payload breaks (issue 18: the counterexample
@@ -106,16 +118,14 @@ fn counterexample_replays(rules: &str, values: &[&str]) {
     let o = situ(&["test", &file, "--engine", "exhaustive"]);
     let out = stdout(&o);
     assert_eq!(code(&o), 1, "{out}");
-    let start = out.find("    test \"counterexample").expect("a test block");
-    let block: String =
-        out[start..].lines().take_while(|l| l.starts_with("    ")).map(|l| format!("{}\n", &l[4..])).collect();
+    let block = replay_block(&out);
     for value in values {
         assert!(block.contains(value), "{value} in:\n{block}");
     }
     let replay = write(dir.path(), "replay.situ", format!("{rules}\n{block}"));
     let o = situ(&["test", &replay, "--filter", "counterexample"]);
     assert_eq!(code(&o), 0, "{}\n{block}", stdout(&o));
-    assert_eq!(stdout(&o).lines().last(), Some("1 passed, 0 failed"));
+    assert_eq!(stdout(&o).lines().last(), Some("1 passed, 0 failed, 0 undecided"));
 }
 
 #[test]
@@ -136,7 +146,7 @@ fn nan_and_infinities_replay_in_a_test_block() {
     let file = write(dir.path(), "odd.situ", format!("{NON_FINITE}\n{block}"));
     let o = situ(&["test", &file, "--filter", "counterexample"]);
     assert_eq!(code(&o), 0, "{}", stdout(&o));
-    assert_eq!(stdout(&o).lines().last(), Some("1 passed, 0 failed"));
+    assert_eq!(stdout(&o).lines().last(), Some("1 passed, 0 failed, 0 undecided"));
 }
 
 #[test]
@@ -147,9 +157,16 @@ fn json_gives_one_object_per_result() {
     assert_eq!(code(&o), 1);
     let lines: Vec<serde_json::Value> =
         stdout(&o).lines().map(|l| serde_json::from_str(l).expect("a JSON object per line")).collect();
-    assert_eq!(lines.len(), 4);
+    assert_eq!(lines.len(), 5);
     let kinds: Vec<&str> = lines.iter().map(|l| l["kind"].as_str().unwrap()).collect();
-    assert_eq!(kinds, ["test", "test", "property", "property"]);
+    assert_eq!(kinds, ["test", "test", "property", "property", "summary"]);
+    assert_eq!(lines[2]["verdict"], "violated");
+    assert_eq!(lines[3]["verdict"], "proved");
+    assert_eq!(lines[3]["proved_by"], "exhaustive exploration");
+    assert_eq!(
+        (lines[4]["passed"].as_u64(), lines[4]["failed"].as_u64(), lines[4]["undecided"].as_u64()),
+        (Some(2), Some(2), Some(0))
+    );
     assert_eq!(lines[1]["passed"], false);
     assert_eq!(lines[1]["failures"][0]["place"], format!("{file}:13:12"));
     assert_eq!(lines[2]["exhaustive"]["verdict"], "failed");
@@ -164,7 +181,7 @@ fn filter_selects_by_name() {
     let file = write(dir.path(), "buggy.situ", BUGGY);
     let o = situ(&["test", &file, "--filter", "lamp"]);
     assert_eq!(code(&o), 0, "{}", stdout(&o));
-    assert_eq!(stdout(&o).lines().last(), Some("2 passed, 0 failed"));
+    assert_eq!(stdout(&o).lines().last(), Some("2 passed, 0 failed, 0 undecided"));
 }
 
 #[test]
@@ -181,7 +198,7 @@ fn a_file_with_errors_fails_with_its_diagnostics() {
     let out = stdout(&o);
     assert_eq!(code(&o), 1, "{out}");
     assert!(out.contains("situ::E0117") && out.contains("situ::E0101"), "{out}");
-    assert_eq!(out.lines().last(), Some("0 passed, 1 failed"));
+    assert_eq!(out.lines().last(), Some("0 passed, 1 failed, 0 undecided"));
 }
 
 #[test]

@@ -18,6 +18,7 @@ use situ_compiler::loader::FsLoader;
 use situ_compiler::spec::{self, Consequent, PropertySpec};
 use situ_verify::abstraction::Alphabet;
 use situ_verify::explore::{Graph, Limits};
+use situ_verify::ic3::Limits as Ic3Limits;
 use situ_verify::model::Model;
 use situ_verify::prove;
 use situ_verify::random::{self, Search};
@@ -96,7 +97,7 @@ fn planted_bugs_are_found_and_correct_properties_proved() {
             // replays on the engine, what holds is proved for runs of any length.
             if !liveness(p) {
                 let model = model.as_ref().unwrap_or_else(|e| panic!("{name}: no circuit: {e:?}"));
-                match (want, prove::prove(&content, &alphabet, model, i, p, None)) {
+                match (want, prove::prove(&content, &alphabet, model, i, p, Ic3Limits::frames(prove::MAX_FRAMES))) {
                     (Expect::Fails(_), Some(Verdict::Failed(_)))
                     | (Expect::Proved | Expect::Exhausted, Some(Verdict::Inductive { sampled: None, .. })) => {}
                     (_, other) => failures.push(format!("{name}: expected {want:?}, IC3 found {other:?}")),

@@ -105,6 +105,14 @@ codes! {
     ROS2_TWO_NODES = "E0412", Error, "agent played by two lifecycle nodes";
     ROS2_TOPIC_TYPES = "E0413", Error, "topic read as two message types";
     ROS2_BAD_NODE = "E0414", Error, "lifecycle node entry the bridge cannot use";
+    VACUOUS_PROPERTY = "W0501", Warning, "property whose premise never holds";
+    UNDECIDED_PROPERTY = "E0502", Error, "property neither proved nor violated";
+}
+
+/// Whether the code is a property's verdict (E05xx, W05xx: `situ test`,
+/// crate `situ-verify`): the checkers raise it, never `situ check`.
+pub fn is_verdict(code: &str) -> bool {
+    code.get(1..3) == Some("05")
 }
 
 /// Whether the code is a ROS 2 map's (E04xx, W04xx: `situ check

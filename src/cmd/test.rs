@@ -1,7 +1,11 @@
 //! `situ test FILE… [--filter NAME] [--format human|json] [--engine …]
-//! [--seed S] [--cases N] [--length L] [--depth K] [--max-states N] [--stats]`:
-//! runs every `test` block and checks every `property` block. Exit 0 when all
-//! hold, 1 when one fails (or a file has errors), 2 on usage or I/O errors.
+//! [--seed S] [--cases N] [--length L] [--depth K] [--max-states N]
+//! [--prove-effort N] [--prove-timeout S] [--allow-undecided] [--stats]`:
+//! runs every `test` block and checks every `property` block
+//! (`situ_verify::property` decides each: proved, violated or undecided).
+//! Exit 0 when every test passes and every property is proved, 1 when one
+//! fails or is undecided (undecided is allowed with `--allow-undecided`), or
+//! a file has errors, 2 on usage or I/O errors.
 
 use super::{FAILED, OK, USAGE};
 use serde_json::json;
@@ -9,16 +13,13 @@ use situ_compiler::bundle::{self, Content};
 use situ_compiler::loader::FsLoader;
 use situ_compiler::render;
 use situ_compiler::spec::{self, PropertySpec, TestSpec};
-use situ_verify::abstraction::Alphabet;
-use situ_verify::explore::{Graph, Limits};
-use situ_verify::model::Model;
-use situ_verify::monitor::Monitor;
-use situ_verify::prove;
-use situ_verify::random::{self, Search};
+use situ_verify::explore::Limits;
+use situ_verify::property::{self, Conclusion, Engines, Premise, Report};
+use situ_verify::random::Search;
 use situ_verify::{scenario, show_event, Counterexample, Verdict};
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::time::Instant;
+use std::time::Duration;
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
 pub enum Format {
@@ -47,51 +48,26 @@ pub struct Args {
     pub length: usize,
     pub depth: usize,
     pub max_states: usize,
-    /// Seconds of IC3 per property.
+    /// IC3's work budget per property (SAT propagations).
+    pub prove_effort: u64,
+    /// Wall-clock guard of IC3 per property, in seconds.
     pub prove_timeout: f64,
+    pub allow_undecided: bool,
     pub stats: bool,
 }
 
-/// What one property came to.
-struct PropertyResult {
-    exhaustive: Option<Verdict>,
-    /// IC3 on the circuit of the abstraction (runs of any length).
-    symbolic: Option<Verdict>,
-    /// Why IC3 gave no verdict, when it gave none.
-    symbolic_note: Option<String>,
-    random: Option<Verdict>,
-}
-
-impl PropertyResult {
-    fn failed(&self) -> bool {
-        let bad = |v: &Option<Verdict>| v.as_ref().is_some_and(|v| v.failed() || matches!(v, Verdict::Disagree { .. }));
-        bad(&self.exhaustive) || bad(&self.symbolic) || bad(&self.random)
-    }
-
-    /// The counterexample to show: the exhaustive one (shortest) first.
-    fn counterexample(&self) -> Option<(&'static str, &Counterexample)> {
-        fn of(v: &Option<Verdict>) -> Option<&Counterexample> {
-            match v {
-                Some(Verdict::Failed(c)) => Some(c),
-                _ => None,
-            }
+impl Engine {
+    fn engines(self) -> Engines {
+        match self {
+            Engine::Both => Engines::Both,
+            Engine::Exhaustive => Engines::Exhaustive,
+            Engine::Random => Engines::Random,
         }
-        let how = |c: &Counterexample| {
-            if c.reason.contains("repeat forever") {
-                "exhaustive, a lasso"
-            } else {
-                "exhaustive, shortest"
-            }
-        };
-        of(&self.exhaustive)
-            .map(|c| (how(c), c))
-            .or_else(|| of(&self.symbolic).map(|c| ("IC3, replayed on the engine", c)))
-            .or_else(|| of(&self.random).map(|c| ("random, shrunk", c)))
     }
 }
 
 pub fn run(args: Args) -> u8 {
-    let (mut passed, mut failed) = (0usize, 0usize);
+    let (mut passed, mut failed, mut undecided) = (0usize, 0usize, 0usize);
     let mut io_failed = false;
     let human = matches!(args.format, Format::Human);
     for path in &args.files {
@@ -156,46 +132,36 @@ pub fn run(args: Args) -> u8 {
             }
         }
         if !props.is_empty() {
-            let results = check_properties(&args, &content, &props, human);
-            for (p, r) in props.iter().zip(&results) {
-                let mut lines: Vec<String> =
-                    [("exhaustive", &r.exhaustive), ("symbolic", &r.symbolic), ("random", &r.random)]
-                        .iter()
-                        .filter_map(|(name, v)| v.as_ref().map(|v| format!("{name}: {}", v.summary())))
-                        .collect();
-                if let Some(note) = &r.symbolic_note {
-                    lines.insert(lines.len().min(1), format!("symbolic: {note}"));
-                }
-                let lines = match (&r.random, args.engine) {
-                    (None, Engine::Both | Engine::Random) => {
-                        let mut l = lines;
-                        l.push("random: not run (an unbounded `eventually` is decided on infinite runs)".into());
-                        l
-                    }
-                    _ => lines,
-                };
+            let reports = check_properties(&args, &content, &props, human);
+            for (p, r) in props.iter().zip(&reports) {
                 if human {
-                    println!("property \"{}\" ... {}", p.name, if r.failed() { "FAILED" } else { "ok" });
-                    for l in &lines {
-                        println!("    {l}");
-                    }
+                    print_property(&content, p, r);
                 } else {
                     println!("{}", property_json(&content, path, p, r));
                 }
-                if r.failed() {
-                    failed += 1;
-                    let mut text = format!("---- property \"{}\" ({}) ----\n", p.name, p.place);
-                    if let Some((how, cex)) = r.counterexample() {
-                        text.push_str(&format!("counterexample ({how}, {} events):\n", cex.steps.len()));
-                        text.push_str(&cex.describe(&content));
+                match &r.conclusion {
+                    Conclusion::Proved { .. } => passed += 1,
+                    Conclusion::Undecided { .. } => undecided += 1,
+                    Conclusion::Violated { by, how, counterexample } => {
+                        failed += 1;
+                        let mut text = format!("---- property \"{}\" ({}) ----\n", p.name, p.place);
+                        text.push_str(&format!(
+                            "counterexample ({}, {how}, {} events):\n",
+                            by.name(),
+                            counterexample.steps.len()
+                        ));
+                        text.push_str(&counterexample.describe(&content));
                         text.push_str("replay it as a test (paste it into the file):\n");
-                        for line in cex.as_test(&content, &p.name).lines() {
-                            text.push_str(&format!("    {line}\n"));
-                        }
+                        text.push_str(&counterexample.as_test(&content, &p.name));
+                        failures.push(text);
                     }
-                    failures.push(text);
-                } else {
-                    passed += 1;
+                    Conclusion::Disagree { .. } => {
+                        failed += 1;
+                        failures.push(format!(
+                            "---- property \"{}\" ({}) ----\nIC3's counterexample does not replay on the engine: an error of situ, please report it\n",
+                            p.name, p.place
+                        ));
+                    }
                 }
             }
         }
@@ -207,22 +173,40 @@ pub fn run(args: Args) -> u8 {
         }
     }
     if human {
-        println!("\n{passed} passed, {failed} failed");
+        println!("\n{passed} passed, {failed} failed, {undecided} undecided");
+        if undecided > 0 && !args.allow_undecided {
+            println!(
+                "undecided properties fail the run (E0502: `situ explain E0502`); `--allow-undecided` lets them pass"
+            );
+        }
+    }
+    if !human {
+        println!(
+            "{}",
+            json!({"kind": "summary", "passed": passed, "failed": failed, "undecided": undecided,
+                   "allow_undecided": args.allow_undecided})
+        );
     }
     if io_failed {
         USAGE
-    } else if failed > 0 {
+    } else if failed > 0 || (undecided > 0 && !args.allow_undecided) {
         FAILED
     } else {
         OK
     }
 }
 
-fn check_properties(args: &Args, content: &Arc<Content>, props: &[&PropertySpec], human: bool) -> Vec<PropertyResult> {
-    let graph = (args.engine != Engine::Random).then(|| {
-        let start = Instant::now();
-        let g = Graph::build(content, props, Limits { depth: args.depth, max_states: args.max_states });
-        if args.stats && human {
+fn check_properties(args: &Args, content: &Arc<Content>, props: &[&PropertySpec], human: bool) -> Vec<Report> {
+    let opts = property::Options {
+        engines: args.engine.engines(),
+        search: Search { seed: args.seed, cases: args.cases, length: args.length },
+        limits: Limits { depth: args.depth, max_states: args.max_states },
+        effort: args.prove_effort,
+        timeout: Some(Duration::from_secs_f64(args.prove_timeout.clamp(0.0, 86_400.0))),
+    };
+    let (session, reports) = property::check_all(content, props, &opts);
+    if args.stats && human {
+        if let Some(g) = &session.graph {
             println!(
                 "exploration: {} abstract states, {} edges, {} letters, {} gaps, complete to {} events{}, {:.3} s",
                 g.states(),
@@ -231,81 +215,89 @@ fn check_properties(args: &Args, content: &Arc<Content>, props: &[&PropertySpec]
                 g.alphabet.gaps.len(),
                 g.complete_depth,
                 if g.closed { " (closed)" } else { "" },
-                start.elapsed().as_secs_f64()
+                session.graph_time.as_secs_f64()
             );
         }
-        g
-    });
-    let alphabet = Arc::new(Alphabet::new(content, props));
-    let budget = std::time::Duration::from_secs_f64(args.prove_timeout.clamp(0.0, 86_400.0));
-    // The circuit of the abstraction, for proofs over runs of any length.
-    let model = (args.engine != Engine::Random).then(|| {
-        let start = Instant::now();
-        let m = Model::build(content, &alphabet, props);
-        if args.stats && human {
-            match &m {
-                Ok(m) => println!(
-                    "circuit: {} latches, {} inputs, {} and-gates, {:.3} s",
-                    m.aig.latches().len(),
-                    m.aig.inputs().len(),
-                    m.aig.len() - 1 - m.aig.latches().len() - m.aig.inputs().len(),
-                    start.elapsed().as_secs_f64()
-                ),
-                Err(why) => println!("circuit: not built ({})", why.0),
+        match &session.model {
+            Some(Ok(m)) => println!(
+                "circuit: {} latches, {} inputs, {} and-gates, {:.3} s",
+                m.aig.latches().len(),
+                m.aig.inputs().len(),
+                m.aig.len() - 1 - m.aig.latches().len() - m.aig.inputs().len(),
+                session.model_time.as_secs_f64()
+            ),
+            Some(Err(why)) => println!("circuit: not built ({why})"),
+            None => {}
+        }
+        for (p, r) in props.iter().zip(&reports) {
+            if let Some(t) = r.ic3_time {
+                println!("ic3 \"{}\": {:.3} s", p.name, t.as_secs_f64());
+            }
+            if let (Some(t), Some(Verdict::NotFound { steps, .. })) = (r.random_time, &r.random) {
+                let s = t.as_secs_f64();
+                println!("random \"{}\": {steps} steps in {s:.3} s ({:.0} steps/s)", p.name, *steps as f64 / s);
             }
         }
-        m
-    });
-    props
-        .iter()
-        .enumerate()
-        .map(|(i, p)| {
-            let exhaustive = graph.as_ref().map(|g| g.check(i, p));
-            let settled = exhaustive.as_ref().is_some_and(|v| v.failed() || matches!(v, Verdict::Proved { .. }));
-            let liveness = Monitor::new(p).is_liveness();
-            let (symbolic, symbolic_note) = match &model {
-                Some(Ok(_)) if liveness => {
-                    (None, Some("not run (an unbounded `eventually` is a liveness property: searched only)".into()))
-                }
-                Some(Ok(m)) if !settled => {
-                    let start = Instant::now();
-                    let v = prove::prove(content, &alphabet, m, i, p, Some(budget));
-                    if args.stats && human {
-                        println!("ic3 \"{}\": {:.3} s", p.name, start.elapsed().as_secs_f64());
-                    }
-                    let note = v.is_none().then(|| {
-                        format!("gave up after {} s (`--prove-timeout`): the other verdicts stand", args.prove_timeout)
-                    });
-                    (v, note)
-                }
-                Some(Err(why)) if !settled => (None, Some(format!("not run (no circuit: {})", why.0))),
-                _ => (None, None),
-            };
-            // Unbounded `eventually` is decided on infinite runs: not by random runs.
-            let m = Monitor::new(p);
-            let decided = !m.is_liveness() || m.never;
-            let random = (args.engine != Engine::Exhaustive && decided).then(|| {
-                let start = Instant::now();
-                let v = random::search(
-                    content,
-                    &alphabet,
-                    p,
-                    Search { seed: args.seed, cases: args.cases, length: args.length },
-                );
-                if args.stats && human {
-                    if let Verdict::NotFound { steps, .. } = v {
-                        let s = start.elapsed().as_secs_f64();
-                        println!("random \"{}\": {steps} steps in {s:.3} s ({:.0} steps/s)", p.name, steps as f64 / s);
-                    }
-                }
-                v
-            });
-            PropertyResult { exhaustive, symbolic, symbolic_note, random }
-        })
-        .collect()
+    }
+    reports
 }
 
-fn property_json(content: &Content, path: &std::path::Path, p: &PropertySpec, r: &PropertyResult) -> serde_json::Value {
+/// A property's line, each checker's answer, its premise.
+fn print_property(content: &Content, p: &PropertySpec, r: &Report) {
+    let head = match &r.conclusion {
+        Conclusion::Proved { by, .. } => format!("ok (proved by {})", by.name()),
+        Conclusion::Violated { .. } => "FAILED".to_string(),
+        Conclusion::Undecided { .. } => "UNDECIDED".to_string(),
+        Conclusion::Disagree { .. } => "ERROR".to_string(),
+    };
+    println!("property \"{}\" ... {head}", p.name);
+    for (name, v) in [("exhaustive", &r.exhaustive), ("symbolic", &r.symbolic), ("random", &r.random)] {
+        if let Some(v) = v {
+            println!("    {name}: {}", v.summary());
+        }
+    }
+    if let Some(n) = &r.symbolic_note {
+        println!("    symbolic: {n}");
+    }
+    if let Some(n) = &r.random_note {
+        println!("    random: {n}");
+    }
+    if let Conclusion::Undecided { .. } = r.conclusion {
+        println!("    undecided: no checker proved or broke it within its budget (`situ explain E0502`)");
+    }
+    match &r.premise {
+        Some(Premise::Reachable(run)) => println!("    premise: reached after {}", brief_run(content, run)),
+        Some(Premise::Vacuous { by }) => println!(
+            "    warning[W0501]: vacuous: the premise never holds ({} proved it), so the property says nothing (`situ explain W0501`)",
+            by.name()
+        ),
+        Some(Premise::Unknown) => println!("    premise: not shown reachable within the budgets"),
+        None => {}
+    }
+}
+
+/// A run in one line: `ARM at 0ms, FIRE at 10ms`, or `the start`.
+fn brief_run(content: &Content, run: &Counterexample) -> String {
+    if run.steps.is_empty() {
+        return "no event (it holds at the start)".to_string();
+    }
+    let show = |s: &situ_verify::CexStep| {
+        format!("{} at {}", show_event(content, s.event, &s.payload), situ_verify::show_duration(s.time))
+    };
+    let n = run.steps.len();
+    // A long run: its first two events and its last three (JSON has them all).
+    let events: Vec<String> = if n <= 6 {
+        run.steps.iter().map(show).collect()
+    } else {
+        let mut v: Vec<String> = run.steps[..2].iter().map(show).collect();
+        v.push(format!("… {} more …", n - 5));
+        v.extend(run.steps[n - 3..].iter().map(show));
+        v
+    };
+    format!("{n} event{}: {}", if n == 1 { "" } else { "s" }, events.join(", "))
+}
+
+fn property_json(content: &Content, path: &std::path::Path, p: &PropertySpec, r: &Report) -> serde_json::Value {
     let verdict = |v: &Option<Verdict>| {
         v.as_ref().map(|v| {
             let kind = match v {
@@ -315,26 +307,48 @@ fn property_json(content: &Content, path: &std::path::Path, p: &PropertySpec, r:
                 Verdict::Exhausted { .. } => "exhausted",
                 Verdict::Bounded { .. } => "bounded",
                 Verdict::NotFound { .. } => "not_found",
+                Verdict::GaveUp { .. } => "gave_up",
                 Verdict::Failed(_) => "failed",
             };
             json!({"verdict": kind, "summary": v.summary()})
         })
     };
-    let cex = r.counterexample().map(|(how, c)| {
-        let steps: Vec<_> = c
-            .steps
+    let run = |c: &Counterexample| -> Vec<serde_json::Value> {
+        c.steps
             .iter()
             .map(|s| {
                 json!({"event": show_event(content, s.event, &s.payload), "time_ns": s.time,
                        "state": content.states[s.state as usize].name, "fired": s.fired})
             })
-            .collect();
-        json!({"found_by": how, "events": steps, "point": c.point, "reason": c.reason,
-               "test": c.as_test(content, &p.name)})
+            .collect()
+    };
+    let cex = match &r.conclusion {
+        Conclusion::Violated { by, how, counterexample: c } => Some(json!({
+            "found_by": format!("{}, {how}", by.name()), "events": run(c), "point": c.point,
+            "reason": c.reason, "test": c.as_test(content, &p.name)})),
+        _ => None,
+    };
+    let (proved_by, reasons) = match &r.conclusion {
+        Conclusion::Proved { by, .. } => (Some(by.name()), Vec::new()),
+        Conclusion::Undecided { reasons } => (None, reasons.clone()),
+        _ => (None, Vec::new()),
+    };
+    let premise = r.premise.as_ref().map(|pr| match pr {
+        Premise::Reachable(c) => json!({"reachable": true, "events": run(c)}),
+        Premise::Vacuous { by } => {
+            json!({"reachable": false, "vacuous": true, "code": "W0501", "proved_by": by.name()})
+        }
+        Premise::Unknown => json!({"reachable": null}),
     });
+    let code = match r.conclusion {
+        Conclusion::Undecided { .. } => Some("E0502"),
+        _ => None,
+    };
     json!({"kind": "property", "file": path.display().to_string(), "name": p.name, "place": p.place.to_string(),
-           "passed": !r.failed(), "exhaustive": verdict(&r.exhaustive), "symbolic": verdict(&r.symbolic), "random": verdict(&r.random),
-           "counterexample": cex})
+           "verdict": r.conclusion.word(), "passed": matches!(r.conclusion, Conclusion::Proved { .. }),
+           "code": code, "proved_by": proved_by, "undecided_because": reasons,
+           "exhaustive": verdict(&r.exhaustive), "symbolic": verdict(&r.symbolic), "random": verdict(&r.random),
+           "counterexample": cex, "premise": premise})
 }
 
 fn count(n: usize, what: &str) -> String {

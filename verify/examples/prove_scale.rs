@@ -70,7 +70,7 @@ fn main() {
         let spec = spec::lower(&checked);
         let props: Vec<_> = spec.properties.iter().collect();
         let start = Instant::now();
-        let alphabet = Alphabet::new(&content, &props);
+        let alphabet = std::sync::Arc::new(Alphabet::new(&content, &props));
         let model = match Model::build(&content, &alphabet, &props) {
             Ok(m) => m,
             Err(why) => {
@@ -83,11 +83,20 @@ fn main() {
         let verdicts: Vec<&str> = props
             .iter()
             .enumerate()
-            .map(|(i, p)| match prove::prove(&content, &alphabet, &model, i, p, None) {
-                Some(Verdict::Inductive { sampled: None, .. }) => "proved",
-                Some(Verdict::Inductive { .. }) => "exhausted",
-                Some(Verdict::Failed(_)) => "FAILED",
-                _ => "unknown",
+            .map(|(i, p)| {
+                match prove::prove(
+                    &content,
+                    &alphabet,
+                    &model,
+                    i,
+                    p,
+                    situ_verify::ic3::Limits::frames(prove::MAX_FRAMES),
+                ) {
+                    Some(Verdict::Inductive { sampled: None, .. }) => "proved",
+                    Some(Verdict::Inductive { .. }) => "exhausted",
+                    Some(Verdict::Failed(_)) => "FAILED",
+                    _ => "unknown",
+                }
             })
             .collect();
         println!(

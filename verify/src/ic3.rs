@@ -17,6 +17,34 @@ use batsat::{lbool, BasicSolver, Lit, SolverInterface, Var};
 use std::collections::BinaryHeap;
 use std::time::Instant;
 
+/// How much IC3 may do before it gives up. `frames` and `work` are
+/// deterministic: the same circuit and limits give the same outcome on any
+/// machine under any load. `deadline` is an outer guard in wall-clock time;
+/// reaching it is said as such ([`Stop::Deadline`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Limits {
+    /// The most frames opened.
+    pub frames: usize,
+    /// The most work, in SAT propagations summed over every query.
+    pub work: u64,
+    pub deadline: Option<Instant>,
+}
+
+impl Limits {
+    /// Frames only (no work budget, no deadline).
+    pub fn frames(frames: usize) -> Limits {
+        Limits { frames, work: u64::MAX, deadline: None }
+    }
+}
+
+/// Which limit stopped IC3.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stop {
+    Frames,
+    Work,
+    Deadline,
+}
+
 /// What IC3 found.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Outcome {
@@ -24,8 +52,9 @@ pub enum Outcome {
     Proved { frames: usize, clauses: usize },
     /// The inputs of each step of a run from the initial state to a bad state.
     Counterexample(Vec<Vec<bool>>),
-    /// Stopped at the budget of frames.
-    Unknown { frames: usize },
+    /// Stopped at a limit: no bad state is reachable in `depth` steps or
+    /// fewer (every frame up to it was cleared), after `work` propagations.
+    Unknown { depth: usize, work: u64, stop: Stop },
 }
 
 /// A cube: literals over latches (index, value), sorted by index.
@@ -36,13 +65,15 @@ struct Copy {
     solver: BasicSolver,
     vars: Vec<Var>,
     act: Vec<Lit>,
+    /// SAT propagations spent by this copy's queries.
+    work: u64,
 }
 
 impl Copy {
     fn new(aig: &Aig) -> Copy {
         let mut solver = BasicSolver::default();
         let vars: Vec<Var> = (0..aig.len()).map(|_| solver.new_var_default()).collect();
-        let mut c = Copy { solver, vars, act: Vec::new() };
+        let mut c = Copy { solver, vars, act: Vec::new(), work: 0 };
         // Variable 0 is false.
         let f = c.lit(0);
         c.clause(&[!f]);
@@ -67,7 +98,11 @@ impl Copy {
     }
 
     fn solve(&mut self, assumptions: &[Lit]) -> bool {
-        self.solver.solve_limited(assumptions) == lbool::TRUE
+        let before = self.solver.num_propagations();
+        let sat = self.solver.solve_limited(assumptions) == lbool::TRUE;
+        // At least one unit per query, so that a budget bounds the queries too.
+        self.work += (self.solver.num_propagations() - before).max(1);
+        sat
     }
 
     fn value(&self, l: Lit) -> bool {
@@ -120,9 +155,17 @@ impl PartialOrd for Obligation {
 }
 
 /// Checks that `bad` (a function of the latches) never holds; gives up
-/// (unknown) past `max_frames` frames or at `deadline`.
-pub fn check(aig: &Aig, bad: ALit, max_frames: usize, deadline: Option<Instant>) -> Outcome {
-    let late = || deadline.is_some_and(|d| Instant::now() >= d);
+/// (unknown) at the first limit reached.
+pub fn check(aig: &Aig, bad: ALit, limits: Limits) -> Outcome {
+    let over = |ic3: &Ic3| -> Option<Stop> {
+        if ic3.work() > limits.work {
+            Some(Stop::Work)
+        } else if limits.deadline.is_some_and(|d| Instant::now() >= d) {
+            Some(Stop::Deadline)
+        } else {
+            None
+        }
+    };
     let mut ic3 = Ic3 { aig, bad, delta: vec![Vec::new()], solvers: Vec::new(), lift: Copy::new(aig) };
     ic3.push_frame(); // F0
                       // Is an initial state bad?
@@ -143,8 +186,8 @@ pub fn check(aig: &Aig, bad: ALit, max_frames: usize, deadline: Option<Instant>)
             trace_inputs.push((Vec::new(), None));
             heap.push(Obligation { frame: k, depth: 0, cube, next: Some(0) });
             while let Some(ob) = heap.pop() {
-                if late() {
-                    return Outcome::Unknown { frames: k };
+                if let Some(stop) = over(&ic3) {
+                    return Outcome::Unknown { depth: k - 1, work: ic3.work(), stop };
                 }
                 let id = ob.next.expect("an id");
                 if ob.frame == 0 || Ic3::initial(&ob.cube) {
@@ -184,8 +227,11 @@ pub fn check(aig: &Aig, bad: ALit, max_frames: usize, deadline: Option<Instant>)
                 }
             }
         }
-        if k >= max_frames || late() {
-            return Outcome::Unknown { frames: k };
+        if k >= limits.frames {
+            return Outcome::Unknown { depth: k, work: ic3.work(), stop: Stop::Frames };
+        }
+        if let Some(stop) = over(&ic3) {
+            return Outcome::Unknown { depth: k, work: ic3.work(), stop };
         }
         ic3.push_frame();
         // Propagate clauses forward; an empty delta closes the proof.
@@ -209,6 +255,11 @@ pub fn check(aig: &Aig, bad: ALit, max_frames: usize, deadline: Option<Instant>)
 }
 
 impl Ic3<'_> {
+    /// The propagations spent so far by every query.
+    fn work(&self) -> u64 {
+        self.solvers.iter().map(|s| s.work).sum::<u64>() + self.lift.work
+    }
+
     fn latch_lit(&self, s: &Copy, i: usize, value: bool) -> Lit {
         let l = s.lit(2 * self.aig.latches()[i]);
         if value {
@@ -438,7 +489,7 @@ mod tests {
     #[test]
     fn a_reachable_bad_state_gives_the_inputs_of_a_run() {
         let (g, bad) = counter(4);
-        match check(&g, bad, 20, None) {
+        match check(&g, bad, Limits::frames(20)) {
             Outcome::Counterexample(ins) => {
                 assert_eq!(ins.len(), 4, "{ins:?}");
                 assert!(ins.iter().all(|i| i == &[true]));
@@ -450,8 +501,29 @@ mod tests {
     #[test]
     fn an_unreachable_bad_state_is_proved() {
         let (g, bad) = counter(7);
-        assert!(matches!(check(&g, bad, 20, None), Outcome::Proved { .. }), "{:?}", check(&g, bad, 20, None));
+        assert!(matches!(check(&g, bad, Limits::frames(20)), Outcome::Proved { .. }));
         let (g, _) = counter(0);
-        assert!(matches!(check(&g, crate::aig::FALSE, 20, None), Outcome::Proved { .. }));
+        assert!(matches!(check(&g, crate::aig::FALSE, Limits::frames(20)), Outcome::Proved { .. }));
+    }
+
+    #[test]
+    fn a_work_budget_stops_ic3_at_the_same_point_every_time() {
+        // The counter needs 5 steps to reach 5: a tiny budget stops it first.
+        let (g, bad) = counter(5);
+        let limits = Limits { frames: 20, work: 10, deadline: None };
+        let first = check(&g, bad, limits);
+        assert!(matches!(first, Outcome::Unknown { stop: Stop::Work, .. }), "{first:?}");
+        for _ in 0..5 {
+            assert_eq!(check(&g, bad, limits), first);
+        }
+        // With enough work the same circuit gives its run.
+        assert!(matches!(check(&g, bad, Limits::frames(20)), Outcome::Counterexample(_)));
+    }
+
+    #[test]
+    fn a_past_deadline_is_said_as_such() {
+        let (g, bad) = counter(5);
+        let limits = Limits { frames: 20, work: u64::MAX, deadline: Some(Instant::now()) };
+        assert!(matches!(check(&g, bad, limits), Outcome::Unknown { stop: Stop::Deadline, .. }));
     }
 }

@@ -12,6 +12,9 @@
 //!   ([`abstraction`]): it proves a property, or finds its shortest
 //!   counterexample, or says up to which depth it found none.
 //!
+//! [`property`] runs them on each property and concludes: proved, violated
+//! or undecided.
+//!
 //! Both checkers run the same [`System`]: the engine and the organisation,
 //! driven as at runtime (the FSMs see an event before the rest for it, and
 //! every change of the state at rest after it).
@@ -23,6 +26,7 @@ pub mod ic3;
 pub mod model;
 pub mod monitor;
 pub mod promela;
+pub mod property;
 pub mod prove;
 pub mod random;
 pub mod scenario;
@@ -267,6 +271,13 @@ pub enum Verdict {
         length: usize,
         steps: u64,
     },
+    /// IC3 stopped at a limit before it closed an invariant or found a run:
+    /// no bad state of the circuit within `depth` steps, after `work` propagations.
+    GaveUp {
+        depth: usize,
+        work: u64,
+        stop: ic3::Stop,
+    },
     Failed(Counterexample),
 }
 
@@ -297,6 +308,16 @@ impl Verdict {
             Verdict::Disagree { events } => format!(
                 "the symbolic model's counterexample of {events} events does not replay on the engine: an error of situ, please report it"
             ),
+            Verdict::GaveUp { depth, work, stop } => {
+                let why = match stop {
+                    ic3::Stop::Frames => format!("the limit of {} frames", prove::MAX_FRAMES),
+                    ic3::Stop::Work => "its work budget (`--prove-effort`)".to_string(),
+                    ic3::Stop::Deadline => "the wall-clock guard (`--prove-timeout`)".to_string(),
+                };
+                format!(
+                    "gave up at {why}: no counterexample of up to {depth} events, after {work} SAT propagations"
+                )
+            }
             Verdict::Failed(c) => format!("counterexample of {} events", c.steps.len()),
         }
     }

@@ -11,7 +11,7 @@
 //! on it there too, or the verdict says that the two disagree.
 
 use super::abstraction::Alphabet;
-use super::ic3::{self, Outcome};
+use super::ic3::{self, Limits, Outcome};
 use super::model::Model;
 use super::random;
 use super::{Counterexample, RunStep, Verdict};
@@ -19,7 +19,6 @@ use situ_compiler::bundle::Content;
 use situ_compiler::spec::PropertySpec;
 use std::cell::Cell;
 use std::sync::Arc;
-use std::time::{Duration, Instant};
 
 /// The most frames IC3 opens before it gives up.
 pub const MAX_FRAMES: usize = 200;
@@ -31,20 +30,21 @@ pub fn sampled(alphabet: &Alphabet) -> Option<String> {
 }
 
 /// Proves property `index` of the model for runs of any length, or finds a
-/// counterexample; `None` for a liveness property or when IC3 gives up.
+/// counterexample (shrunk as the random checker's are: fewest events, round
+/// values and gaps), or says where it gave up ([`Verdict::GaveUp`]); `None`
+/// for a liveness property (the circuit has no bad output for it).
 pub fn prove(
     content: &Arc<Content>,
-    alphabet: &Alphabet,
+    alphabet: &Arc<Alphabet>,
     model: &Model,
     index: usize,
     property: &PropertySpec,
-    budget: Option<Duration>,
+    limits: Limits,
 ) -> Option<Verdict> {
     let bad = model.bad.get(index).copied().flatten()?;
-    let deadline = budget.map(|b| Instant::now() + b);
-    match ic3::check(&model.aig, bad, MAX_FRAMES, deadline) {
+    match ic3::check(&model.aig, bad, limits) {
         Outcome::Proved { frames, clauses } => Some(Verdict::Inductive { frames, clauses, sampled: sampled(alphabet) }),
-        Outcome::Unknown { .. } => None,
+        Outcome::Unknown { depth, work, stop } => Some(Verdict::GaveUp { depth, work, stop }),
         Outcome::Counterexample(inputs) => {
             let run: Vec<RunStep> = inputs
                 .iter()
@@ -55,7 +55,13 @@ pub fn prove(
                 })
                 .collect();
             Some(match random::check_run(content, property, &run, &Cell::new(0)) {
-                Err((point, reason)) => Verdict::Failed(Counterexample::replay(content, &run[..point], point, reason)),
+                Err((point, _)) => {
+                    let run = random::shrink(content, alphabet, property, run[..point].to_vec());
+                    let (point, reason) = random::check_run(content, property, &run, &Cell::new(0))
+                        .err()
+                        .unwrap_or((run.len(), String::new()));
+                    Verdict::Failed(Counterexample::replay(content, &run[..point.min(run.len())], point, reason))
+                }
                 Ok(()) => Verdict::Disagree { events: run.len() },
             })
         }

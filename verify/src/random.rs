@@ -266,14 +266,53 @@ pub fn check_run(
     Ok(())
 }
 
+/// The most candidates tried while shrinking a run.
+const MAX_SHRINK: u32 = 20_000;
+
+/// Shrinks a run that breaks the property as the search's failures are
+/// (events removed one at a time, values to their class's representative,
+/// gaps rounded), each candidate checked on the real system. `run` must
+/// break the property; so does the result, which is 1-minimal when the
+/// candidates ran out before [`MAX_SHRINK`].
+pub fn shrink(
+    content: &Arc<Content>,
+    alphabet: &Arc<Alphabet>,
+    property: &PropertySpec,
+    run: Vec<RunStep>,
+) -> Vec<RunStep> {
+    let steps = Cell::new(0u64);
+    let fails = |r: &[RunStep]| check_run(content, property, r, &steps).is_err();
+    if !fails(&run) {
+        return run;
+    }
+    let mut tree = RunTree::new(run.clone(), alphabet.clone());
+    let mut best = run;
+    if !tree.simplify() {
+        return best;
+    }
+    for _ in 0..MAX_SHRINK {
+        let current = tree.current();
+        if fails(&current) {
+            best = current;
+            if !tree.simplify() {
+                break;
+            }
+        } else if !tree.complicate() {
+            break;
+        }
+    }
+    best
+}
+
 /// Searches runs for a counterexample; a failing run is shrunk first.
 pub fn search(content: &Arc<Content>, alphabet: &Arc<Alphabet>, property: &PropertySpec, s: Search) -> Verdict {
     let strategy = RunStrategy::new(content.clone(), alphabet.clone(), s.length);
     let config = Config {
         cases: s.cases.max(1),
         failure_persistence: None,
-        max_shrink_iters: 20_000,
-        max_shrink_time: 20_000,
+        max_shrink_iters: MAX_SHRINK,
+        // No wall-clock limit: the shrunk run must not depend on the machine's load.
+        max_shrink_time: 0,
         ..Config::default()
     };
     let mut seed = [0u8; 32];
