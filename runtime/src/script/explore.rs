@@ -415,6 +415,21 @@ mod tests {
     }
 
     #[test]
+    fn a_recording_of_many_episodes_replays_the_same() {
+        let c = content("inspection-drone.situ", DRONE);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("d.mcap");
+        let bytes = situ_compiler::bundle::encode(&c, situ_compiler::bundle::Encoding::Json);
+        let rec = crate::record::mcap::McapRecorder::create(&path, c.clone(), &bytes).unwrap();
+        let mut run = ScriptRun::new(c.clone(), Driver::Random { seed: 1 }, Some(3_000_000_000), Some(Box::new(rec)));
+        run.run(&mut |_| {});
+        let report = run.finish().unwrap();
+        assert!(report.exploration.unwrap().episodes > 2);
+        let replayed = crate::replay::replay(&std::fs::read(&path).unwrap(), c).unwrap();
+        assert!(replayed.same(), "{}", replayed.describe());
+    }
+
+    #[test]
     fn one_seed_gives_one_run() {
         let c = content("inspection-drone.situ", DRONE);
         let (a, sa) = explore(&c, 7, 30);
