@@ -187,9 +187,48 @@ fn a_file_of_another_robot_without_a_script_says_what_to_give() {
     let o = common::situ(&["run", &f]);
     assert_eq!(code(&o), 2, "{}", text(&o));
     assert!(text(&o).contains("--random SEED"), "{}", text(&o));
-    let o = common::situ(&["run", &f, "--random", "3"]);
+    let o = common::situ(&["run", &f, "--random", "3", "--until", "10"]);
     assert_eq!(code(&o), 0, "{}", text(&o));
-    assert!(stdout(&o).contains("path: A → B\n"), "{}", text(&o));
+    // B is final: each episode ends at the first GO, and the next begins.
+    assert!(stdout(&o).contains("path: A → B → A → B"), "{}", text(&o));
+    let (episodes, visited, reachable) = exploration(&stdout(&o));
+    assert!(episodes > 1, "{}", text(&o));
+    assert_eq!((visited, reachable), (2, 2), "{}", text(&o));
+}
+
+/// `(episodes, visited, reachable)` of the summary's exploration line.
+fn exploration(out: &str) -> (u64, usize, usize) {
+    let line = out.lines().find(|l| l.starts_with("episodes: ")).unwrap_or_else(|| panic!("no episodes line:\n{out}"));
+    let numbers: Vec<u64> =
+        line.split(|c: char| !c.is_ascii_digit()).filter(|w| !w.is_empty()).map(|w| w.parse().unwrap()).collect();
+    (numbers[0], numbers[1] as usize, numbers[2] as usize)
+}
+
+const DRONE: &str = "tests/explore/inspection-drone.situ";
+
+#[test]
+fn a_random_run_explores_the_drone_past_its_preflight_abort() {
+    // Five simulated minutes by default; the first mission ends in the
+    // preflight check, the run goes on.
+    let o = common::situ(&["run", DRONE, "--random", "1"]);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let out = stdout(&o);
+    assert!(out.contains("(end of the run at 300.000 s)"), "{out}");
+    let (episodes, visited, reachable) = exploration(&out);
+    assert!(episodes > 1, "{out}");
+    assert_eq!(reachable, 10, "{out}");
+    assert!(visited * 10 >= reachable * 8, "at least 80 %: {out}");
+    // The same seed, the same run.
+    let again = common::situ(&["run", DRONE, "--random", "1"]);
+    assert_eq!(stdout(&again), out);
+}
+
+#[test]
+fn a_random_run_explores_the_mower() {
+    let o = common::situ(&["run", MOWER, "--random", "2", "--until", "300"]);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let (episodes, visited, reachable) = exploration(&stdout(&o));
+    assert!(episodes > 1 && visited * 10 >= reachable * 8, "{}", text(&o));
 }
 
 #[test]

@@ -7,6 +7,10 @@
 //! `/situ/ticks`, in the order they were recorded. Time comes from them
 //! only, so the replay is exact: the same bundle gives the same changes.
 //!
+//! A `--random` run's new episode (a change that no rule made, from a
+//! final state to the initial one) resets the replay's working memory as
+//! it did the run's, when the replay is in a final state there too.
+//!
 //! A recording cut short (a run that was killed) is replayed up to the cut
 //! and the report says so ([`ReplayReport::cut`]); a damaged recording, or
 //! one with nothing of situ's in it, is an error.
@@ -149,7 +153,7 @@ pub fn replay_reading(reading: &Reading, content: Arc<Content>) -> Result<Replay
             }
             topics::STATE => {
                 if msg["from"] != msg["state"] {
-                    report.recorded.push(Change {
+                    let change = Change {
                         time_ns: msg["time_ns"].as_u64().unwrap_or(*time),
                         from: msg["from"].as_str().unwrap_or("?").into(),
                         to: msg["state"].as_str().unwrap_or("?").into(),
@@ -157,7 +161,19 @@ pub fn replay_reading(reading: &Reading, content: Arc<Content>) -> Result<Replay
                             .as_array()
                             .map(|r| r.iter().filter_map(|x| x.as_str().map(String::from)).collect())
                             .unwrap_or_default(),
-                    });
+                    };
+                    // A new episode of a `--random` run: no rule, from a
+                    // final state to the initial one. The replay starts
+                    // one too if its own state is final there.
+                    let state = engine.state();
+                    if change.rules.is_empty()
+                        && content.states[state as usize].is_final
+                        && change.to == name(content.initial)
+                    {
+                        engine.reset();
+                        report.replayed.push(Change { from: name(state), ..change.clone() });
+                    }
+                    report.recorded.push(change);
                 }
                 continue;
             }

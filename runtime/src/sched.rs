@@ -185,6 +185,22 @@ impl SimRuntime {
         }
     }
 
+    /// Starts a new mission from the initial state now (a `--random` run
+    /// goes on after a final state): see [`BoardRunner::restart`]; the run
+    /// is no longer finished, and every agent that steps on input takes
+    /// the new status.
+    pub fn restart(&mut self, on_change: &mut dyn FnMut(&StateChange)) {
+        let now = self.now;
+        self.finished = false;
+        if let Some(c) = self.board.restart(&self.shared, now) {
+            self.summary.change(&c);
+            on_change(&c);
+            for a in 0..self.agents.len() as u32 {
+                self.wake(a, now);
+            }
+        }
+    }
+
     /// Queues a step of the agent at `time` (not before now), once, whatever
     /// its rate: an agent with something to report steps when it happens
     /// (a scripted event, say), not at its next period.

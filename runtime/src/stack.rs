@@ -333,6 +333,26 @@ impl BoardRunner {
         self.broadcast(shared, now);
     }
 
+    /// A new mission (a `--random` run's next episode, after a final
+    /// state): the working memory goes back to the initial state with no
+    /// facts, as `situ bench`'s reset (now and each agent's latest stamp
+    /// are kept), the FSMs to their initial states, and the initial status
+    /// is broadcast. The change (no rule fired it) is recorded and
+    /// returned, if the state was not already the initial one.
+    pub fn restart(&mut self, shared: &Shared, now: u64) -> Option<StateChange> {
+        let from = self.board.state();
+        self.board.reset();
+        shared.org_mut().reset();
+        let change = StateChange { from, to: self.board.state(), time: now, firings: Vec::new() };
+        shared.record(|s| s.change(&change));
+        if !change.changed() {
+            return None;
+        }
+        self.counters.changes += 1;
+        self.broadcast(shared, now);
+        Some(change)
+    }
+
     /// Repeats the current status, unchanged (same sequence number), with
     /// the time of now: agents in other processes know the Bulletinboard
     /// is alive.

@@ -208,32 +208,53 @@ impl Generator {
         let guided = if self.rng.random_bool(GUIDED) { self.guided(payload) } else { None };
         let event = match guided {
             Some(e) => e,
-            None => {
-                let pick = self.rng.random::<f64>() * total;
-                let k = self.cumulative.partition_point(|&c| c <= pick).min(self.agents.len() - 1);
-                let agent = self.agents[k];
-                let events = &self.content.agents[agent as usize].events;
-                let weights = &self.event_weights[agent as usize];
-                let pick = self.rng.random::<f64>() * weights[weights.len() - 1];
-                let event = events[weights.partition_point(|&w| w <= pick).min(events.len() - 1)];
-                for f in 0..self.content.events[event as usize].fields.len() {
-                    let v = self.value(event as usize, f);
-                    payload.push(v);
-                }
-                event
-            }
+            None => self.random_event(total, payload),
         };
         let agent = self.content.events[event as usize].agent;
         self.last[agent as usize] = Some(event);
-        // Exponential gaps; at least 1 ns.
-        let u: f64 = self.rng.random::<f64>();
-        let gap = (-(1.0 - u).ln() * self.mean_gap).clamp(1.0, 1e12) as u64;
-        self.now += gap;
+        self.now += self.gap();
         let _ = self.guide.engine.post(event, self.now, &payload[start..]);
         if self.guide.reset_on_final {
             self.guide.engine.reset_if_final();
         }
         Some((event, self.now))
+    }
+
+    /// The sum of the reporting agents' rates (`None`: no agent reports).
+    pub(crate) fn total_rate(&self) -> Option<f64> {
+        self.cumulative.last().copied()
+    }
+
+    /// Per rule, the alpha nodes of its positive event patterns.
+    pub(crate) fn patterns(&self) -> &[Vec<u32>] {
+        &self.guide.patterns
+    }
+
+    pub(crate) fn rng(&mut self) -> &mut ChaCha8Rng {
+        &mut self.rng
+    }
+
+    /// An event of an agent picked in proportion to the rates (`total`: the
+    /// sum of them), its payload appended.
+    pub(crate) fn random_event(&mut self, total: f64, payload: &mut Vec<Value>) -> u32 {
+        let pick = self.rng.random::<f64>() * total;
+        let k = self.cumulative.partition_point(|&c| c <= pick).min(self.agents.len() - 1);
+        let agent = self.agents[k];
+        let events = &self.content.agents[agent as usize].events;
+        let weights = &self.event_weights[agent as usize];
+        let pick = self.rng.random::<f64>() * weights[weights.len() - 1];
+        let event = events[weights.partition_point(|&w| w <= pick).min(events.len() - 1)];
+        for f in 0..self.content.events[event as usize].fields.len() {
+            let v = self.value(event as usize, f);
+            payload.push(v);
+        }
+        event
+    }
+
+    /// The interval to the next event (ns): exponential, at least 1 ns.
+    pub(crate) fn gap(&mut self) -> u64 {
+        let u: f64 = self.rng.random::<f64>();
+        (-(1.0 - u).ln() * self.mean_gap).clamp(1.0, 1e12) as u64
     }
 
     /// An event of a pattern of a rule that can fire in the guide's state,
@@ -266,6 +287,13 @@ impl Generator {
             return None;
         }
         let alpha = patterns[self.rng.random_range(0..patterns.len())] as usize;
+        self.payload_for(alpha, payload)
+    }
+
+    /// The event of the alpha node `alpha`, with a payload appended that
+    /// passes its tests when one of 16 draws does; `None` if `alpha` is not
+    /// an event's node.
+    pub(crate) fn payload_for(&mut self, alpha: usize, payload: &mut Vec<Value>) -> Option<u32> {
         let AlphaNode::Event { event, tests, .. } = &self.content.network.alpha[alpha] else { return None };
         let (event, tests) = (*event, tests.clone());
         let n = self.content.events[event as usize].fields.len();

@@ -203,6 +203,9 @@ pub fn run(args: Args) -> u8 {
     }
     println!("{} on {} ({})\n", content.source, report.driver, report.ended);
     print!("{}", report.runtime.table());
+    if let Some(x) = &report.exploration {
+        println!("{}", x.line());
+    }
     println!("\n{}", report.agents_table(&content));
     if !report.problems.is_empty() {
         println!("problems the Bulletinboard reported:");

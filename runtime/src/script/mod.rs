@@ -8,6 +8,9 @@
 //! - [`timeline`]: the script's events in time order, made lazily (one
 //!   event, periodic events, silences, seeded random sections that use the
 //!   guided generator of [`crate::stream`]);
+//! - [`explore`]: the closed-loop generator of `--random SEED`, steered by
+//!   the state the stack is in towards the states least visited, a new
+//!   episode from the initial state after each final state;
 //! - [`standin`]: the agent that plays any agent of the rules;
 //! - [`report`]: each agent's modes over time, its time running, waiting
 //!   and sleeping and in each function; `metrics.json`;
@@ -20,6 +23,7 @@
 //! same report to the byte.
 
 pub mod chart;
+pub mod explore;
 pub mod report;
 pub mod standin;
 pub mod timeline;
@@ -28,6 +32,7 @@ pub mod wiring;
 use crate::agent::{self, Agent};
 use crate::record::{Sink, Tee};
 use crate::sched::{SimConfig, SimRuntime};
+use explore::Explorer;
 use report::{agent_times, ScriptReport, Track};
 use situ_compiler::bundle::Content;
 use situ_compiler::spec::ScriptSpec;
@@ -37,7 +42,7 @@ use timeline::{Due, Timeline};
 use wiring::Snapshot;
 
 /// How long a `--random` run lasts when not told (ns).
-pub const DEFAULT_RANDOM_NS: u64 = 60_000_000_000;
+pub const DEFAULT_RANDOM_NS: u64 = 300_000_000_000;
 
 /// What drives the agents.
 #[derive(Debug, Clone)]
@@ -82,12 +87,34 @@ impl Progress {
     }
 }
 
+/// Where a run's events come from.
+enum Feed {
+    Script(Timeline),
+    Explore(Box<Explorer>),
+}
+
+impl Feed {
+    fn next(&mut self) -> Option<Due> {
+        match self {
+            Feed::Script(t) => t.next(),
+            Feed::Explore(x) => x.next_due(),
+        }
+    }
+
+    fn silenced(&self, agent: usize) -> u64 {
+        match self {
+            Feed::Script(t) => t.silenced[agent],
+            Feed::Explore(_) => 0,
+        }
+    }
+}
+
 /// A scripted run in progress.
 pub struct ScriptRun {
     content: Arc<Content>,
     rt: SimRuntime,
     inboxes: Vec<Inbox>,
-    timeline: Timeline,
+    feed: Feed,
     next: Option<Due>,
     end: u64,
     track: Track,
@@ -110,11 +137,11 @@ impl ScriptRun {
             .map(|a| Box::new(StandIn::new(&content, a, inboxes[a as usize].clone())) as Box<dyn Agent>)
             .collect();
         let bound = agent::bind(&content, agents, true).expect("a stand-in offers every function of its agent");
-        let (timeline, end) = match &driver {
-            Driver::Script(s) => (Timeline::of_script(content.clone(), s), until.unwrap_or(s.end)),
+        let (feed, end) = match &driver {
+            Driver::Script(s) => (Feed::Script(Timeline::of_script(content.clone(), s)), until.unwrap_or(s.end)),
             Driver::Random { seed } => {
                 let end = until.unwrap_or(DEFAULT_RANDOM_NS);
-                (Timeline::random(content.clone(), end, *seed), end)
+                (Feed::Explore(Box::new(Explorer::new(content.clone(), *seed, end))), end)
             }
         };
         let track = Track::new(n);
@@ -128,7 +155,7 @@ impl ScriptRun {
             content,
             rt,
             inboxes,
-            timeline,
+            feed,
             next: None,
             end,
             track,
@@ -142,7 +169,8 @@ impl ScriptRun {
         self.end
     }
 
-    /// Whether a final state ended the run.
+    /// Whether a final state ended the run (a `--random` run goes on with
+    /// a new episode instead).
     pub fn finished(&self) -> bool {
         self.rt.finished()
     }
@@ -181,7 +209,7 @@ impl ScriptRun {
         let until = until.min(self.end);
         loop {
             if self.next.is_none() {
-                self.next = self.timeline.next();
+                self.next = self.feed.next();
             }
             let Some(due) = self.next.take_if(|d| d.time <= until) else { break };
             // Queued first: a periodic step of the agent at that very time
@@ -205,12 +233,22 @@ impl ScriptRun {
     /// that the organisation is seen as each new state comes to rest.
     fn advance(&mut self, until: u64) {
         while !self.rt.finished() && self.rt.next_time().is_some_and(|t| t <= until) {
-            let mut changed = 0u64;
-            self.rt.step(&mut |_| changed += 1);
-            self.changes += changed;
+            let mut rests = Vec::new();
+            self.rt.step(&mut |c| rests.push(c.to));
+            self.changes += rests.len() as u64;
             let state = self.rt.state() as usize;
-            if changed > 0 && self.snapshots[state].is_none() {
+            if !rests.is_empty() && self.snapshots[state].is_none() {
                 self.snapshots[state] = Some(Snapshot::take(&self.rt.shared.org(), self.rt.now()));
+            }
+            if let Feed::Explore(x) = &mut self.feed {
+                rests.iter().for_each(|&s| x.visit(s));
+                if self.rt.finished() {
+                    // The episode ends; the run goes on with the next one.
+                    let mut restarted = 0u64;
+                    self.rt.restart(&mut |_| restarted += 1);
+                    self.changes += restarted;
+                    x.new_episode(self.rt.state());
+                }
             }
         }
         if !self.rt.finished() {
@@ -244,7 +282,7 @@ impl ScriptRun {
             .map(|((a, def), mut t)| {
                 t.scripted_events = self.inboxes[a].reported();
                 t.asleep_events = self.inboxes[a].asleep(now.saturating_add(1));
-                t.silenced_events = self.timeline.silenced[a];
+                t.silenced_events = self.feed.silenced(a);
                 (def.name.clone(), t)
             })
             .collect();
@@ -262,6 +300,10 @@ impl ScriptRun {
             runtime: summary,
             agent_times,
             timeline,
+            exploration: match &self.feed {
+                Feed::Explore(x) => Some(x.coverage()),
+                Feed::Script(_) => None,
+            },
         })
     }
 

@@ -136,6 +136,9 @@ pub struct ScriptReport {
     pub agent_times: BTreeMap<String, AgentTimes>,
     /// Each change of the state at rest: `(seconds, state)`.
     pub timeline: Vec<(f64, String)>,
+    /// What a `--random` run explored: episodes, states visited.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exploration: Option<super::explore::Coverage>,
 }
 
 impl ScriptReport {
