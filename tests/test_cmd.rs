@@ -207,3 +207,92 @@ fn usage_and_io_errors_exit_2() {
     assert_eq!(code(&situ(&["test"])), 2);
     assert_eq!(code(&situ(&["test", "rules/outdoor.situ", "--engine", "magic"])), 2);
 }
+
+/// A ladder of `n` states, one event per rung: "never the top" is false,
+/// with a counterexample of `n` events.
+fn ladder(n: usize) -> String {
+    let mut s = String::from("states { S0 initial");
+    for i in 1..=n {
+        s.push_str(&format!(" S{i}"));
+    }
+    s.push_str(" }\nagent Up sensor {");
+    for i in 1..=n {
+        s.push_str(&format!(" event U{i}"));
+    }
+    s.push_str(" }\n");
+    for i in 1..=n {
+        s.push_str(&format!("rule r{i} {{ when state == S{} and U{i} then S{i} }}\n", i - 1));
+    }
+    s.push_str(&format!("property \"the top is never reached\" {{ never state == S{n} }}\n"));
+    s
+}
+
+#[test]
+fn a_false_property_is_undecided_at_a_tiny_budget_never_ok() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "ladder.situ", ladder(16));
+    let tiny = ["--depth", "2", "--length", "3", "--cases", "8", "--prove-effort", "50"];
+    let o = situ(&[&["test", file.as_str()][..], &tiny].concat());
+    let out = stdout(&o);
+    assert_eq!(code(&o), 1, "{out}");
+    assert!(out.contains("property \"the top is never reached\" ... UNDECIDED"), "{out}");
+    assert!(out.contains("symbolic: gave up at its work budget (`--prove-effort`)"), "{out}");
+    assert!(!out.contains("... ok"), "{out}");
+    assert_eq!(out.lines().rev().find(|l| l.contains("passed")), Some("0 passed, 0 failed, 1 undecided"), "{out}");
+    // Allowed, it passes the run but is still called undecided.
+    let o = situ(&[&["test", file.as_str(), "--allow-undecided"][..], &tiny].concat());
+    assert_eq!(code(&o), 0, "{}", stdout(&o));
+    assert!(stdout(&o).contains("UNDECIDED"));
+    // The wall-clock guard is said as such, and is never a pass.
+    let o = situ(&[&["test", file.as_str(), "--prove-timeout", "0"][..], &tiny[..6]].concat());
+    assert_eq!(code(&o), 1, "{}", stdout(&o));
+    assert!(stdout(&o).contains("gave up at the wall-clock guard (`--prove-timeout`)"), "{}", stdout(&o));
+    // JSON says the same.
+    let o = situ(&[&["test", file.as_str(), "--format", "json"][..], &tiny].concat());
+    assert_eq!(code(&o), 1);
+    let lines: Vec<serde_json::Value> = stdout(&o).lines().map(|l| serde_json::from_str(l).expect("JSON")).collect();
+    assert_eq!(lines[0]["verdict"], "undecided");
+    assert_eq!(lines[0]["code"], "E0502");
+    assert_eq!(lines[0]["passed"], false);
+    assert_eq!(lines[1]["undecided"], 1);
+    // With the default budget, the 16 events are found and replay.
+    let o = situ(&["test", &file, "--depth", "2", "--length", "3", "--cases", "8"]);
+    let out = stdout(&o);
+    assert_eq!(code(&o), 1, "{out}");
+    assert!(out.contains("counterexample (IC3, replayed on the engine, shrunk, 16 events)"), "{out}");
+}
+
+#[test]
+fn a_printed_counterexample_parses_after_an_include() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "buggy.situ", BUGGY);
+    let file = write(dir.path(), "main.situ", "include \"buggy.situ\"\n");
+    let o = situ(&["test", &file, "--filter", "firing", "--engine", "exhaustive"]);
+    let block = replay_block(&stdout(&o));
+    let replay = write(dir.path(), "replay.situ", format!("include \"buggy.situ\"\n{block}"));
+    let o = situ(&["test", &replay, "--filter", "counterexample"]);
+    assert_eq!(code(&o), 0, "{}\n{block}", stdout(&o));
+}
+
+#[test]
+fn a_vacuous_property_is_reported_with_its_code() {
+    let dir = tempfile::tempdir().unwrap();
+    let rules = r#"states { Idle initial Armed Fired final }
+agent Btn interface { event ARM event FIRE }
+agent Lamp actuator { function glow table { Armed => run glow()  Fired => run glow()  _ => sleep } }
+rule arm { when state == Idle and ARM then Armed }
+rule fire { when state == Armed and FIRE then Fired }
+property "vacuous" { always (state == Fired and Lamp sleeping -> next state == Fired) }
+property "real" { always (state == Fired -> next state == Fired) }
+"#;
+    let file = write(dir.path(), "lamp.situ", rules);
+    let o = situ(&["test", &file]);
+    let out = stdout(&o);
+    assert_eq!(code(&o), 0, "{out}");
+    let vacuous = &out[out.find("property \"vacuous\"").unwrap()..out.find("property \"real\"").unwrap()];
+    assert!(vacuous.contains("warning[W0501]: vacuous"), "{out}");
+    let real = &out[out.find("property \"real\"").unwrap()..];
+    assert!(real.contains("premise: reached after 2 events: ARM at 0ms, FIRE at 0ms"), "{out}");
+    let explain = situ(&["explain", "W0501"]);
+    assert!(stdout(&explain).contains("premise never holds"), "{}", stdout(&explain));
+}
