@@ -28,6 +28,8 @@ const SLOT: f64 = 10.0;
 const MARGIN: f64 = 12.0;
 /// Average width of a character, as a fraction of the font size (Helvetica).
 const CHAR: f64 = 0.6;
+/// The attribute that marks a node of a `rank=sink` subgraph.
+const SINK: &str = "situ-sink";
 
 struct Node {
     id: String,
@@ -128,6 +130,10 @@ fn walk(
                             match (k.as_str(), top) {
                                 ("label", true) => p.title = v.clone(),
                                 ("rankdir", true) => p.lr = v == "LR",
+                                // `{ rank=sink; … }`: its nodes in the last rank.
+                                ("rank", false) if v == "sink" => {
+                                    nd.insert(SINK.into(), "true".into());
+                                }
                                 _ => {}
                             }
                         }

@@ -1,7 +1,7 @@
 //! Where the built-in layout puts things: ranks, orders, positions, edge
 //! paths (straight in the ranks, curved in the gaps) and edge labels.
 
-use super::{font, text_size, Picture, NODESEP, RANKSEP, SLOT};
+use super::{font, text_size, Picture, NODESEP, RANKSEP, SINK, SLOT};
 use std::collections::HashMap;
 
 /// Where everything goes: ranks, orders, positions, and each edge's path
@@ -85,7 +85,13 @@ fn ranks(n: usize, edges: &[(usize, usize)]) -> (Vec<usize>, Vec<bool>) {
 pub(super) fn place(p: &Picture) -> Placed {
     let n = p.nodes.len();
     let pairs: Vec<(usize, usize)> = p.edges.iter().map(|e| (e.from, e.to)).collect();
-    let (rank, _) = ranks(n, &pairs);
+    let (mut rank, _) = ranks(n, &pairs);
+    let sink = |v: usize| p.nodes[v].attrs.contains_key(SINK);
+    if let Some(last) = (0..n).filter(|&v| !sink(v)).map(|v| rank[v] + 1).max() {
+        for v in (0..n).filter(|&v| sink(v)) {
+            rank[v] = rank[v].max(last);
+        }
+    }
     let top = rank.iter().copied().max().unwrap_or(0) + 1;
     // The layers: real nodes, then a slot per rank an edge passes.
     // An item is (Some(node), None) or (None, Some(edge)).
@@ -231,6 +237,7 @@ pub(super) fn place(p: &Picture) -> Placed {
             across[r] = xs.iter().map(|x| x + shift).collect();
         }
     }
+    squeeze(&layers, &mut across, &extent);
     let lowest = (0..top)
         .flat_map(|r| layers[r].iter().zip(&across[r]).map(|(it, x)| x - extent(it) / 2.0).collect::<Vec<_>>())
         .fold(f64::INFINITY, f64::min);
@@ -327,6 +334,32 @@ pub(super) fn place(p: &Picture) -> Placed {
     placed.labels = place_labels(p, &placed, &labels);
     fit(p, &mut placed);
     placed
+}
+
+/// Closes the bands across the picture that no rank uses (what pulling
+/// toward the neighbours may leave between two parts of the graph) down to
+/// twice the spacing.
+fn squeeze(layers: &[Vec<Item>], across: &mut [Vec<f64>], extent: &dyn Fn(&Item) -> f64) {
+    let mut spans: Vec<(f64, f64)> = layers
+        .iter()
+        .zip(across.iter())
+        .flat_map(|(l, xs)| l.iter().zip(xs).map(|(it, &x)| (x - extent(it) / 2.0, x + extent(it) / 2.0)))
+        .collect();
+    spans.sort_by(|a, b| a.0.total_cmp(&b.0));
+    // Each empty band: where it starts and how much to take out of it.
+    let mut cuts: Vec<(f64, f64)> = Vec::new();
+    let mut reach = f64::NEG_INFINITY;
+    for (a, b) in spans {
+        if reach.is_finite() && a - reach > 2.0 * NODESEP {
+            cuts.push((reach, a - reach - 2.0 * NODESEP));
+        }
+        reach = reach.max(b);
+    }
+    for xs in across.iter_mut() {
+        for x in xs.iter_mut() {
+            *x -= cuts.iter().filter(|c| *x > c.0).map(|c| c.1).sum::<f64>();
+        }
+    }
 }
 
 /// A point of the gap crossing from `a` to `b` (the curve the SVG draws there).
