@@ -376,3 +376,60 @@ pub fn svg(dot: &str) -> Result<String, String> {
     out.push_str("</g>\n</svg>\n");
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The boxes of an SVG of ours, by id: `(x0, y0, x1, y1)`.
+    fn boxes(svg: &str) -> HashMap<String, [f64; 4]> {
+        let mut out = HashMap::new();
+        for part in svg.split("<g class=\"node\">").skip(1) {
+            let id = &part[part.find("<title>").unwrap() + 7..part.find("</title>").unwrap()];
+            let rect = &part[part.find("<rect").unwrap()..];
+            let v = |n: &str| -> f64 {
+                let at = rect.find(&format!(" {n}=\"")).unwrap() + n.len() + 3;
+                rect[at..at + rect[at..].find('"').unwrap()].parse().unwrap()
+            };
+            out.insert(id.to_string(), [v("x"), v("y"), v("x") + v("width"), v("y") + v("height")]);
+        }
+        out
+    }
+
+    #[test]
+    fn a_long_edge_goes_around_the_box_in_its_way() {
+        // a → b → c and a → c: the long edge has its own slot in b's rank.
+        let svg = svg("digraph g { rankdir=LR; label=\"T\"; node [shape=box]; a -> b; b -> c; a -> c; }").unwrap();
+        let b = boxes(&svg)["b"];
+        let long = svg.split("<title>a&#45;&gt;c</title>").nth(1).unwrap();
+        let d = &long[long.find(" d=\"").unwrap() + 4..];
+        let d = &d[..d.find('"').unwrap()];
+        let nums: Vec<f64> = d
+            .split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
+            .filter(|t| !t.is_empty())
+            .map(|t| t.parse().unwrap())
+            .collect();
+        // Every point of the path, ends and control points, is outside b's
+        // box (tests/pictures.rs samples the curves themselves).
+        for p in nums.chunks_exact(2) {
+            let inside = p[0] > b[0] && p[0] < b[2] && p[1] > b[1] && p[1] < b[3];
+            assert!(!inside, "({}, {}) in b {b:?}: {d}", p[0], p[1]);
+        }
+        assert!(svg.contains(">T</text>"), "the title");
+    }
+
+    #[test]
+    fn cycles_loops_empty_graphs_and_a_legend_lay_out() {
+        let svg = svg(
+            "digraph g { a -> b; b -> a; a -> a [label=\"self\"]; \
+             subgraph cluster_legend { label=\"legend\"; l0 [label=\"kind\", fillcolor=\"#ff0000\", style=filled]; } }",
+        )
+        .unwrap();
+        let ids: Vec<String> = boxes(&svg).into_keys().collect();
+        assert_eq!(ids.len(), 2, "the legend is no node: {ids:?}");
+        assert!(svg.contains("<g class=\"legend\">") && svg.contains(">kind</text>") && svg.contains("#ff0000"));
+        assert_eq!(svg.matches("<g class=\"edge\">").count(), 3);
+        assert!(super::svg("digraph g { }").unwrap().contains("</svg>"));
+        assert!(super::svg("not a graph").is_err());
+    }
+}
