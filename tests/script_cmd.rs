@@ -92,13 +92,22 @@ fn the_files_of_a_scripted_run_are_the_same_bytes_every_time() {
     }
     assert!(svg.contains("Drive: running home()"), "Drive's homing is a segment with a tooltip");
     assert!(svg.contains("Blades: sleeping"), "Blades' sleep is a segment");
-    // The wiring of a state as the run saw it: Blades' FSM asleep, Drive waiting.
+    // The wiring of a state as the run saw it, drawn as `situ graph` draws
+    // it: Blades' FSM asleep, Drive waiting.
     let charging = std::fs::read_to_string(a.join("wiring-CHARGING.svg")).unwrap();
-    assert!(charging.contains("CHARGING — on the station, charging"), "a title");
-    assert!(charging.contains("Blades (Actuator): sleeping"), "{charging}");
-    assert!(charging.contains("Drive (Actuator): waiting"), "{charging}");
+    assert!(charging.contains(">Wiring in CHARGING: on the station, charging</text>"), "a title: {charging}");
+    let node = |svg: &str, name: &str| -> String {
+        let at =
+            svg.find(&format!("class=\"node\">\n<title>{name}</title>")).unwrap_or_else(|| panic!("{name}: {svg}"));
+        svg[at..at + svg[at..].find("</g>").unwrap()].to_string()
+    };
+    assert!(node(&charging, "Blades").contains(">(sleeping)</text>"), "{charging}");
+    assert!(node(&charging, "Drive").contains(">(waiting)</text>"), "{charging}");
     let stuck = std::fs::read_to_string(a.join("wiring-STUCK.svg")).unwrap();
-    assert!(stuck.contains("<title>Bumper → Drive</title>") && stuck.contains("<title>GPS → Drive</title>"), "{stuck}");
+    assert!(
+        stuck.contains("<title>Bumper&#45;&gt;Drive</title>") && stuck.contains("<title>GPS&#45;&gt;Drive</title>"),
+        "{stuck}"
+    );
     let metrics: serde_json::Value = serde_json::from_slice(&std::fs::read(a.join("metrics.json")).unwrap()).unwrap();
     assert_eq!(metrics["runtime"]["final_state"], "FAULT");
     assert!(metrics["agent_times"]["Drive"]["functions"]["home"].as_f64().unwrap() > 10.0, "{metrics}");

@@ -273,12 +273,12 @@ fn write_out(
     visited.dedup();
     for s in visited {
         let svg = match snapshots.get(s as usize).and_then(Option::as_ref) {
-            Some(snap) => wiring::svg(content, snap),
+            Some(snap) => super::graph::svg(&wiring::dot(content, snap)),
             // A state that was at rest only inside one step of the
             // scheduler: its static wiring.
-            None => super::graph::svg(&situ_compiler::graph::wiring(content, Some(s)))
-                .map_err(|e| format!("cannot lay out the wiring of a state: {e}"))?,
-        };
+            None => super::graph::svg(&situ_compiler::graph::wiring(content, Some(s))),
+        }
+        .map_err(|e| format!("cannot lay out the wiring of a state: {e}"))?;
         write(&format!("wiring-{}.svg", content.states[s as usize].name), svg.as_bytes())?;
     }
     write("metrics.json", report.to_json().as_bytes())?;

@@ -17,13 +17,15 @@
 //! Pure: no I/O and no process here (invariant 3); running `dot` is the
 //! command line's business.
 
+mod fsm;
 mod rete;
 mod states;
 mod wiring;
 
+pub use fsm::possible as fsm_possible;
 pub use rete::rete;
 pub use states::{states, StateKind};
-pub use wiring::{wiring, wiring_cell, wiring_legend};
+pub use wiring::{wiring, wiring_cell, wiring_legend, wiring_moment, Moment};
 
 /// A DOT string literal.
 pub(crate) fn q(s: &str) -> String {

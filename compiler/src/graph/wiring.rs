@@ -1,13 +1,16 @@
 //! The wiring graph of a state: agents by mode (running green, waiting
 //! yellow, sleeping grey, FSM agents blue, each also said in the label), a
 //! solid edge per link, a dashed edge per link of an FSM agent with the FSM
-//! state it depends on. A title names the state; a legend explains the
+//! state it depends on, drawn only where that FSM state can be active
+//! ([`super::fsm`]). A title names the state; a legend explains the
 //! colours. For every state at once: clusters in DOT ([`wiring`] with no
 //! state), small multiples in SVG ([`wiring_cell`] per state, composed by
-//! the command line, with [`wiring_legend`]).
+//! the command line, with [`wiring_legend`]). The wiring a run saw at one
+//! moment ([`wiring_moment`]) is drawn by the same writer.
 
+use super::fsm::all_possible;
 use super::{header, legend, q};
-use crate::bundle::{Behaviour, Content, Mode};
+use crate::bundle::{Behaviour, Content, FsmLink, Mode};
 use std::fmt::Write as _;
 
 const RUNNING: &str = "style=filled, fillcolor=\"#c8e6c9\", color=\"#1b5e20\"";
@@ -57,8 +60,9 @@ pub fn wiring(c: &Content, state: Option<u32>) -> String {
 /// without a link, named under the title.
 pub fn wiring_cell(c: &Content, s: u32) -> String {
     let w = &c.wiring[s as usize];
+    let fsm = fsm_links(c, s);
     let linked =
-        |a: u32| w.links.iter().any(|&(f, t)| f == a || t == a) || w.fsm_links.iter().any(|l| l.from == a || l.to == a);
+        |a: u32| w.links.iter().any(|&(f, t)| f == a || t == a) || fsm.iter().any(|l| l.from == a || l.to == a);
     let listed = |m: Mode| -> Vec<&str> {
         (0..c.agents.len())
             .filter(|&a| mode(c, a, s).0 == Some(m) && (m == Mode::Sleeping || !linked(a as u32)))
@@ -76,6 +80,77 @@ pub fn wiring_cell(c: &Content, s: u32) -> String {
     body(c, s, "", true, &mut out);
     out.push_str("}\n");
     out
+}
+
+/// What a run saw at one moment: the state, every agent's mode and
+/// function, the links of the moment, and a caption (when, and how).
+pub struct Moment<'a> {
+    pub state: u32,
+    pub agents: &'a [(Mode, Option<String>)],
+    pub links: &'a [(u32, u32)],
+    pub caption: String,
+}
+
+/// The wiring a run saw at one moment, drawn as [`wiring`] draws a state:
+/// the same styles, title and legend (`wiring-STATE.svg` of `situ run --out`).
+pub fn wiring_moment(c: &Content, m: &Moment) -> String {
+    let title = format!("Wiring in {}\n{}", state_title(c, m.state), m.caption);
+    let mut out = header("wiring", "LR", &title);
+    out.push_str("  node [shape=box];\n");
+    let id = |a: u32| q(&c.agents[a as usize].name);
+    for (i, a) in c.agents.iter().enumerate() {
+        let (mode, function) = m.agents.get(i).cloned().unwrap_or((Mode::Sleeping, None));
+        let mut label = a.name.clone();
+        if let (Some(f), false) = (&function, mode == Mode::Sleeping) {
+            label.push_str(&format!("\n{f}()"));
+        }
+        let style = match mode {
+            Mode::Running => RUNNING,
+            Mode::Waiting => {
+                label.push_str("\n(waiting)");
+                WAITING
+            }
+            Mode::Sleeping => {
+                label.push_str("\n(sleeping)");
+                SLEEPING
+            }
+        };
+        let _ = writeln!(out, "  {} [label={}, {style}];", id(i as u32), q(&label));
+    }
+    for &(from, to) in m.links {
+        if (from as usize) < c.agents.len() && (to as usize) < c.agents.len() {
+            let _ = writeln!(out, "  {} -> {};", id(from), id(to));
+        }
+    }
+    let mut entries = legend_entries();
+    entries.pop();
+    legend(&mut out, &entries);
+    out.push_str("}\n");
+    out
+}
+
+/// The FSM links of state `s` whose FSM state can be active in `s`.
+fn fsm_links(c: &Content, s: u32) -> Vec<&FsmLink> {
+    let possible = all_possible(c);
+    c.wiring[s as usize]
+        .fsm_links
+        .iter()
+        .filter(|l| {
+            possible.get(l.agent as usize).and_then(Option::as_ref).is_some_and(|p| {
+                p.get(s as usize).and_then(|row| row.get(l.fsm_state as usize)).copied().unwrap_or(false)
+            })
+        })
+        .collect()
+}
+
+/// The FSM states an FSM agent can be in during state `s`.
+fn fsm_states(c: &Content, a: usize, s: u32) -> Vec<&str> {
+    let Behaviour::Fsm(f) = &c.agents[a].behaviour else { return Vec::new() };
+    let p = super::fsm::possible(c, a as u32, f);
+    (0..f.states.len())
+        .filter(|&k| p.get(s as usize).is_some_and(|row| row[k]))
+        .map(|k| f.states[k].name.as_str())
+        .collect()
 }
 
 /// The legend of the wiring pictures alone, for the small multiples.
@@ -113,8 +188,9 @@ fn mode(c: &Content, a: usize, s: u32) -> (Option<Mode>, Option<u32>) {
 fn body(c: &Content, s: u32, prefix: &str, compact: bool, out: &mut String) {
     let id = |a: u32| q(&format!("{prefix}{}", c.agents[a as usize].name));
     let w = &c.wiring[s as usize];
+    let fsm = fsm_links(c, s);
     let linked =
-        |a: u32| w.links.iter().any(|&(f, t)| f == a || t == a) || w.fsm_links.iter().any(|l| l.from == a || l.to == a);
+        |a: u32| w.links.iter().any(|&(f, t)| f == a || t == a) || fsm.iter().any(|l| l.from == a || l.to == a);
     for (i, a) in c.agents.iter().enumerate() {
         let (mode, function) = mode(c, i, s);
         if compact && (mode == Some(Mode::Sleeping) || (mode == Some(Mode::Waiting) && !linked(i as u32))) {
@@ -135,7 +211,7 @@ fn body(c: &Content, s: u32, prefix: &str, compact: bool, out: &mut String) {
                 SLEEPING
             }
             None => {
-                label.push_str("\n(FSM)");
+                let _ = write!(label, "\n(FSM: {})", fsm_states(c, i, s).join(", "));
                 FSM
             }
         };
@@ -144,7 +220,7 @@ fn body(c: &Content, s: u32, prefix: &str, compact: bool, out: &mut String) {
     for &(from, to) in &w.links {
         let _ = writeln!(out, "  {} -> {};", id(from), id(to));
     }
-    for l in &w.fsm_links {
+    for l in fsm {
         let Behaviour::Fsm(f) = &c.agents[l.agent as usize].behaviour else { continue };
         let when = format!("{} in {}", c.agents[l.agent as usize].name, f.states[l.fsm_state as usize].name);
         let _ =

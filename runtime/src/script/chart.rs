@@ -15,6 +15,11 @@ const RIGHT: f64 = 20.0;
 const TOP: f64 = 56.0;
 const BAND: f64 = 26.0;
 const GAP: f64 = 6.0;
+/// The narrowest a visited state or an agent's stretch is drawn, however
+/// short it was, so that nothing the run went through is invisible.
+pub const MIN_WIDTH: f64 = 4.0;
+/// A row of the labels moved above the state band.
+const CALLOUT: f64 = 15.0;
 
 /// A colour per index, readable with black text.
 const PALETTE: [&str; 10] =
@@ -24,8 +29,41 @@ const PALETTE: [&str; 10] =
 pub fn timeline_svg(content: &Content, tracked: &Tracked, end: u64, title: &str) -> String {
     let end = end.max(1);
     let rows = content.agents.len() + 1;
-    let height = TOP + rows as f64 * (BAND + GAP) + 70.0;
     let x = |t: u64| LEFT + (t.min(end) as f64 / end as f64) * (WIDTH - LEFT - RIGHT);
+    let mut changes: Vec<(u64, u32)> = vec![(0, content.initial)];
+    changes.extend(tracked.states.iter().copied());
+    // Each state's segment, at least MIN_WIDTH wide; the labels that do not
+    // fit their segment go above the band, in as many rows as they need.
+    let segments: Vec<(f64, f64, u64, u64, u32)> = changes
+        .iter()
+        .enumerate()
+        .map(|(i, &(t, state))| {
+            let until = changes.get(i + 1).map_or(end, |n| n.0);
+            let x1 = x(t).min(WIDTH - RIGHT - MIN_WIDTH);
+            (x1, x(until).max(x1 + MIN_WIDTH), t, until, state)
+        })
+        .collect();
+    let name = |state: u32| content.states[state as usize].name.as_str();
+    let mut moved: Vec<(f64, usize, usize)> = Vec::new();
+    let mut row_ends: Vec<f64> = Vec::new();
+    for (i, &(x1, x2, _, _, state)) in segments.iter().enumerate() {
+        if fits(x1, x2, name(state)) {
+            continue;
+        }
+        let w = text_width(name(state));
+        let cx = ((x1 + x2) / 2.0).clamp(LEFT + w / 2.0, WIDTH - RIGHT - w / 2.0);
+        let row = match row_ends.iter().position(|&e| e + 4.0 <= cx - w / 2.0) {
+            Some(r) => r,
+            None => {
+                row_ends.push(f64::NEG_INFINITY);
+                row_ends.len() - 1
+            }
+        };
+        row_ends[row] = cx + w / 2.0;
+        moved.push((cx, row, i));
+    }
+    let top = TOP + row_ends.len() as f64 * CALLOUT;
+    let height = top + rows as f64 * (BAND + GAP) + 70.0;
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -43,34 +81,44 @@ pub fn timeline_svg(content: &Content, tracked: &Tracked, end: u64, title: &str)
         r##"<text x="{LEFT}" y="38" fill="#444">state at rest, then each agent: filled running, hatched waiting, dotted sleeping; the label is its function</text>"##
     );
 
-    // The state band.
-    let y0 = TOP;
+    // The state band: the short states drawn last, over their neighbours.
+    let y0 = top;
     let _ = writeln!(
         s,
         r##"<text x="{}" y="{:.1}" text-anchor="end" font-weight="bold">state</text>"##,
         LEFT - 8.0,
         y0 + 17.0
     );
-    let mut changes: Vec<(u64, u32)> = vec![(0, content.initial)];
-    changes.extend(tracked.states.iter().copied());
-    for (i, &(t, state)) in changes.iter().enumerate() {
-        let until = changes.get(i + 1).map_or(end, |n| n.0);
-        let (x1, x2) = (x(t), x(until));
-        let name = &content.states[state as usize].name;
-        let tip = format!("{name}: {} – {}", secs(t), secs(until));
+    let mut order: Vec<usize> = (0..segments.len()).collect();
+    order.sort_by(|&a, &b| (x(segments[b].3) - x(segments[b].2)).total_cmp(&(x(segments[a].3) - x(segments[a].2))));
+    for &i in &order {
+        let (x1, x2, t, until, state) = segments[i];
+        let tip = format!("{}: {} – {}", name(state), secs(t), secs(until));
         let _ = writeln!(
             s,
             r##"<rect x="{x1:.2}" y="{y0:.1}" width="{:.2}" height="{BAND}" fill="{}" stroke="#333" stroke-width="0.5"><title>{}</title></rect>"##,
-            (x2 - x1).max(0.5),
+            x2 - x1,
             PALETTE[state as usize % PALETTE.len()],
             esc(&tip)
         );
-        label(&mut s, x1, x2, y0, name);
+        label(&mut s, x1, x2, y0, name(state));
+    }
+    // The moved labels, each with a line down to its segment.
+    for &(cx, row, i) in &moved {
+        let (x1, x2, _, _, state) = segments[i];
+        let ty = TOP + row as f64 * CALLOUT + 11.0;
+        let _ = writeln!(
+            s,
+            r##"<text x="{cx:.2}" y="{ty:.1}" text-anchor="middle">{}</text><line x1="{cx:.2}" y1="{:.1}" x2="{:.2}" y2="{y0:.1}" stroke="#666" stroke-width="0.5"/>"##,
+            esc(name(state)),
+            ty + 2.0,
+            (x1 + x2) / 2.0
+        );
     }
 
     // One band per agent.
     for (a, def) in content.agents.iter().enumerate() {
-        let y = TOP + (a + 1) as f64 * (BAND + GAP);
+        let y = top + (a + 1) as f64 * (BAND + GAP);
         let _ = writeln!(
             s,
             r##"<text x="{}" y="{:.1}" text-anchor="end">{}</text>"##,
@@ -84,7 +132,8 @@ pub fn timeline_svg(content: &Content, tracked: &Tracked, end: u64, title: &str)
             if until <= st.time && i + 1 < stretches.len() {
                 continue;
             }
-            let (x1, x2) = (x(st.time), x(until));
+            let x1 = x(st.time).min(WIDTH - RIGHT - MIN_WIDTH);
+            let x2 = x(until).max(x1 + MIN_WIDTH);
             let function = st.function.as_deref();
             let colour = function
                 .and_then(|f| def.functions.iter().position(|g| g.name == f))
@@ -100,7 +149,7 @@ pub fn timeline_svg(content: &Content, tracked: &Tracked, end: u64, title: &str)
                 }
                 _ => format!("{}: {mode} {} – {}", def.name, secs(st.time), secs(until)),
             };
-            let w = (x2 - x1).max(0.5);
+            let w = x2 - x1;
             match st.mode {
                 Mode::Running => {
                     let _ = writeln!(
@@ -137,7 +186,7 @@ pub fn timeline_svg(content: &Content, tracked: &Tracked, end: u64, title: &str)
     }
 
     // The time axis.
-    let axis = TOP + rows as f64 * (BAND + GAP) + 6.0;
+    let axis = top + rows as f64 * (BAND + GAP) + 6.0;
     let _ =
         writeln!(s, r##"<line x1="{LEFT}" y1="{axis:.1}" x2="{:.1}" y2="{axis:.1}" stroke="#333"/>"##, WIDTH - RIGHT);
     let step = tick_step(end);
@@ -166,9 +215,19 @@ pub fn timeline_svg(content: &Content, tracked: &Tracked, end: u64, title: &str)
     s
 }
 
+/// The width of a label (12 px sans-serif).
+fn text_width(text: &str) -> f64 {
+    7.0 * text.chars().count() as f64
+}
+
+/// Whether a label fits in a segment.
+fn fits(x1: f64, x2: f64, text: &str) -> bool {
+    (x2 - x1) >= text_width(text) + 6.0
+}
+
 /// A label centred in a segment, when it fits.
 fn label(s: &mut String, x1: f64, x2: f64, y: f64, text: &str) {
-    if text.is_empty() || (x2 - x1) < 7.0 * text.chars().count() as f64 + 6.0 {
+    if text.is_empty() || !fits(x1, x2, text) {
         return;
     }
     let _ = writeln!(

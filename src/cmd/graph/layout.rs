@@ -2,8 +2,8 @@
 //! PATH: its layered layout reduces crossings, keeps every label on its
 //! edge and draws every border style, which is what makes the pictures of
 //! a real rule file readable (`docs/tools.md`, "Pictures"). Without it,
-//! the pure-Rust `layout-rs` crate lays the same DOT out: the pictures
-//! keep their fill colours, shapes and words, not their border styles.
+//! the built-in layered layout ([`super::builtin`]) lays the same DOT out,
+//! with its title, its legend and no edge over a box.
 //! `SITU_LAYOUT=builtin` chooses the built-in layout; `SITU_DOT=PATH`
 //! names the `dot` to run.
 
@@ -73,16 +73,7 @@ fn graphviz(path: &PathBuf, dots: &[&str]) -> Result<Vec<String>, String> {
 }
 
 fn builtin(dot: &str) -> Result<String, String> {
-    use layout::backends::svg::SVGWriter;
-    use layout::gv::{DotParser, GraphBuilder};
-    let mut parser = DotParser::new(dot);
-    let tree = parser.process()?;
-    let mut builder = GraphBuilder::new();
-    builder.visit_graph(&tree);
-    let mut graph = builder.get();
-    let mut writer = SVGWriter::new();
-    graph.do_it(false, false, false, &mut writer);
-    Ok(writer.finalize())
+    super::builtin::svg(dot)
 }
 
 /// An SVG document's size (in its own units, `pt` or `px`), view box and

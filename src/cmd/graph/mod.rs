@@ -1,13 +1,14 @@
 //! `situ graph FILE --view wiring|rete|states [--state S] [--format dot|svg]`:
 //! pictures. The compiler writes DOT (`situ_compiler::graph`); DOT is printed
 //! as is, SVG is laid out here ([`layout`]): by Graphviz's `dot` when it is
-//! on the PATH, else by the pure-Rust `layout-rs` crate.
+//! on the PATH, else by the built-in layered layout ([`builtin`]).
 //!
 //! Findings are drawn, not refused: the diagnostics of a source go to
 //! standard error, and the states view of a file with errors draws what
 //! resolved (exit 1, the picture written all the same). The wiring and Rete
 //! views come from a compiled program and need a file without errors.
 
+mod builtin;
 pub mod layout;
 
 use super::{FAILED, OK, USAGE};
