@@ -85,7 +85,9 @@ impl Alphabet {
         // Constant comparisons per (event, field), and links between fields.
         let mut checks: Vec<Vec<Vec<Check>>> = c.events.iter().map(|e| vec![Vec::new(); e.fields.len()]).collect();
         let mut links: Vec<((u32, u32), (u32, u32))> = Vec::new();
-        let mut add_test = |event: u32, t: &Test, links: &mut Vec<_>| {
+        // `bound`: the events that earlier joins of the test's chain matched,
+        // per agent: there the agent's fact is of that event.
+        let mut add_test = |event: u32, t: &Test, bound: &[(u32, u32)], links: &mut Vec<_>| {
             let mut constant = true;
             let mut link = |o: &Operand| match o {
                 Operand::Value(_) => {}
@@ -95,8 +97,13 @@ impl Alphabet {
                 }
                 Operand::Fact { agent, field } => {
                     constant = false;
-                    // Every event of that agent with this field index.
-                    for &e in &c.agents[*agent as usize].events {
+                    // The event its chain joined for that agent, else every
+                    // event of the agent with this field index.
+                    let events = match bound.iter().find(|(a, _)| a == agent) {
+                        Some(&(_, e)) => vec![e],
+                        None => c.agents[*agent as usize].events.clone(),
+                    };
+                    for e in events {
                         if (*field as usize) < c.events[e as usize].fields.len() {
                             links.push(((event, t.field), (e, *field)));
                         }
@@ -123,7 +130,7 @@ impl Alphabet {
             if let AlphaNode::Event { event, tests, min_run, within_ns } = node {
                 event_of_alpha[i] = Some(*event);
                 for t in tests {
-                    add_test(*event, t, &mut links);
+                    add_test(*event, t, &[], &mut links);
                 }
                 let agent = c.events[*event as usize].agent as usize;
                 run_cap[agent] = run_cap[agent].max(*min_run);
@@ -135,8 +142,9 @@ impl Alphabet {
         }
         for b in &net.beta {
             if let Some(event) = event_of_alpha[b.alpha as usize] {
+                let bound = joined_events(c, b.parent, &event_of_alpha);
                 for t in &b.tests {
-                    add_test(event, t, &mut links);
+                    add_test(event, t, &bound, &mut links);
                 }
             }
         }
@@ -145,7 +153,7 @@ impl Alphabet {
                 pred.visit(&mut |q| {
                     if let Pred::Event { event, tests, min_run } = q {
                         for t in tests {
-                            add_test(*event, t, &mut links);
+                            add_test(*event, t, &[], &mut links);
                         }
                         let agent = c.events[*event as usize].agent as usize;
                         run_cap[agent] = run_cap[agent].max(*min_run);
@@ -432,6 +440,26 @@ fn same(a: Value, b: Value) -> bool {
 
 /// Candidate values of a field: they meet every signature of comparisons
 /// with `consts` (two inside each open interval when `two`).
+/// Per agent, the event that a positive join above `parent` (in a rule's
+/// chain) matched: wherever the chain's tests run, that agent's fact is of
+/// that event (one fact per agent). The nearest join wins.
+fn joined_events(c: &Content, mut parent: Option<u32>, event_of_alpha: &[Option<u32>]) -> Vec<(u32, u32)> {
+    let mut out: Vec<(u32, u32)> = Vec::new();
+    while let Some(p) = parent {
+        let node = &c.network.beta[p as usize];
+        if node.kind == BetaKind::Join {
+            if let Some(e) = event_of_alpha[node.alpha as usize] {
+                let agent = c.events[e as usize].agent;
+                if !out.iter().any(|(a, _)| *a == agent) {
+                    out.push((agent, e));
+                }
+            }
+        }
+        parent = node.parent;
+    }
+    out
+}
+
 fn candidates(ty: &FieldType, consts: &[f64], two: bool) -> Vec<Value> {
     let mut cs: Vec<f64> = consts.iter().copied().filter(|c| c.is_finite()).collect();
     cs.sort_by(f64::total_cmp);

@@ -228,3 +228,24 @@ fn a_verdict_never_reads_proved_when_it_is_not() {
     assert_eq!(r.conclusion.word(), "undecided");
     assert!(matches!(r.symbolic, Some(Verdict::Inductive { sampled: Some(_), .. })), "{:?}", r.symbolic);
 }
+
+#[test]
+fn a_variable_is_linked_only_to_the_event_its_rule_joined() {
+    // `?n` compares PATH_BLOCKED's route with ROUTE's number: the route
+    // planner's other event (NO_ROUTE, its field 0) never meets it there,
+    // so two fields are linked and the abstraction is exact (DLA's rules).
+    let text = r#"states { Planning initial Following Replanning Unreachable final }
+agent Planner processing { event ROUTE { number: i64 } event NO_ROUTE { explored: f64 } }
+agent Path processing { event PATH_BLOCKED { route: i64 } }
+rule routed { when state in {Planning, Replanning} and ROUTE(number: ?n) and not PATH_BLOCKED(route: ?n) then Following }
+rule blocked { when state == Following and ROUTE(number: ?n) and PATH_BLOCKED(route: ?n) then Replanning }
+rule none { when state in {Planning, Replanning} and NO_ROUTE then Unreachable }
+property "replanning follows a blocked path" { always (state == Replanning -> PATH_BLOCKED) }
+"#;
+    let (content, props) = load(text);
+    let refs: Vec<&PropertySpec> = props.iter().collect();
+    let alphabet = situ_verify::abstraction::Alphabet::new(&content, &refs);
+    assert!(alphabet.exact(), "{:?}", alphabet.samples);
+    let r = &check(text, &options(12, property::DEFAULT_EFFORT, 16, 30))[0];
+    assert!(matches!(r.conclusion, Conclusion::Proved { .. }), "{:?}", r.conclusion);
+}
