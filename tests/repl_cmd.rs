@@ -99,3 +99,18 @@ fn a_bundle_can_be_stepped_through_too() {
     let o = repl(&junk, "state\n");
     assert_eq!(o.status.code(), Some(2));
 }
+
+#[test]
+fn an_event_of_a_sleeping_agent_is_dropped_and_said_so() {
+    // In DOCKING the blades sleep: a run never reports their stall.
+    let o = repl("examples/mower/mower.situ", "BATT charge=15\nBlades.BLSTALL\nfacts\nstate\n");
+    let text = out(&o);
+    assert_eq!(o.status.code(), Some(0), "a dropped event is no error of the script:\n{text}");
+    assert!(text.contains("MOWING -> DOCKING (battery_low)"), "{text}");
+    assert!(
+        text.contains("dropped: `Blades` sleeps in DOCKING, and a sleeping agent is not stepped: a run never reports its `BLSTALL` now; nothing changed"),
+        "{text}"
+    );
+    assert!(!text.contains("Blades: BLSTALL"), "no fact of the blades:\n{text}");
+    assert!(text.contains("DOCKING at 0.000s"), "{text}");
+}

@@ -245,6 +245,68 @@ fn bad_input_exits_2_before_serving() {
     assert!(stderr(&o).contains("is not a port or an address"), "{}", text(&o));
 }
 
+/// `GET path` from the server of `url` with these extra header lines: the
+/// status, the content type and the body.
+fn request(url: &str, path: &str, headers: &[&str]) -> (u16, String, String) {
+    use std::io::{Read, Write};
+    let addr = url.strip_prefix("http://").unwrap().trim_end_matches('/');
+    let mut stream = std::net::TcpStream::connect(addr).expect("the server listens");
+    stream.set_read_timeout(Some(Duration::from_secs(30))).unwrap();
+    let lines: String = headers.iter().map(|h| format!("{h}\r\n")).collect();
+    write!(stream, "GET {path} HTTP/1.0\r\n{lines}\r\n").unwrap();
+    let mut response = String::new();
+    stream.read_to_string(&mut response).expect("a whole response");
+    let (head, body) = response.split_once("\r\n\r\n").expect("a head and a body");
+    let status = head.split_whitespace().nth(1).and_then(|s| s.parse().ok()).expect("a status");
+    let kind = head
+        .lines()
+        .find_map(|l| l.split_once(':').filter(|(k, _)| k.eq_ignore_ascii_case("content-type")))
+        .map_or(String::new(), |(_, v)| v.trim().to_string());
+    (status, kind, body.to_string())
+}
+
+/// A server at `url` answers `data` (a JSON endpoint) to a request for its
+/// own address, and refuses it (403, plain text, a reason) to a rebinding
+/// page's (a foreign `Host`) and to another site's page (a foreign `Origin`);
+/// `also` (a live run's long poll) too.
+fn answers_only_its_own_address(url: &str, data: &str, also: &str) {
+    let addr = url.strip_prefix("http://").unwrap().trim_end_matches('/');
+    let port = addr.rsplit_once(':').unwrap().1;
+    let own = format!("Host: {addr}");
+    let (status, _, body) = request(url, data, &[&own]);
+    assert_eq!(status, 200, "{body}");
+    assert!(serde_json::from_str::<serde_json::Value>(&body).is_ok(), "{body}");
+    let (status, _, _) = request(url, data, &[&format!("Host: localhost:{port}"), &format!("Origin: http://{addr}")]);
+    assert_eq!(status, 200, "localhost, and the page's own origin");
+    for path in [data, also] {
+        let rebound = format!("Host: evil.example:{port}");
+        let (status, kind, body) = request(url, path, &[&rebound]);
+        assert_eq!((status, kind.as_str()), (403, "text/plain; charset=utf-8"), "{path}: {body}");
+        assert!(body.contains("Host `evil.example:") && body.contains("not this server's address"), "{body}");
+        let (status, kind, body) = request(url, path, &[&own, "Origin: http://evil.example"]);
+        assert_eq!((status, kind.as_str()), (403, "text/plain; charset=utf-8"), "{path}: {body}");
+        assert!(body.contains("Origin `http://evil.example` is not a page of this server"), "{body}");
+        let (status, _, body) = request(url, path, &[]);
+        assert_eq!(status, 403, "no Host: {body}");
+    }
+    // What held before still holds: no file outside the page, plain-text 404s.
+    for path in ["/../Cargo.toml", "/%2e%2e/Cargo.toml", "/src/main.rs"] {
+        let (status, kind, body) = request(url, path, &[&own]);
+        assert_eq!((status, kind.as_str()), (404, "text/plain; charset=utf-8"), "{path}: {body}");
+        assert!(body.starts_with("no page"), "{body}");
+    }
+}
+
+#[test]
+fn the_servers_answer_only_their_own_address() {
+    let served = Served::start(&["rules/outdoor.situ"]);
+    answers_only_its_own_address(&served.url, "/api/timeline", "/api/state?at=1");
+    // A live run's server, with its long poll (which waits for the run to
+    // start: a refused poll is answered at once, and does not start it).
+    let live = Served::command(&["run", "tests/view/greenhouse.situ", "--serve"]);
+    answers_only_its_own_address(&live.url, "/api/program", "/api/live?since=0");
+}
+
 /// Follows a live run's `/api/live` to its end: every entry, and how late
 /// each state change was heard (ms, the server's stamp to here).
 fn follow(url: &str) -> (Vec<serde_json::Value>, Vec<f64>) {

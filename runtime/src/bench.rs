@@ -11,7 +11,10 @@
 //! event ([`Engine::reset_if_final`], §10.12 of the language reference;
 //! `--no-reset` turns this off). Every event goes through the engine's
 //! acceptance rule ([`Engine::admit`]), at the clock its line gives
-//! (`@CLOCK`) if any. Nothing grows with the stream: the
+//! (`@CLOCK`) if any: a refused one (a payload that does not fit its
+//! event, out of order, from the future, an unknown event) changes
+//! nothing, is counted by reason, and the run goes on, as a running
+//! stack's does. Nothing grows with the stream: the
 //! buffer, the histogram and the engine are of fixed size, so the peak
 //! resident memory of 10,000,000 events is that of 1,000.
 
@@ -19,6 +22,7 @@ use crate::rete::{Engine, PostError};
 use crate::stream::{self, Event, Generator};
 use serde::Serialize;
 use situ_compiler::bundle::{Content, Value};
+use std::collections::BTreeMap;
 use std::io::Write;
 use std::sync::Arc;
 use std::time::Instant;
@@ -57,13 +61,49 @@ pub struct Report {
     pub nodes: Nodes,
     pub state_changes: u64,
     /// How many events arrived in each state (at rest).
-    pub events_by_state: std::collections::BTreeMap<String, u64>,
+    pub events_by_state: BTreeMap<String, u64>,
     pub firings: u64,
     pub missions: u64,
     pub cascade_errors: u64,
     /// Events the acceptance rule refused (`Engine::admit`): a payload that
     /// does not fit, out of order, from the future. They change nothing.
     pub refused: u64,
+    /// The refused events by reason ([`PostError::key`]: `payload`, `out of
+    /// order`, `from the future`, `unknown event`), as a running stack
+    /// counts them.
+    pub refused_by_reason: BTreeMap<String, u64>,
+    /// The first refused event of each reason: where and why.
+    pub first_refused: BTreeMap<String, Refusal>,
+}
+
+impl Report {
+    /// The refused events for a person, one line per reason with the first
+    /// of them (`place` names an event by its index: its line in a stream
+    /// file); nothing when none was refused.
+    pub fn refusals(&self, place: impl Fn(u64) -> String) -> Vec<String> {
+        if self.refused == 0 {
+            return Vec::new();
+        }
+        let mut lines = vec![format!(
+            "{} of {} events refused, as every part of situ refuses them (language reference §10.4); the run went on:",
+            self.refused, self.events
+        )];
+        for (key, n) in &self.refused_by_reason {
+            if let Some(first) = self.first_refused.get(key) {
+                lines.push(format!("  {key}: {n}, the first at {}: {}", place(first.index), first.reason));
+            }
+        }
+        lines
+    }
+}
+
+/// A refused event of a stream.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Refusal {
+    /// Its 0-based index among the stream's events.
+    pub index: u64,
+    /// Why, as the runtime says it.
+    pub reason: String,
 }
 
 #[derive(Debug, Clone, Copy, Serialize)]
@@ -210,6 +250,8 @@ pub fn run(content: Arc<Content>, mut opts: Options) -> Report {
     let mut elapsed = 0.0f64;
     let (mut total, mut changes, mut firings, mut missions, mut cascades) = (0u64, 0u64, 0u64, 0u64, 0u64);
     let mut refused = 0u64;
+    let mut by_reason: BTreeMap<&'static str, u64> = BTreeMap::new();
+    let mut first_refused = BTreeMap::new();
     let mut at_rest = engine.state();
     let mut by_state = vec![0u64; content.states.len()];
     let mut lines: Vec<(u64, u32)> = Vec::new();
@@ -226,7 +268,14 @@ pub fn run(content: Arc<Content>, mut opts: Options) -> Report {
             match chunk.step(&mut engine, i) {
                 Ok(step) => firings += step.firings as u64,
                 Err(PostError::Cascade { .. }) => cascades += 1,
-                Err(_) => refused += 1,
+                Err(e) => {
+                    // Counted as a running stack counts it; the run goes on.
+                    refused += 1;
+                    *by_reason.entry(e.key()).or_default() += 1;
+                    first_refused
+                        .entry(e.key().to_string())
+                        .or_insert_with(|| Refusal { index: total + i as u64, reason: e.describe(&content) });
+                }
             }
             let state = engine.state();
             if state != at_rest {
@@ -304,6 +353,8 @@ pub fn run(content: Arc<Content>, mut opts: Options) -> Report {
         missions,
         cascade_errors: cascades,
         refused,
+        refused_by_reason: by_reason.into_iter().map(|(k, n)| (k.to_string(), n)).collect(),
+        first_refused,
     }
 }
 
@@ -378,5 +429,38 @@ mod tests {
         );
         assert_eq!(String::from_utf8(again).unwrap(), states);
         assert_eq!(replay.state_changes, report.state_changes);
+    }
+
+    #[test]
+    fn a_stream_goes_on_past_the_events_it_refuses_and_counts_them_by_reason() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../rules/outdoor.situ");
+        let checked = situ_compiler::check(&path, &situ_compiler::loader::FsLoader).unwrap();
+        let content = Arc::new(situ_compiler::bundle::build(&checked));
+        // Two events that do not fit, one out of order, one from the future,
+        // one unknown: refused and counted; the rest is run.
+        let text = "10000000 LAOBS 12.0\n20000000 LAOBS 12.0 0.5\n30000000 LAOBS near 0.5\n\
+            5000000 LAOBS 12.0 0.5\n900000000 LAOBN @40000000\n50000000 NOPE\n60000000 LAOBS 12.0 0.5\n";
+        let events = stream::parse(&content, text).unwrap();
+        let mut states = Vec::new();
+        let report = run(
+            content,
+            Options {
+                source: Source::File(&events),
+                reset_on_final: true,
+                stream_out: None,
+                states_out: Some(&mut states),
+            },
+        );
+        assert_eq!(report.events, 7);
+        assert_eq!(report.refused, 5, "{report:?}");
+        let by: Vec<(&str, u64)> = report.refused_by_reason.iter().map(|(k, n)| (k.as_str(), *n)).collect();
+        assert_eq!(by, [("from the future", 1), ("out of order", 1), ("payload", 2), ("unknown event", 1)]);
+        let first = &report.first_refused["payload"];
+        assert_eq!((first.index, first.reason.as_str()), (0, "event `LAOBS` has 2 payload field(s), 1 given"));
+        assert_eq!(report.first_refused["out of order"].index, 3);
+        let summary = report.refusals(|i| format!("event {i}"));
+        assert_eq!(summary.len(), 5, "{summary:?}");
+        assert!(summary[0].starts_with("5 of 7 events refused"), "{summary:?}");
+        assert_eq!(summary[3], "  payload: 2, the first at event 0: event `LAOBS` has 2 payload field(s), 1 given");
     }
 }

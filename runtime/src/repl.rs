@@ -190,22 +190,46 @@ impl Session {
         }
         let payload: Vec<Value> = payload.into_iter().flatten().collect();
         let mut out = Vec::new();
-        for _ in 0..repeat {
-            out.push(self.post(event, payload.clone())?);
+        for i in 0..repeat {
+            if let Some(why) = self.not_taken(event, &payload) {
+                out.push(if repeat > 1 { format!("{why} ({} of the {repeat} not posted)", repeat - i) } else { why });
+                break;
+            }
+            out.push(self.post(event, payload.clone()));
         }
         Ok(out.into_iter().filter(|s| !s.is_empty()).collect::<Vec<_>>().join("\n"))
     }
 
-    /// Posts one event now, as the runtime does: the agent's FSM first, then
-    /// the rules, then every FSM on a new state.
-    fn post(&mut self, event: u32, payload: Vec<Value>) -> Result<String, String> {
+    /// Why a run would not take this event now, if it would not, as the
+    /// line that says so: its agent sleeps (a sleeping agent is not
+    /// stepped, so it reports nothing: language reference §10.7, §10.11),
+    /// or the acceptance rule of every part of situ refuses it (§10.4,
+    /// [`Engine::admit`](crate::rete::Engine::admit)). Nothing changes.
+    fn not_taken(&self, event: u32, payload: &[Value]) -> Option<String> {
+        let c = &self.content;
+        let agent = c.events[event as usize].agent;
+        if self.org.mode(agent) == Mode::Sleeping {
+            return Some(format!(
+                "dropped: `{}` sleeps in {}, and a sleeping agent is not stepped: a run never reports its `{}` now; nothing changed",
+                c.agents[agent as usize].name,
+                self.state(),
+                c.events[event as usize].name
+            ));
+        }
+        let refused = self.board.engine().admit(event, self.now, payload).err()?;
+        Some(format!("refused: {}; nothing changed", refused.describe(c)))
+    }
+
+    /// Posts one event now that [`not_taken`](Self::not_taken) lets
+    /// through, as the runtime does: the agent's FSM first, then the rules,
+    /// then every FSM on a new state.
+    fn post(&mut self, event: u32, payload: Vec<Value>) -> String {
         let agent = self.content.events[event as usize].agent;
-        self.board.engine().validate(event, &payload).map_err(|e| e.describe(&self.content))?;
         self.org.on_event(agent, event);
         let result = self.board.post(event, self.now, &payload);
         let text = self.after(result);
         self.steps.push(Step::Post { event, payload, time: self.now, state: self.board.state() });
-        Ok(text)
+        text
     }
 
     fn wait(&mut self, d: u64) -> Result<String, String> {
@@ -338,7 +362,10 @@ impl Session {
             match step {
                 Step::Post { event, payload, time, .. } => {
                     self.now = time;
-                    let _ = self.post(event, payload);
+                    // Taken before, but the rules may have been reloaded since.
+                    if self.not_taken(event, &payload).is_none() {
+                        self.post(event, payload);
+                    }
                 }
                 Step::Wait { to, .. } => {
                     let _ = self.wait(to.saturating_sub(self.now));

@@ -441,7 +441,7 @@ impl BoardRunner {
     fn take(&mut self, shared: &Shared, msg: &EventMsg, now: u64) -> Option<StateChange> {
         let c = shared.content.clone();
         if let Some(error) = self.check(&c, msg, now) {
-            let key = reason_key(&error).to_string();
+            let key = error.key().to_string();
             let reason = error.describe(&c);
             *self.counters.refused.entry(key).or_default() += 1;
             let rec = record_of(msg, Verdict::Refused(reason.clone()));
@@ -547,16 +547,5 @@ fn record_of(msg: &EventMsg, verdict: Verdict) -> EventRecord {
         payload: msg.payload.clone(),
         urgent: msg.urgent,
         verdict,
-    }
-}
-
-/// A short key for a refusal reason, for counting.
-fn reason_key(error: &PostError) -> &'static str {
-    match error {
-        PostError::UnknownEvent { .. } => "unknown event",
-        PostError::AnotherAgent { .. } => "another agent's event",
-        PostError::OutOfOrder { .. } => "out of order",
-        PostError::FromTheFuture { .. } => "from the future",
-        PostError::Arity { .. } | PostError::Type { .. } | PostError::Cascade { .. } => "payload",
     }
 }

@@ -360,7 +360,11 @@ pub fn write_event(c: &Content, out: &mut String, e: &Event) {
 
 /// Appends one event as a line of the text form.
 pub fn write_line(c: &Content, out: &mut String, event: u32, time: u64, payload: &[Value]) {
-    let e = &c.events[event as usize];
+    let Some(e) = c.events.get(event as usize) else {
+        // An event of no name: a stream line's unknown event, as read.
+        let _ = writeln!(out, "{time} #{event}");
+        return;
+    };
     let _ = write!(out, "{time} {}", e.name);
     for (f, v) in e.fields.iter().zip(payload) {
         let _ = match (v, &f.ty) {
@@ -368,7 +372,7 @@ pub fn write_line(c: &Content, out: &mut String, event: u32, time: u64, payload:
             (Value::F64(x), _) => write!(out, " {x:.3}"),
             (Value::I64(i), _) => write!(out, " {i}"),
             (Value::Bool(b), _) => write!(out, " {b}"),
-            (Value::Symbol(k), FieldType::Symbols(s)) => write!(out, " {}", s[*k as usize]),
+            (Value::Symbol(k), FieldType::Symbols(s)) if (*k as usize) < s.len() => write!(out, " {}", s[*k as usize]),
             (Value::Symbol(k), _) => write!(out, " #{k}"),
         };
     }
@@ -390,6 +394,16 @@ impl std::fmt::Display for StreamError {
 }
 
 /// Reads a stream's text; comments and blank lines are skipped.
+///
+/// A line with a timestamp and a name is an event, and is read as it is
+/// written, whether or not it fits: its event (an unknown name is the id
+/// [`Content::events`]`.len()`, which no event has) and its payload values
+/// (a value that is not of its field's type, or an unknown symbol, is one
+/// that no field takes). The acceptance rule then refuses those, as every
+/// part of situ does (`Engine::admit`, language reference §10.4): a
+/// missing or extra value, a value of another type, an unknown symbol, an
+/// unknown event. The errors are for a line that is not an event: no
+/// timestamp, no name, a bad `@CLOCK` or words after it.
 pub fn parse(c: &Content, text: &str) -> Result<Vec<Event>, StreamError> {
     let mut out = Vec::new();
     for (i, line) in text.lines().enumerate() {
@@ -399,37 +413,52 @@ pub fn parse(c: &Content, text: &str) -> Result<Vec<Event>, StreamError> {
             continue;
         }
         let err = |message: String| StreamError { line: line_no, message };
-        let mut words = line.split_whitespace();
+        let mut words = line.split_whitespace().peekable();
         let time: u64 = words
             .next()
             .and_then(|w| w.parse().ok())
-            .ok_or_else(|| err("expected a timestamp in nanoseconds".into()))?;
+            .ok_or_else(|| err("expected a timestamp in nanoseconds (0 to 2^64 - 1)".into()))?;
         let name = words.next().ok_or_else(|| err("expected an event name after the timestamp".into()))?;
-        let event = c.event_id(name).ok_or_else(|| err(format!("unknown event `{name}`")))?;
-        let fields = &c.events[event as usize].fields;
+        let event = c.event_id(name).unwrap_or(c.events.len() as u32);
+        let fields = c.events.get(event as usize).map_or(&[][..], |e| &e.fields[..]);
         let mut payload = Vec::with_capacity(fields.len());
-        for f in fields {
-            let w = words.next().ok_or_else(|| err(format!("`{name}` needs a value for `{}`", f.name)))?;
-            let bad = || err(format!("`{w}` is not a {} for `{name}.{}`", f.ty.describe(), f.name));
-            let v = match &f.ty {
-                FieldType::F64 => Value::F64(w.parse().map_err(|_| bad())?),
-                FieldType::I64 => Value::I64(w.parse().map_err(|_| bad())?),
-                FieldType::Bool => Value::Bool(w.parse().map_err(|_| bad())?),
-                FieldType::Symbols(s) => Value::Symbol(s.iter().position(|x| x == w).ok_or_else(bad)? as u32),
-            };
-            payload.push(v);
+        while let Some(w) = words.next_if(|w| !w.starts_with('@')) {
+            payload.push(fields.get(payload.len()).map_or(MISFIT, |f| value(&f.ty, w)));
         }
         let mut clock = None;
-        if let Some(at) = words.clone().next().and_then(|w| w.strip_prefix('@')) {
-            words.next();
+        if let Some(at) = words.next().and_then(|w| w.strip_prefix('@')) {
             clock = Some(at.parse().map_err(|_| err(format!("`@{at}` is not a clock in nanoseconds")))?);
         }
         if let Some(extra) = words.next() {
-            return Err(err(format!("unexpected `{extra}` after the payload of `{name}`")));
+            return Err(err(format!("unexpected `{extra}` after the clock of `{name}`")));
         }
         out.push(Event { event, time, payload, clock });
     }
     Ok(out)
+}
+
+/// A value that no field takes (the acceptance rule refuses it): a symbol
+/// past every list.
+const MISFIT: Value = Value::Symbol(u32::MAX);
+
+/// A payload word read as its field's type, or [`MISFIT`].
+fn value(ty: &FieldType, w: &str) -> Value {
+    let v = match ty {
+        FieldType::F64 => w.parse().ok().map(Value::F64),
+        FieldType::I64 => w.parse().ok().map(Value::I64),
+        FieldType::Bool => w.parse().ok().map(Value::Bool),
+        FieldType::Symbols(s) => s.iter().position(|x| x == w).map(|i| Value::Symbol(i as u32)),
+    };
+    v.unwrap_or(MISFIT)
+}
+
+/// The 1-based line of the `index`-th event (0-based) of a stream's text.
+pub fn line_of(text: &str, index: u64) -> Option<usize> {
+    text.lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty() && !l.trim().starts_with('#'))
+        .nth(usize::try_from(index).ok()?)
+        .map(|(i, _)| i + 1)
 }
 
 #[cfg(test)]
@@ -496,12 +525,9 @@ mod tests {
     fn bad_lines_say_where_and_why() {
         let c = outdoor();
         let cases = [
-            ("10 NOPE", "unknown event `NOPE`"),
             ("x LAOBN", "expected a timestamp"),
-            ("10 LAOBS 1.0", "needs a value for `height`"),
-            ("10 LAOBS 1.0 high", "`high` is not a f64"),
-            ("10 LAOBN 3", "unexpected `3`"),
-            ("10 PLF maybe", "`maybe` is not a {no_path, blocked, timeout}"),
+            ("18446744073709551616 LAOBN", "expected a timestamp"),
+            ("10", "expected an event name"),
             ("10 LAOBN @soon", "`@soon` is not a clock"),
             ("10 LAOBN @5 6", "unexpected `6`"),
         ];
@@ -510,5 +536,34 @@ mod tests {
             assert_eq!(e.line, 3, "{line}");
             assert!(e.message.contains(want), "{line}: {}", e.message);
         }
+    }
+
+    #[test]
+    fn an_event_that_does_not_fit_is_read_for_the_acceptance_rule_to_refuse() {
+        let c = outdoor();
+        let engine = Engine::new(c.clone());
+        let cases = [
+            ("10 NOPE", "unknown event"),
+            ("10 LAOBS 1.0", "payload"),
+            ("10 LAOBS 1.0 @20", "payload"),
+            ("10 LAOBS 1.0 high", "payload"),
+            ("10 LAOBN 3", "payload"),
+            ("10 PLF maybe", "payload"),
+        ];
+        let text: String = cases.iter().map(|(l, _)| format!("{l}\n")).collect();
+        let events = parse(&c, &format!("# header\n{text}")).unwrap();
+        assert_eq!(events.len(), cases.len());
+        for ((line, key), e) in cases.iter().zip(&events) {
+            let refused = engine.admit(e.event, e.time, &e.payload).expect_err(line);
+            assert_eq!(refused.key(), *key, "{line}: {refused:?}");
+        }
+        assert_eq!(events[2].clock, Some(20));
+        let why = engine.admit(events[3].event, 10, &events[3].payload).unwrap_err().describe(&c);
+        assert_eq!(why, "field `LAOBS.height` is f64, the value is not");
+        let mut again = String::new();
+        write_event(&c, &mut again, &events[4]);
+        assert_eq!(again, "10 LAOBN\n", "a value past the fields is not written back");
+        assert_eq!(line_of("# h\n\n1 A\n2 B\n", 1), Some(4));
+        assert_eq!(line_of("1 A\n", 1), None);
     }
 }

@@ -1,7 +1,9 @@
 //! `situ bench FILE|BUNDLE [--events N] [--seed S]`: the Bulletinboard's
 //! throughput and latency on a seeded random event stream, as one JSON
 //! object. `--stream-out`, `--states-out` and `--stream-in` make the runs
-//! comparable with other engines (`bench/README.md`).
+//! comparable with other engines (`bench/README.md`). The events the
+//! acceptance rule refuses are counted by reason in the object and said on
+//! standard error (file and line, why); the run goes on past them.
 
 use super::{OK, USAGE};
 use situ_runtime::bench::{self, Options, Source};
@@ -28,6 +30,7 @@ pub fn run(args: Args) -> u8 {
         Err(code) => return code,
     };
     let content = program.content;
+    let mut stream_text = None;
     let events = match &args.stream_in {
         None => None,
         Some(path) => {
@@ -39,7 +42,9 @@ pub fn run(args: Args) -> u8 {
                     return USAGE;
                 }
             };
-            match situ_runtime::stream::parse(&content, &text) {
+            let parsed = situ_runtime::stream::parse(&content, &text);
+            stream_text = Some(text);
+            match parsed {
                 Ok(events) => Some(events),
                 Err(e) => {
                     eprintln!("error: `{}`: {e}", path.display());
@@ -87,5 +92,14 @@ pub fn run(args: Args) -> u8 {
         }
     }
     println!("{}", serde_json::to_string(&report).expect("the report serializes"));
+    // The refused events, for a person: where in the stream, and why.
+    let place = |i: u64| match (&stream_text, &args.stream_in) {
+        (Some(text), Some(path)) => situ_runtime::stream::line_of(text, i)
+            .map_or(format!("event {i}"), |line| format!("{}:{line}", path.display())),
+        _ => format!("event {i}"),
+    };
+    for line in report.refusals(place) {
+        eprintln!("{line}");
+    }
     OK
 }

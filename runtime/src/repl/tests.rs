@@ -101,3 +101,35 @@ fn words_complete_events_fields_and_symbols() {
         assert!(w.iter().any(|y| y == x), "{x}");
     }
 }
+
+/// A camera that sleeps except in A: a run never reports its `SEEN` in B.
+const CAMERA: &str = "states { A initial B }\n\
+    agent Cam sensor { event SEEN function look table { A => wait look() _ => sleep } }\n\
+    agent Clock sensor { event TICK }\n\
+    rule go { when state == A and TICK then B }\n\
+    rule seen { when state == A and SEEN then B }\n";
+
+#[test]
+fn a_sleeping_agents_event_is_dropped_as_a_run_drops_it() {
+    let mut s = session(CAMERA);
+    assert_eq!(text(s.execute("TICK")), "A -> B (go)");
+    let dropped = text(s.execute("Cam.SEEN"));
+    assert_eq!(
+        dropped,
+        "dropped: `Cam` sleeps in B, and a sleeping agent is not stepped: a run never reports its `SEEN` now; nothing changed"
+    );
+    assert_eq!(s.state(), "B");
+    assert!(!text(s.execute("facts")).contains("Cam"), "no fact of the camera");
+    assert!(text(s.execute("undo")).starts_with("took back TICK"), "the drop is no step");
+}
+
+#[test]
+fn a_repeat_stops_where_its_agent_falls_asleep() {
+    let mut s = session(CAMERA);
+    let out = text(s.execute("SEEN x3"));
+    let (posted, dropped) = out.split_once('\n').unwrap();
+    assert_eq!(posted, "A -> B (seen)");
+    assert!(dropped.starts_with("dropped: `Cam` sleeps in B") && dropped.ends_with("(2 of the 3 not posted)"), "{out}");
+    assert!(text(s.execute("facts")).starts_with("Cam: SEEN at"), "one SEEN, not three");
+    assert_eq!(s.test_block("t", None).matches("on SEEN").count(), 1);
+}

@@ -138,6 +138,20 @@ pub enum PostError {
 }
 
 impl PostError {
+    /// A short key for why an event was refused, the same in every count
+    /// of refusals (a running stack's, `situ bench`'s): `unknown event`,
+    /// `another agent's event`, `out of order`, `from the future`,
+    /// `payload`.
+    pub fn key(&self) -> &'static str {
+        match self {
+            PostError::UnknownEvent { .. } => "unknown event",
+            PostError::AnotherAgent { .. } => "another agent's event",
+            PostError::OutOfOrder { .. } => "out of order",
+            PostError::FromTheFuture { .. } => "from the future",
+            PostError::Arity { .. } | PostError::Type { .. } | PostError::Cascade { .. } => "payload",
+        }
+    }
+
     pub fn describe(&self, c: &Content) -> String {
         match self {
             PostError::UnknownEvent { event } => format!("unknown event id {event}"),

@@ -16,11 +16,18 @@
 //! (`situ_runtime::record::mcap`): a damaged one, or one made on other
 //! rules than `--rules`, is refused before the server starts (exit 2), as
 //! is a port in use.
+//!
+//! Both servers (this one and a live run's, [`serve_live`]) answer only
+//! requests addressed to them ([`guard::Guard`]): a foreign `Host` or
+//! `Origin` gets a 403 with the reason, so that no other site's page can
+//! read the rules or the run through DNS rebinding.
 
 pub mod data;
+pub mod guard;
 pub mod live;
 
 use super::USAGE;
+use guard::Guard;
 use live::Live;
 use std::io::Write as _;
 use std::net::TcpListener;
@@ -40,7 +47,8 @@ pub fn run(file: &Path, rules: Option<&Path>, port: Option<u16>) -> u8 {
         Ok(s) => s,
         Err(code) => return code,
     };
-    let server = match listen("127.0.0.1", port.unwrap_or(0), "--port") {
+    let host = "127.0.0.1";
+    let server = match listen(host, port.unwrap_or(0), "--port") {
         Ok(s) => s,
         Err(code) => return code,
     };
@@ -49,7 +57,7 @@ pub fn run(file: &Path, rules: Option<&Path>, port: Option<u16>) -> u8 {
     println!("serving http://{}/", server.1);
     let _ = std::io::stdout().flush();
     eprintln!("{}; Ctrl-C stops", site.summary());
-    serve(Arc::new(site), server.0, None);
+    serve(Arc::new(site), server.0, Guard::new(server.1, host), None);
     super::OK
 }
 
@@ -65,7 +73,9 @@ pub fn serve_live(site: data::Site, addr: &str) -> Result<(String, Arc<Live>), u
     let live = Arc::new(Live::default());
     let site = Arc::new(site);
     let l = live.clone();
-    std::thread::Builder::new().name("situ-view".into()).spawn(move || serve(site, server, Some(l))).map_err(|e| {
+    let guard = Guard::new(bound, host);
+    let thread = std::thread::Builder::new().name("situ-view".into());
+    thread.spawn(move || serve(site, server, guard, Some(l))).map_err(|e| {
         eprintln!("error: cannot start the page's server: {e}");
         USAGE
     })?;
@@ -110,11 +120,20 @@ fn respond(request: tiny_http::Request, status: u16, kind: &str, body: String) {
     let _ = request.respond(response);
 }
 
-/// Answers requests until the process ends; a live page's polls wait in
-/// threads of their own.
-fn serve(site: Arc<data::Site>, server: tiny_http::Server, live: Option<Arc<Live>>) {
+/// A request's header, if it has it (the first of that name).
+fn header<'r>(request: &'r tiny_http::Request, name: &'static str) -> Option<&'r str> {
+    request.headers().iter().find(|h| h.field.equiv(name)).map(|h| h.value.as_str())
+}
+
+/// Answers requests until the process ends (those `guard` lets through);
+/// a live page's polls wait in threads of their own.
+fn serve(site: Arc<data::Site>, server: tiny_http::Server, guard: Guard, live: Option<Arc<Live>>) {
     let waiting = Arc::new(std::sync::atomic::AtomicUsize::new(0));
     for request in server.incoming_requests() {
+        if let Err(reason) = guard.check(header(&request, "Host"), header(&request, "Origin")) {
+            respond(request, 403, "text/plain; charset=utf-8", reason);
+            continue;
+        }
         let url = request.url().to_string();
         let (path, query) = url.split_once('?').unwrap_or((&url, ""));
         match (&live, path) {
