@@ -107,7 +107,7 @@ pub(super) fn set_of_values(cx: &Cx) -> Option<Advice> {
     };
     let f = field.text;
     let mut advice = Advice::new(
-        format!("a payload field cannot be tested against a set of values: only `state in {{…}}` can"),
+        "a payload field cannot be tested against a set of values: only `state in {…}` can",
         Span::new(kw.start, end.end),
         "not a payload constraint",
         format!(
