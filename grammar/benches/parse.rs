@@ -3,8 +3,8 @@
 //! The file is the repository's `rules/*.situ`, copied with every name renamed
 //! (`Fusion` → `Fusion_3`) until it reaches about 1.7 MB; `SITU_BENCH_FILE=path`
 //! times that file instead. Prints the best of several runs of the parse, of
-//! the formatter (parse and print), and of a parse of the same items with a
-//! syntax error in each (the error path).
+//! the formatter (parse and print), of the item splitter alone, and of a
+//! parse of the same items with a syntax error in each (the error path).
 
 use situ_grammar::diag::FileId;
 use std::time::{Duration, Instant};
@@ -122,6 +122,8 @@ fn main() {
     println!("{} bytes, {} items, {} syntax errors", src.len(), parsed.file.items.len(), parsed.errors.len());
     report("parse", src.len(), best(runs, || situ_grammar::parse(&src, FileId(0))));
     report("format", src.len(), best(runs, || situ_grammar::format(&src)));
+    // The item splitter alone (part of the parse).
+    report("split items", src.len(), best(runs * 4, || situ_grammar::lex::split_items(&src)));
     // The error path: the first 40 items, each with a mistake after its
     // first `{` (the parse stops reporting after 50 errors per file).
     let spans = situ_grammar::lex::split_items(&src);

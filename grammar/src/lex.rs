@@ -15,14 +15,46 @@ pub struct Comment {
 }
 
 /// Whether an item keyword (or an attribute) starts at `at`.
+///
+/// `script` is not reserved (a state or a field may be called so): it starts
+/// an item only as `script "name" {`, which no member of an item can be.
 fn item_starts_at(bytes: &[u8], at: usize) -> bool {
     let rest = &bytes[at..];
     if rest.starts_with(b"#[") {
         return true;
     }
     ITEM_KEYWORDS.iter().any(|kw| {
-        rest.starts_with(kw.as_bytes()) && rest.get(kw.len()).is_none_or(|c| !(c.is_ascii_alphanumeric() || *c == b'_'))
+        rest.starts_with(kw.as_bytes())
+            && rest.get(kw.len()).is_none_or(|c| !(c.is_ascii_alphanumeric() || *c == b'_'))
+            && (*kw != "script" || script_head_at(bytes, at + kw.len()))
     })
+}
+
+/// Whether `"name" {` follows `at`, trivia aside: the rest of a script's head.
+fn script_head_at(bytes: &[u8], at: usize) -> bool {
+    let skip_blank = |mut i: usize| loop {
+        match bytes.get(i) {
+            Some(c) if c.is_ascii_whitespace() => i += 1,
+            Some(b'/') if bytes.get(i + 1) == Some(&b'/') => i = skip_comment(bytes, i),
+            _ => return i,
+        }
+    };
+    let i = skip_blank(at);
+    if bytes.get(i) != Some(&b'"') {
+        return false;
+    }
+    let end = skip_string(bytes, i);
+    bytes.get(end - 1) == Some(&b'"') && end - 1 > i && bytes.get(skip_blank(end)) == Some(&b'{')
+}
+
+/// Whether the line after the newline at `newline` starts with an item, at
+/// any indentation.
+fn next_line_starts_item(bytes: &[u8], newline: usize) -> bool {
+    let mut at = newline + 1;
+    while bytes.get(at).is_some_and(|c| matches!(c, b' ' | b'\t' | b'\r')) {
+        at += 1;
+    }
+    at < bytes.len() && item_starts_at(bytes, at)
 }
 
 /// Skips a string literal that starts at `i` (a `"`); returns the index after
@@ -48,9 +80,13 @@ fn skip_comment(bytes: &[u8], i: usize) -> usize {
 
 /// Splits a source into the spans of its top-level items.
 ///
-/// An item ends at the `}` that closes its first brace, or, so that a missing
-/// `}` costs one item and not the rest of the file, where a line starts in
-/// column 0 with an item keyword. Trivia between items belongs to no item.
+/// An item ends at the `}` that closes its first brace, or where a line starts
+/// with an item keyword (so that a missing `}` costs one item and not the
+/// rest of the file, and an item without braces, `include "a.situ"`, ends
+/// where the next begins). The keyword may stand at any column: layout never
+/// changes what a file means. No item keyword but `script` can appear in an
+/// item, and `script` starts one only as `script "name" {` (see
+/// `item_starts_at`). Trivia between items belongs to no item.
 pub fn split_items(src: &str) -> Vec<Span> {
     let bytes = src.as_bytes();
     let mut items = Vec::new();
@@ -95,8 +131,8 @@ pub fn split_items(src: &str) -> Vec<Span> {
                     }
                 }
                 // Attributes stand on their own lines before the item they annotate.
-                b'\n' if i + 1 < bytes.len() && item_starts_at(bytes, i + 1) && (opened || bytes[start] != b'#') => {
-                    // A new item in column 0: this one ends here, closed or not.
+                b'\n' if (opened || bytes[start] != b'#') && next_line_starts_item(bytes, i) => {
+                    // A new item starts the next line: this one ends here, closed or not.
                     end = i;
                     i += 1;
                     break;
@@ -188,6 +224,35 @@ mod tests {
     fn attributes_stay_with_their_item() {
         let src = "#[allow(W0301)]\nrule r { when X then A }\nrule s { when Y then B }";
         assert_eq!(texts(src), vec!["#[allow(W0301)]\nrule r { when X then A }", "rule s { when Y then B }"]);
+    }
+
+    #[test]
+    fn an_item_may_start_at_any_column() {
+        // What `situ test` prints for a counterexample, pasted after an include.
+        let src = "include \"x.situ\"\n    test \"t\" {\n        on A\n    }\n\t rule r { when X then A\n\tproperty \"p\" { always true }";
+        assert_eq!(
+            texts(src),
+            vec![
+                "include \"x.situ\"",
+                "test \"t\" {\n        on A\n    }",
+                "rule r { when X then A",
+                "property \"p\" { always true }"
+            ]
+        );
+    }
+
+    #[test]
+    fn script_starts_an_item_only_with_its_head() {
+        // `script` is not reserved: a state may be called so.
+        let src = "states {\n    script \"a state\"\n    B initial\n}\ninclude \"x.situ\"\n  script \"s\" // c\n  { at 1s E }";
+        assert_eq!(
+            texts(src),
+            vec![
+                "states {\n    script \"a state\"\n    B initial\n}",
+                "include \"x.situ\"",
+                "script \"s\" // c\n  { at 1s E }"
+            ]
+        );
     }
 
     #[test]

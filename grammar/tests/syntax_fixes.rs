@@ -167,3 +167,36 @@ fn expected_lists_do_not_repeat_themselves() {
     let d = error(&rule("when BPHIT(side: left) x then S"));
     assert!(!d.message.contains("found a space"), "{}", d.message);
 }
+
+#[test]
+fn links_after_run_without_a_function_say_how_links_are_written() {
+    let agent =
+        |entry: &str| format!("agent F processing {{\n    function fuse\n    table {{\n        {entry}\n    }}\n}}");
+    check(
+        &agent("_ => run from IMU, GPS"),
+        "in a table, an agent's links are written after the function it runs: `run fuse() from IMU, GPS`",
+        &agent("_ => run fuse() from IMU, GPS"),
+    );
+    let d = error("agent F processing { table { _ => run from IMU to Drive } }");
+    assert!(d.message.contains("`run f() from IMU to Drive`"), "{}", d.message);
+    assert!(d.help.as_deref().is_some_and(|h| h.contains("declare one in the agent")), "{:?}", d.help);
+    assert!(!d.help.as_deref().unwrap_or("").contains("keyword"), "{:?}", d.help);
+    let d = error("agent F processing { function a function b fsm { S initial => run to Drive } }");
+    assert!(d.message.starts_with("syntax error: in an FSM,"), "{}", d.message);
+    assert_eq!(d.fixes.iter().map(|f| f.title.as_str()).collect::<Vec<_>>(), ["run `a()`", "run `b()`"]);
+}
+
+#[test]
+fn a_set_of_values_on_a_field_says_how_to_write_it() {
+    let d = error(&rule("when BPHIT(side in {left, right}) then S"));
+    assert!(d.message.contains("cannot be tested against a set of values"), "{}", d.message);
+    let help = d.help.as_deref().unwrap_or("");
+    assert!(help.contains("one rule per value (`side == left`, `side == right`)"), "{help}");
+    assert_eq!(
+        &rule("when BPHIT(side in {left, right}) then S")[d.primary.span.start..d.primary.span.end],
+        "in {left, right}"
+    );
+    check(&rule("when BPHIT(side in {left}) then S"), "against a set", &rule("when BPHIT(side == left) then S"));
+    // The system state has a set test of its own.
+    assert!(parse(&rule("when state in {A, B} and BPHIT then S"), FileId(0)).errors.is_empty());
+}

@@ -29,6 +29,7 @@ pub(super) fn test(cx: &mut Cx, file: FileId, test: &ast::Test) {
                             Some(s) => state = Some(s),
                             None => ok = false,
                         },
+                        ast::GivenItem::Event(e) if not_an_event(cx, file, e) => ok = false,
                         ast::GivenItem::Event(e) => match event_fact(cx, file, e) {
                             Some(f) => facts.push(f),
                             None => ok = false,
@@ -98,6 +99,60 @@ fn time_order(
     };
     *last = Some((at, e.span));
     ok
+}
+
+/// E0104 in a `given`: a name that is no event but a system state, an agent
+/// or a state of an agent's FSM. Says what the name is and how `given` writes
+/// what the writer meant; false (and nothing said) for any other name.
+fn not_an_event(cx: &mut Cx, file: FileId, e: &ast::EventInstance) -> bool {
+    let name = e.event.name.as_str();
+    if cx.events.contains_key(name) {
+        return false;
+    }
+    let bare = e.arguments.is_empty() && e.repeat.is_none() && e.at.is_none();
+    let (what, help) = if cx.states.contains_key(name) {
+        ("a system state".to_string(), format!("to start the test in this state, write `given state {name}`"))
+    } else if let Some(&agent) = cx.agents.get(name) {
+        let events: Vec<String> =
+            cx.model.agent(agent).events.iter().map(|&ev| format!("`{}`", cx.model.event(ev).name)).collect();
+        let reports = match events.as_slice() {
+            [] => format!("`{name}` reports no event"),
+            _ => format!("the events of `{name}` are {}", events.join(", ")),
+        };
+        (
+            "an agent".to_string(),
+            format!("`given` sets the system state (`given state S`) and the latest event of agents: {reports}"),
+        )
+    } else if let Some(owner) = fsm_owner(cx, name) {
+        (
+            format!("a state of the FSM of `{owner}`"),
+            "`given` cannot set an FSM's state: every FSM starts in its initial state and follows the system state and its agent's events; write `given state S` for the system state that leads there".to_string(),
+        )
+    } else {
+        return false;
+    };
+    let mut d = Diagnostic::error(
+        codes::UNDEFINED_EVENT,
+        format!("`{name}` is {what}, not an event"),
+        file,
+        e.event.span,
+        "not an event",
+    )
+    .with_help(help);
+    if bare && cx.states.contains_key(name) {
+        let at = ast::Span::new(e.event.span.start, e.event.span.start);
+        d = d.with_fix(format!("write `state {name}`"), file, at, "state ");
+    }
+    cx.diags.push(d);
+    true
+}
+
+/// The agent whose FSM has a state of this name (as far as resolved).
+fn fsm_owner(cx: &Cx, name: &str) -> Option<String> {
+    cx.model.agents.iter().find_map(|a| match &a.behaviour {
+        Behaviour::Fsm(fsm) if fsm.states.iter().any(|s| s.name == name) => Some(a.name.clone()),
+        _ => None,
+    })
 }
 
 /// A concrete event: every field given once, each of the right type.

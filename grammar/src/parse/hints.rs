@@ -276,10 +276,12 @@ fn item_keyword<'a>(toks: &[Tok<'a>]) -> &'a str {
     ""
 }
 
+mod forms;
 mod items;
 mod numbers;
 mod words;
 
+use forms::*;
 use items::*;
 use numbers::*;
 use words::*;
@@ -290,10 +292,12 @@ pub(super) fn advise(text: &str, pos: usize, exp: &Expected) -> Option<Advice> {
     let toks = tokens(text);
     let item = item_keyword(&toks);
     let cx = Cx { text, pos, exp, toks, item };
-    let detectors: [fn(&Cx) -> Option<Advice>; 19] = [
+    let detectors: [fn(&Cx) -> Option<Advice>; 21] = [
         unclosed_brace,
         stray_brace,
         semicolon,
+        links_without_function,
+        set_of_values,
         quantities,
         float_forms,
         run_length,
