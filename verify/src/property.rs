@@ -296,7 +296,7 @@ fn conclude(r: &Report, liveness: bool) -> Conclusion {
 }
 
 /// Whether the premise of a property can hold: `never P` checked by the
-/// exploration, then by IC3.
+/// exploration, then by the random search, then by IC3.
 fn premise(content: &Arc<Content>, s: &Session, j: usize, never_p: &PropertySpec, opts: &Options) -> Premise {
     let exhaustive = s.graph.as_ref().map(|g| g.check(j, never_p));
     match &exhaustive {
@@ -304,16 +304,18 @@ fn premise(content: &Arc<Content>, s: &Session, j: usize, never_p: &PropertySpec
         Some(Verdict::Proved { .. }) => return Premise::Vacuous { by: Checker::Exhaustive },
         _ => {}
     }
+    // A run that reaches the premise is usually found at random at once;
+    // IC3 finds deep ones slowly, and alone proves that none exists.
+    if opts.engines != Engines::Exhaustive {
+        if let Verdict::Failed(c) = random::search(content, &s.alphabet, never_p, opts.search) {
+            return Premise::Reachable(c);
+        }
+    }
     if let Some(Ok(m)) = &s.model {
         match prove::prove(content, &s.alphabet, m, j, never_p, limits(opts)) {
             Some(Verdict::Failed(c)) => return Premise::Reachable(c),
             Some(Verdict::Inductive { sampled: None, .. }) => return Premise::Vacuous { by: Checker::Symbolic },
             _ => {}
-        }
-    }
-    if opts.engines != Engines::Exhaustive {
-        if let Verdict::Failed(c) = random::search(content, &s.alphabet, never_p, opts.search) {
-            return Premise::Reachable(c);
         }
     }
     Premise::Unknown
