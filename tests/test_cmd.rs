@@ -298,3 +298,42 @@ property "real" { always (state == Fired -> next state == Fired) }
     let explain = situ(&["explain", "W0501"]);
     assert!(stdout(&explain).contains("premise never holds"), "{}", stdout(&explain));
 }
+
+#[test]
+fn sarif_carries_every_verdict_with_its_code_and_place() {
+    let dir = tempfile::tempdir().unwrap();
+    // The buggy stack (a failed test, a violated property) and an undecided ladder.
+    let buggy = write(dir.path(), "b.situ", BUGGY);
+    let ladder = write(dir.path(), "l.situ", ladder(16));
+    let o = situ(&[
+        "test",
+        &buggy,
+        &ladder,
+        "--format",
+        "sarif",
+        "--depth",
+        "2",
+        "--length",
+        "3",
+        "--cases",
+        "8",
+        "--prove-effort",
+        "50",
+    ]);
+    assert_eq!(code(&o), 1, "{}", stdout(&o));
+    let log: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("one SARIF document");
+    assert_eq!(log["version"], "2.1.0");
+    let results = log["runs"][0]["results"].as_array().expect("results");
+    let ids: Vec<&str> = results.iter().map(|r| r["ruleId"].as_str().unwrap()).collect();
+    assert!(ids.contains(&"situ::E0504"), "{ids:?}");
+    assert!(ids.contains(&"situ::E0503"), "{ids:?}");
+    assert!(ids.contains(&"situ::E0502"), "{ids:?}");
+    let in_ladder = |r: &&serde_json::Value| {
+        r["locations"][0]["physicalLocation"]["artifactLocation"]["uri"].as_str().is_some_and(|u| u.ends_with("l.situ"))
+    };
+    let undecided = results.iter().filter(in_ladder).find(|r| r["ruleId"] == "situ::E0502").unwrap();
+    let region = &undecided["locations"][0]["physicalLocation"]["region"];
+    assert_eq!(region["startLine"], 19, "{undecided}");
+    let violated = results.iter().find(|r| r["ruleId"] == "situ::E0503").unwrap();
+    assert_eq!(violated["properties"]["witness"]["events"][0]["event"], "FIRE", "{violated}");
+}

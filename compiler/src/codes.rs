@@ -107,6 +107,8 @@ codes! {
     ROS2_BAD_NODE = "E0414", Error, "lifecycle node entry the bridge cannot use";
     VACUOUS_PROPERTY = "W0501", Warning, "property whose premise never holds";
     UNDECIDED_PROPERTY = "E0502", Error, "property neither proved nor violated";
+    VIOLATED_PROPERTY = "E0503", Error, "property broken by a run";
+    FAILED_TEST = "E0504", Error, "test whose expectations do not hold";
 }
 
 /// Whether the code is a property's verdict (E05xx, W05xx: `situ test`,

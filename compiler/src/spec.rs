@@ -40,6 +40,8 @@ pub struct Spec {
 pub struct TestSpec {
     pub name: String,
     pub place: Place,
+    /// The block's file and span (for findings about it).
+    pub origin: model::Origin,
     pub steps: Vec<TestStep>,
 }
 
@@ -99,6 +101,8 @@ pub enum Expected {
 pub struct PropertySpec {
     pub name: String,
     pub place: Place,
+    /// The block's file and span (for findings about it).
+    pub origin: model::Origin,
     /// `never F` rather than `always F`.
     pub never: bool,
     pub premise: Option<Pred>,
@@ -218,7 +222,7 @@ fn test(t: &model::Test, place: &dyn Fn(model::Origin) -> Place) -> TestSpec {
             }
         })
         .collect();
-    TestSpec { name: t.name.clone(), place: place(t.origin), steps }
+    TestSpec { name: t.name.clone(), place: place(t.origin), origin: t.origin, steps }
 }
 
 /// The times of the copies of a test event (§10.9): the first at `at`, or
@@ -278,6 +282,7 @@ fn property(p: &model::Property, place: &dyn Fn(model::Origin) -> Place) -> Prop
     PropertySpec {
         name: p.name.clone(),
         place: place(p.origin),
+        origin: p.origin,
         never: matches!(p.quantifier, situ_grammar::ast::Quantifier::Never),
         premise,
         consequent,

@@ -10,9 +10,11 @@
 use super::{FAILED, OK, USAGE};
 use serde_json::json;
 use situ_compiler::bundle::{self, Content};
+use situ_compiler::codes;
 use situ_compiler::loader::FsLoader;
 use situ_compiler::render;
 use situ_compiler::spec::{self, PropertySpec, TestSpec};
+use situ_grammar::diag::Diagnostic;
 use situ_verify::explore::Limits;
 use situ_verify::property::{self, Conclusion, Engines, Premise, Report};
 use situ_verify::random::Search;
@@ -27,6 +29,9 @@ pub enum Format {
     Human,
     /// One JSON object per test or property, one per line.
     Json,
+    /// One SARIF 2.1.0 log: failed tests (E0504), violated (E0503),
+    /// undecided (E0502) and vacuous (W0501) properties, with the files' findings.
+    Sarif,
 }
 
 /// Which checkers look at the properties.
@@ -70,12 +75,16 @@ pub fn run(args: Args) -> u8 {
     let (mut passed, mut failed, mut undecided) = (0usize, 0usize, 0usize);
     let mut io_failed = false;
     let human = matches!(args.format, Format::Human);
+    let sarif = matches!(args.format, Format::Sarif);
+    let json_lines = matches!(args.format, Format::Json);
+    let (mut sarif_checked, mut sarif_failures) = (Vec::new(), Vec::new());
     for path in &args.files {
-        let checked = match situ_compiler::check(path, &FsLoader) {
+        let mut checked = match situ_compiler::check(path, &FsLoader) {
             Ok(c) => c,
             Err(e) => {
                 eprintln!("error: {e}");
                 io_failed = true;
+                sarif_failures.push(e);
                 continue;
             }
         };
@@ -83,10 +92,11 @@ pub fn run(args: Args) -> u8 {
             if human {
                 print!("{}", render::human_all(&checked, super::style()));
                 println!("{}: {} error(s): no test or property was run", path.display(), checked.errors());
-            } else {
+            } else if json_lines {
                 print!("{}", render::json_lines(&checked));
             }
             failed += 1;
+            sarif_checked.push(checked);
             continue;
         }
         let content = Arc::new(bundle::build(&checked));
@@ -103,11 +113,12 @@ pub fn run(args: Args) -> u8 {
             );
         }
         let mut failures = Vec::new();
+        let mut verdicts = Vec::new();
         for t in &tests {
             let outcome = scenario::run(&content, t);
             if human {
                 println!("test \"{}\" ... {}", t.name, if outcome.passed() { "ok" } else { "FAILED" });
-            } else {
+            } else if json_lines {
                 let list: Vec<_> = outcome
                     .failures
                     .iter()
@@ -124,6 +135,7 @@ pub fn run(args: Args) -> u8 {
                 passed += 1;
             } else {
                 failed += 1;
+                verdicts.push(test_diagnostic(t, &outcome));
                 let mut text = format!("---- test \"{}\" ({}) ----\n", t.name, t.place);
                 for f in &outcome.failures {
                     text.push_str(&format!("  {}: {}\n", f.place, f.message));
@@ -136,9 +148,10 @@ pub fn run(args: Args) -> u8 {
             for (p, r) in props.iter().zip(&reports) {
                 if human {
                     print_property(&content, p, r);
-                } else {
+                } else if json_lines {
                     println!("{}", property_json(&content, path, p, r));
                 }
+                verdicts.extend(property_diagnostics(&content, p, r));
                 match &r.conclusion {
                     Conclusion::Proved { .. } => passed += 1,
                     Conclusion::Undecided { .. } => undecided += 1,
@@ -171,6 +184,15 @@ pub fn run(args: Args) -> u8 {
                 println!("{f}");
             }
         }
+        if sarif {
+            checked.diagnostics.extend(verdicts);
+            sarif_checked.push(checked);
+        }
+    }
+    if sarif {
+        let checks: Vec<&situ_compiler::Checked> = sarif_checked.iter().collect();
+        let failures: Vec<_> = sarif_failures.iter().collect();
+        println!("{}", render::sarif_with_failures(&checks, &failures));
     }
     if human {
         println!("\n{passed} passed, {failed} failed, {undecided} undecided");
@@ -180,7 +202,7 @@ pub fn run(args: Args) -> u8 {
             );
         }
     }
-    if !human {
+    if json_lines {
         println!(
             "{}",
             json!({"kind": "summary", "passed": passed, "failed": failed, "undecided": undecided,
@@ -349,6 +371,87 @@ fn property_json(content: &Content, path: &std::path::Path, p: &PropertySpec, r:
            "code": code, "proved_by": proved_by, "undecided_because": reasons,
            "exhaustive": verdict(&r.exhaustive), "symbolic": verdict(&r.symbolic), "random": verdict(&r.random),
            "counterexample": cex, "premise": premise})
+}
+
+/// A failed test as a finding (E0504), at its block.
+fn test_diagnostic(t: &TestSpec, outcome: &scenario::TestOutcome) -> Diagnostic {
+    let first = outcome.failures.first().map_or(String::new(), |f| format!(": {}", f.message));
+    let help: Vec<String> = outcome.failures.iter().map(|f| format!("{}: {}", f.place, f.message)).collect();
+    Diagnostic::error(
+        codes::FAILED_TEST,
+        format!("test \"{}\" failed{first}", t.name),
+        t.origin.file,
+        t.origin.span,
+        "this test",
+    )
+    .with_help(help.join("\n"))
+}
+
+/// A property's verdict as findings: violated (E0503), undecided (E0502),
+/// vacuous (W0501); none for a proved property with a reachable premise.
+fn property_diagnostics(content: &Content, p: &PropertySpec, r: &Report) -> Vec<Diagnostic> {
+    let (file, span) = (p.origin.file, p.origin.span);
+    let mut out = Vec::new();
+    match &r.conclusion {
+        Conclusion::Violated { by, counterexample: c, .. } => {
+            let mut d = Diagnostic::error(
+                codes::VIOLATED_PROPERTY,
+                format!(
+                    "property \"{}\" is broken by a run of {} events (found by {}): {}",
+                    p.name,
+                    c.steps.len(),
+                    by.name(),
+                    c.reason
+                ),
+                file,
+                span,
+                "this property",
+            )
+            .with_help(format!("the run as a test to paste into the file:\n{}", c.as_test(content, &p.name)));
+            let steps: Vec<_> = c
+                .steps
+                .iter()
+                .map(|s| json!({"event": show_event(content, s.event, &s.payload), "time_ns": s.time,
+                                 "state": content.states[s.state as usize].name}))
+                .collect();
+            d.witness = Some(json!({"events": steps, "point": c.point, "reason": c.reason}));
+            out.push(d);
+        }
+        Conclusion::Undecided { reasons } => out.push(
+            Diagnostic::error(
+                codes::UNDECIDED_PROPERTY,
+                format!("property \"{}\" is undecided: no checker proved or broke it within its budget", p.name),
+                file,
+                span,
+                "this property",
+            )
+            .with_help(reasons.join("\n")),
+        ),
+        Conclusion::Disagree { events } => out.push(Diagnostic::error(
+            codes::VIOLATED_PROPERTY,
+            format!(
+                "property \"{}\": IC3's counterexample of {events} events does not replay on the engine (an error of situ, please report it)",
+                p.name
+            ),
+            file,
+            span,
+            "this property",
+        )),
+        Conclusion::Proved { .. } => {}
+    }
+    if let Some(Premise::Vacuous { by }) = &r.premise {
+        out.push(
+            Diagnostic::warning(
+                codes::VACUOUS_PROPERTY,
+                format!("property \"{}\" is vacuous: its premise never holds ({} proved it)", p.name, by.name()),
+                file,
+                span,
+                "this property",
+            )
+            .with_help("check the premise: a state, mode or event pattern that no run reaches together"),
+        );
+    }
+    out
 }
 
 fn count(n: usize, what: &str) -> String {

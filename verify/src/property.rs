@@ -155,6 +155,7 @@ fn premise_property(p: &PropertySpec) -> Option<PropertySpec> {
     Some(PropertySpec {
         name: format!("the premise of {}", p.name),
         place: p.place.clone(),
+        origin: p.origin,
         never: true,
         premise: None,
         consequent: Consequent::Now(premise.clone()),

@@ -9,7 +9,7 @@ use situ_compiler::{bundle, check_source, codes};
 use situ_verify::explore::Limits;
 use situ_verify::property::{self, Checker, Conclusion, Engines, Options, Premise, Report};
 use situ_verify::random::{self, Search};
-use situ_verify::Verdict;
+use situ_verify::{scenario, Verdict};
 use std::cell::Cell;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -200,13 +200,19 @@ fn blocks_after<'a>(doc: &'a str, heading: &str) -> Vec<&'a str> {
 fn the_examples_of_the_verdict_codes_are_real() {
     let opts = options(12, property::DEFAULT_EFFORT, 64, 30);
     let verdict_codes: Vec<_> = codes::ALL.iter().filter(|c| codes::is_verdict(c.code)).collect();
-    assert_eq!(verdict_codes.len(), 2);
+    assert_eq!(verdict_codes.len(), 4);
     for c in verdict_codes {
         let raises = |text: &str| -> bool {
+            if c.code == codes::FAILED_TEST {
+                let checked = check_source("t.situ", text);
+                let content = Arc::new(bundle::build(&checked));
+                return spec::lower(&checked).tests.iter().any(|t| !scenario::run(&content, t).passed());
+            }
             let reports = check(text, &opts);
             reports.iter().any(|r| match c.code {
                 codes::VACUOUS_PROPERTY => matches!(r.premise, Some(Premise::Vacuous { .. })),
                 codes::UNDECIDED_PROPERTY => matches!(r.conclusion, Conclusion::Undecided { .. }),
+                codes::VIOLATED_PROPERTY => matches!(r.conclusion, Conclusion::Violated { .. }),
                 other => panic!("{other}: no rule for this code"),
             })
         };
