@@ -362,8 +362,12 @@ fn incomplete(
             format!("the oscillation check (E0305) stopped {why} in the cycles through `{}`", st.name),
             st.origin,
             "cycles through this state and the states after it were not all examined",
-            format!("{help}; the cycles through states declared before `{}` were all examined", st.name),
-            json!({ "stopped_at": st.name, "work": work, "found": full.then_some(MAX_FOUND), "undecided": undecided_json, "undecided_count": undecided_count }),
+            if at.index() == 0 {
+                help
+            } else {
+                format!("{help}; the cycles through states declared before `{}` were all examined", st.name)
+            },
+            json!({ "stopped_at": st.name, "work": work, "oscillations_reported": full.then_some(MAX_FOUND), "undecided": undecided_json, "undecided_count": undecided_count }),
         );
         return Some(d);
     }
