@@ -144,7 +144,8 @@ impl<'a> Search<'a> {
         }
     }
 
-    /// Spends one unit of work; false when there is none left.
+    /// Spends `units` of work; false (and the search stops at `at`) when
+    /// there are not that many left.
     fn spend(&mut self, units: usize, at: StateId) -> bool {
         if self.work < units {
             self.work = 0;
