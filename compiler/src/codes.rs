@@ -91,6 +91,7 @@ codes! {
     DATA_CYCLE = "W0318", Warning, "data cycle";
     MAY_CONFLICT = "W0319", Warning, "rules that may conflict";
     CONCURRENT_COMMANDS = "W0320", Warning, "actuator commanded by several agents at once";
+    INCOMPLETE_CHECK = "W0321", Warning, "static check stopped at its work budget";
     ROS2_BAD_MAP = "E0401", Error, "ROS 2 map that is not a valid map";
     ROS2_UNKNOWN_TYPE = "E0402", Error, "unknown ROS 2 message type";
     ROS2_UNKNOWN_FIELD = "E0403", Error, "field not in the ROS 2 message";

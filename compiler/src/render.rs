@@ -48,13 +48,38 @@ fn human_with(texts: &Texts, d: &Diagnostic, style: Style) -> String {
     out
 }
 
-/// Every visible finding of a check, then a summary line.
+/// How many findings of one code [`human_all`] draws; the others are
+/// counted on one line. JSON and SARIF keep every finding.
+pub const SHOWN_PER_CODE: usize = 20;
+
+/// The visible findings of a check, at most [`SHOWN_PER_CODE`] of each code,
+/// then a line per code with more: `… and N more CODE (title)`.
 pub fn human_all(checked: &Checked, style: Style) -> String {
     let texts = Texts::new(&checked.sources);
     let mut out = String::new();
+    let mut shown: std::collections::BTreeMap<&str, usize> = std::collections::BTreeMap::new();
     for d in checked.visible() {
-        out.push_str(&human_with(&texts, d, style));
-        out.push('\n');
+        let n = shown.entry(d.code).or_default();
+        *n += 1;
+        if *n <= SHOWN_PER_CODE {
+            out.push_str(&human_with(&texts, d, style));
+            out.push('\n');
+        }
+    }
+    out.push_str(&more_lines(&shown));
+    out
+}
+
+/// `… and N more CODE (title); --format json lists them all`, per code with
+/// more findings than are drawn.
+fn more_lines(counts: &std::collections::BTreeMap<&str, usize>) -> String {
+    let mut out = String::new();
+    for (code, &n) in counts.iter().filter(|(_, &n)| n > SHOWN_PER_CODE) {
+        let title = codes::lookup(code).map_or("", |c| c.title);
+        out.push_str(&format!(
+            "… and {} more situ::{code} ({title}): `--format json` or `--format sarif` lists every finding\n",
+            n - SHOWN_PER_CODE
+        ));
     }
     out
 }
@@ -462,6 +487,27 @@ mod tests {
         let conflict = checked.diagnostics.iter().find(|d| d.code == codes::CONFLICTING_RULES).expect("a conflict");
         let out = human(&checked.sources, conflict, Style { colour: false, width: 80 });
         assert_eq!(out.matches("╭─[").count(), 1, "one snippet:\n{out}");
+    }
+
+    #[test]
+    fn human_output_draws_a_bounded_number_of_findings_per_code() {
+        let rules: String =
+            (0..SHOWN_PER_CODE + 5).map(|i| format!("rule r{i} {{ when state == A then B }}\n")).collect();
+        let checked = crate::check_source("many.situ", &format!("states {{ A initial }}\n{rules}"));
+        assert_eq!(checked.errors(), SHOWN_PER_CODE + 5, "every finding is kept");
+        let out = human_all(&checked, Style::PLAIN);
+        assert_eq!(out.matches("situ::E0101").count(), SHOWN_PER_CODE + 1, "{out}");
+        assert!(
+            out.ends_with(
+                "… and 5 more situ::E0101 (undefined state): `--format json` or `--format sarif` lists every finding\n"
+            ),
+            "{out}"
+        );
+        assert_eq!(json_lines(&checked).lines().count(), SHOWN_PER_CODE + 5, "JSON keeps them all");
+        // At the bound, nothing is counted.
+        let rules: String = (0..SHOWN_PER_CODE).map(|i| format!("rule r{i} {{ when state == A then B }}\n")).collect();
+        let checked = crate::check_source("few.situ", &format!("states {{ A initial }}\n{rules}"));
+        assert!(!human_all(&checked, Style::PLAIN).contains("more situ::"));
     }
 
     #[test]

@@ -94,8 +94,12 @@ fn search_mut(model: &Model, sit: &mut Situation, avoid: &[&Rule], by_state: boo
             }
         }
     }
-    // One of its patterns does not match.
+    // One of its patterns does not match (not one the situation's facts
+    // surely match: that branch could only fail at its leaf).
     for p in &rule.patterns {
+        if surely_matches(model, sit, p) {
+            continue;
+        }
         let widened = sit.widened;
         sit.widened |= p.tests.iter().any(|t| has_var(&t.check));
         sit.negations.push(p.clone());
@@ -130,6 +134,16 @@ fn search_mut(model: &Model, sit: &mut Situation, avoid: &[&Rule], by_state: boo
     } else {
         Outcome::None
     }
+}
+
+/// Whether every memory of the situation matches the pattern: it tests
+/// nothing but the event, and the situation requires that event as its
+/// agent's latest fact.
+fn surely_matches(model: &Model, sit: &Situation, p: &Pattern) -> bool {
+    p.tests.is_empty()
+        && p.run_length <= 1
+        && p.within.is_none()
+        && matches!(sit.agents.get(&model.event(p.event).agent), Some(AgentReq::Fact(f)) if f.event == p.event)
 }
 
 fn has_var(c: &FieldCheck) -> bool {

@@ -5,6 +5,7 @@
 //! [`transitions`] builds the state graph. Each check is one module.
 
 pub mod behaviour;
+pub mod budget;
 pub mod conflicts;
 pub mod domain;
 pub mod escape;
@@ -60,3 +61,6 @@ type Check = fn(&Model, &transitions::Transitions) -> Vec<Diagnostic>;
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod budget_tests;
