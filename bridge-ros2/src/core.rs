@@ -201,6 +201,17 @@ impl Core {
         out
     }
 
+    /// A sample of `topic` that the middleware could not hand over (an
+    /// encapsulation it does not name): counted as a message refused, its
+    /// `reason` reported with the topic's problems.
+    pub fn on_unreadable(&mut self, topic: &str, reason: &str) {
+        self.counters.messages += 1;
+        self.counters.refused += 1;
+        let slot = self.problems.entry(topic.to_string()).or_insert((0, String::new()));
+        slot.0 += 1;
+        slot.1 = reason.to_string();
+    }
+
     /// The clock: staleness, the timeout of the request in flight, the
     /// `get_state` retries and the periodic diagnostics.
     pub fn on_tick(&mut self, now: u64) -> Vec<Output> {

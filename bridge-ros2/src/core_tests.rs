@@ -210,6 +210,36 @@ fn bad_messages_are_counted_and_reported_once_a_second() {
 }
 
 #[test]
+fn a_sample_the_middleware_could_not_hand_over_is_counted_and_reported() {
+    let mut core = started();
+    core.on_unreadable("/scan", "not read: unknown representation id 00 0c");
+    core.on_unreadable("/scan", "not read: unknown representation id 00 0c");
+    assert_eq!((core.counters().messages, core.counters().refused), (2, 2));
+    let out = core.on_tick(T0 + 2 * S);
+    let Some(Output::Diagnostics(a)) = out.iter().find(|o| matches!(o, Output::Diagnostics(_))) else {
+        panic!("no diagnostics in {out:?}")
+    };
+    let scan = a.status.iter().find(|s| s.name == "situ: /scan").expect("a status for /scan");
+    assert_eq!(
+        (scan.message.as_str(), scan.values[0].value.as_str()),
+        ("not read: unknown representation id 00 0c", "2")
+    );
+}
+
+#[test]
+fn an_xcdr2_message_is_refused_with_its_encapsulation() {
+    let mut core = started();
+    let mut bytes = scan(2.0);
+    bytes[1] = 7;
+    assert!(core.on_message("/scan", &bytes, T0 + S).is_empty());
+    assert_eq!((core.counters().messages, core.counters().refused), (1, 1));
+    let out = core.on_tick(T0 + 2 * S);
+    let Some(Output::Diagnostics(a)) = out.iter().find(|o| matches!(o, Output::Diagnostics(_))) else { panic!() };
+    let scan = a.status.iter().find(|s| s.name == "situ: /scan").expect("a status for /scan");
+    assert!(scan.message.contains("encapsulation 00 07"), "{scan:?}");
+}
+
+#[test]
 fn the_agents_say_mode_function_links_and_lifecycle() {
     let mut core = started();
     let out = core.on_message("/goal_pose", &goal(4.0, 2.0), T0 + S);
