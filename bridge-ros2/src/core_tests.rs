@@ -227,16 +227,40 @@ fn a_sample_the_middleware_could_not_hand_over_is_counted_and_reported() {
 }
 
 #[test]
-fn an_xcdr2_message_is_refused_with_its_encapsulation() {
+fn an_xcdr2_scan_is_read_as_its_xcdr1() {
+    // A LaserScan has no 8-byte field and no sequence of structures: its
+    // XCDR2 (`00 07`) is its XCDR1 under another header.
     let mut core = started();
-    let mut bytes = scan(2.0);
+    let mut bytes = scan(0.2);
     bytes[1] = 7;
-    assert!(core.on_message("/scan", &bytes, T0 + S).is_empty());
-    assert_eq!((core.counters().messages, core.counters().refused), (1, 1));
-    let out = core.on_tick(T0 + 2 * S);
-    let Some(Output::Diagnostics(a)) = out.iter().find(|o| matches!(o, Output::Diagnostics(_))) else { panic!() };
-    let scan = a.status.iter().find(|s| s.name == "situ: /scan").expect("a status for /scan");
-    assert!(scan.message.contains("encapsulation 00 07"), "{scan:?}");
+    core.on_message("/scan", &bytes, T0 + S);
+    assert_eq!((core.counters().messages, core.counters().refused, core.counters().events), (1, 0, 1));
+}
+
+#[test]
+fn encapsulations_not_read_are_refused_with_their_identifier() {
+    let mut core = started();
+    let mut mutable = scan(2.0);
+    mutable[1] = 0x0b; // PL_CDR2: mutable types, not read
+    assert!(core.on_message("/scan", &mutable, T0 + S).is_empty());
+    let mut cut = scan(2.0);
+    cut[1] = 7;
+    cut.truncate(30); // XCDR2 cut short
+    assert!(core.on_message("/scan", &cut, T0 + S).is_empty());
+    assert_eq!((core.counters().messages, core.counters().refused), (2, 2));
+    let reported = |core: &mut Core, t: u64| {
+        let out = core.on_tick(t);
+        let Some(Output::Diagnostics(a)) = out.into_iter().find(|o| matches!(o, Output::Diagnostics(_))) else {
+            panic!("no diagnostics")
+        };
+        a.status.into_iter().find(|s| s.name == "situ: /scan").expect("a status for /scan")
+    };
+    let last = reported(&mut core, T0 + 2 * S);
+    assert_eq!(last.values[0].value, "2");
+    assert!(last.message.starts_with("LaserScan: XCDR2: "), "{last:?}");
+    core.on_message("/scan", &mutable, T0 + 3 * S);
+    let last = reported(&mut core, T0 + 4 * S);
+    assert!(last.message.contains("encapsulation 00 0b"), "{last:?}");
 }
 
 #[test]
