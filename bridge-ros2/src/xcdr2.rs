@@ -172,3 +172,62 @@ impl Transcoder<'_> {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_appendable_point_loses_its_dheader_and_its_padding() {
+        // Point { x: 1.0, y: 2.0, z: 3.0 }, appendable, little-endian, with
+        // 4 bytes of a member a newer definition added.
+        let mut v2 = vec![0, 9, 0, 0];
+        v2.extend(28u32.to_le_bytes());
+        for x in [1.0f64, 2.0, 3.0] {
+            v2.extend(x.to_le_bytes());
+        }
+        v2.extend([0xaa; 4]);
+        let v1 = to_xcdr1("geometry_msgs/msg/Point", &v2).unwrap();
+        let mut expected = vec![0, 1, 0, 0];
+        for x in [1.0f64, 2.0, 3.0] {
+            expected.extend(x.to_le_bytes());
+        }
+        assert_eq!(v1, expected);
+    }
+
+    #[test]
+    fn lengths_past_the_end_are_errors() {
+        let mut v2 = vec![0, 9, 0, 0];
+        v2.extend(u32::MAX.to_le_bytes());
+        let e = to_xcdr1("geometry_msgs/msg/Point", &v2).unwrap_err();
+        assert!(e.contains("DHEADER of 4294967295 bytes"), "{e}");
+        let mut v2 = vec![0, 7, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0];
+        v2.extend(4_000_000_000u32.to_le_bytes());
+        assert!(to_xcdr1("diagnostic_msgs/msg/DiagnosticArray", &v2).is_err());
+        assert!(to_xcdr1("std_msgs/msg/Bool", &[0, 7]).is_err());
+        assert!(to_xcdr1("std_msgs/msg/Bool", &[0, 1, 0, 0, 1]).unwrap_err().contains("00 01 is not XCDR2"));
+    }
+
+    #[test]
+    fn no_input_panics_or_grows_more_than_the_alignment_it_adds() {
+        // A small xorshift: the same inputs every run.
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        for ty in msgs::names() {
+            for round in 0..300 {
+                let len = (next() % 96) as usize;
+                let mut v2 = vec![0, 6 + (round % 4) as u8, 0, 0];
+                // Small numbers mostly, so counts and lengths often fit.
+                v2.extend((0..len).map(|_| if next() % 3 == 0 { next() as u8 } else { (next() % 4) as u8 }));
+                if let Ok(v1) = to_xcdr1(ty, &v2) {
+                    assert!(v1.len() <= 2 * v2.len() + 8, "{ty}: {v2:02x?}");
+                }
+            }
+        }
+    }
+}
