@@ -24,10 +24,14 @@ const NODES: [&str; 4] = ["/costmap", "/planner", "/recovery", "/controller"];
 const GIVE_UP: Duration = Duration::from_secs(20);
 
 fn bridge(domain: u16, stop: Arc<AtomicBool>) -> std::thread::JoinHandle<Report> {
+    bridge_on(domain, Rmw::CycloneDds, stop)
+}
+
+fn bridge_on(domain: u16, rmw: Rmw, stop: Arc<AtomicBool>) -> std::thread::JoinHandle<Report> {
     let checked = check_source("amr.situ", RULES);
     let content = Arc::new(bundle::build(&checked));
     let core = Core::new(content, &checked.model, MAP, FileId(1)).expect("the map");
-    let options = Options { domain, rmw: Rmw::CycloneDds, heartbeat: Duration::from_millis(10), duration: None, stop };
+    let options = Options { domain, rmw, heartbeat: Duration::from_millis(10), duration: None, stop };
     std::thread::spawn(move || dds::run(core, &options, None).expect("the bridge"))
 }
 
@@ -238,5 +242,87 @@ fn scans_in_an_encapsulation_not_read_are_refused_counted_and_reported() {
     assert!(!reported.is_empty());
     for status in &reported {
         assert!(status.message.contains("encapsulation 00 0b"), "{status:?}");
+    }
+}
+
+/// What each node was asked: (node, transition id or `None` for `get_state`).
+type Requests = Arc<Mutex<Vec<(usize, Option<u8>)>>>;
+
+/// ros2-client's own lifecycle servers, in the mapping of `rmw`.
+fn ros2_client_servers(domain: u16, rmw: Rmw, asked: Requests, stop: Arc<AtomicBool>) -> std::thread::JoinHandle<()> {
+    use ros2_client::service::ServiceMapping;
+    use ros2_client::{Context, ContextOptions, Name, NodeName, NodeOptions, QosProfile, ServiceTypeName};
+    use situ_bridge_ros2::msgs::{ChangeStateRequest, GetStateRequest};
+    std::thread::spawn(move || {
+        let mapping = match rmw {
+            Rmw::CycloneDds => ServiceMapping::Cyclone,
+            Rmw::FastRtps => ServiceMapping::Enhanced,
+        };
+        let context = Context::with_options(ContextOptions::new().domain_id(domain)).expect("participant");
+        let mut node = context
+            .new_node(NodeName::new("/", "lifecycle_nodes").unwrap(), NodeOptions::new().enable_rosout(false))
+            .expect("node");
+        let qos = QosProfile::publisher_default().history(ros2_client::qos::History::KeepLast { depth: 10 });
+        let mut servers = Vec::new();
+        for n in NODES {
+            let change = node
+                .create_server::<ChangeStateRequest, ChangeStateResponse>(
+                    mapping,
+                    &Name::new(n, "change_state").unwrap(),
+                    &ServiceTypeName::new("lifecycle_msgs", "ChangeState"),
+                    qos.clone(),
+                    qos.clone(),
+                )
+                .expect("server");
+            let get = node
+                .create_server::<GetStateRequest, GetStateResponse>(
+                    mapping,
+                    &Name::new(n, "get_state").unwrap(),
+                    &ServiceTypeName::new("lifecycle_msgs", "GetState"),
+                    qos.clone(),
+                    qos.clone(),
+                )
+                .expect("server");
+            servers.push((change, get));
+        }
+        while !stop.load(Ordering::Relaxed) {
+            for (i, (change, get)) in servers.iter().enumerate() {
+                while let Ok(Some((id, _))) = get.receive_request() {
+                    asked.lock().unwrap().push((i, None));
+                    let current_state = State { id: 1, label: "unconfigured".into() };
+                    let _ = get.send_response(id, GetStateResponse { current_state });
+                }
+                while let Ok(Some((id, rq))) = change.receive_request() {
+                    asked.lock().unwrap().push((i, Some(rq.transition.id)));
+                    let _ = change.send_response(id, ChangeStateResponse { success: true });
+                }
+            }
+            std::thread::sleep(Duration::from_millis(1));
+        }
+    })
+}
+
+/// Both mappings of the bridge's service client against ros2-client's
+/// servers: the request ids and the answers are matched (every node is
+/// configured), and each node is asked its state once.
+#[test]
+fn ros2_client_servers_are_driven_in_both_mappings() {
+    for (domain, rmw) in [(66, Rmw::CycloneDds), (67, Rmw::FastRtps)] {
+        let stop = Arc::new(AtomicBool::new(false));
+        let asked: Requests = Arc::default();
+        let servers = ros2_client_servers(domain, rmw, Arc::clone(&asked), stop.clone());
+        let bridge = bridge_on(domain, rmw, stop.clone());
+        wait_until("a configure to every node", || {
+            asked.lock().unwrap().iter().filter(|(_, t)| t.is_some()).count() >= NODES.len()
+        });
+        stop.store(true, Ordering::Relaxed);
+        let report = bridge.join().unwrap();
+        servers.join().unwrap();
+        let mut asked = asked.lock().unwrap().clone();
+        asked.sort();
+        let expected: Vec<_> = (0..NODES.len()).flat_map(|n| [(n, None), (n, Some(1))]).collect();
+        assert_eq!(asked, expected, "{rmw:?}");
+        assert_eq!(report.get_state_sent, [1, 1, 1, 1], "{rmw:?}");
+        assert_eq!(report.counters.requests, 4, "{rmw:?}");
     }
 }
