@@ -157,14 +157,17 @@ impl<Req: Serialize, Resp: DeserializeOwned> ServiceClient<Req, Resp> {
     }
 
     /// Sends the held request if the reply path has matched; drops it once
-    /// it waited `patience` (the asker has given up on it by then).
+    /// it waited `patience` (the asker has given up on it by then). Called
+    /// on every turn of the loop: it also takes the endpoints' status
+    /// events, whose channels are small and keep no event past their room.
     pub fn flush(&mut self, patience: Duration, now: Instant) {
+        let matched = self.matched();
         let Some((_, since)) = &self.held else { return };
         if now.saturating_duration_since(*since) >= patience {
             self.held = None;
             return;
         }
-        if !self.matched() {
+        if !matched {
             return;
         }
         let Some((request, _)) = self.held.take() else { return };
