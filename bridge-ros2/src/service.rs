@@ -201,19 +201,27 @@ impl<Req: Serialize, Resp: DeserializeOwned> ServiceClient<Req, Resp> {
     }
 
     /// The reply to the awaited request, if it came; other replies (to
-    /// requests given up on, or to other clients) are taken and dropped.
+    /// requests given up on, or to other clients of the service) are taken
+    /// and dropped, awaited or not: left in the reader they would wake the
+    /// poll again at once.
     pub fn reply(&mut self) -> Option<Resp> {
-        let awaited = self.awaited?;
+        let mut failed = 0;
         loop {
             let sample = match self.reader.take_next_sample() {
                 Ok(Some(s)) => s,
                 Ok(None) => return None,
-                Err(_) => continue, // a reply that does not read: not ours to keep
+                // A reply that does not read (consumed): not ours to keep.
+                // Bounded: the next turn of the loop reads on.
+                Err(_) if failed < 256 => {
+                    failed += 1;
+                    continue;
+                }
+                Err(_) => return None,
             };
             let related = sample.sample_info().related_sample_identity();
             let bytes = sample.into_value().0;
             let Some((id, resp)) = self.decode(&bytes, related) else { continue };
-            if id == awaited {
+            if Some(id) == self.awaited {
                 self.awaited = None;
                 return Some(resp);
             }
