@@ -36,8 +36,8 @@ fn bridge_on(domain: u16, rmw: Rmw, stop: Arc<AtomicBool>) -> std::thread::JoinH
 }
 
 /// What the lifecycle servers were asked: (node, service, sequence number
-/// read as rmw_cyclonedds reads it, an `int64`).
-type Asked = Arc<Mutex<Vec<(usize, &'static str, i64)>>>;
+/// read as rmw_cyclonedds reads it, an `int64`, transition id or 0).
+type Asked = Arc<Mutex<Vec<(usize, &'static str, i64, u8)>>>;
 
 struct Endpoint {
     node: usize,
@@ -76,10 +76,23 @@ fn servers(domain: u16, asked: Asked, stop: Arc<AtomicBool>) -> std::thread::Joi
                     let bytes = sample.into_value().0;
                     let header: [u8; 16] = bytes[4..20].try_into().unwrap();
                     let seq = i64::from_le_bytes(header[8..].try_into().unwrap());
-                    asked.lock().unwrap().push((e.node, e.service, seq));
+                    // The transition asked for (0 for get_state).
+                    let transition = if e.service == "change_state" { bytes[20] } else { 0 };
+                    asked.lock().unwrap().push((e.node, e.service, seq, transition));
+                    let state = |id: u8| cdr(&GetStateResponse { current_state: State { id, label: String::new() } });
                     let answer = match e.service {
                         "get_state" => {
-                            cdr(&GetStateResponse { current_state: State { id: 1, label: "unconfigured".into() } })
+                            // First an answer to another client of the same
+                            // service, with the same sequence number: replies
+                            // go to every client, and this one is not the
+                            // bridge's (were it taken, the node would be
+                            // active and deactivated, not configured).
+                            let mut other = header;
+                            other[0] ^= 0xff;
+                            let mut reply = other.to_vec();
+                            reply.extend(state(3));
+                            let _ = e.replies.write(Payload(reply), None);
+                            state(1)
                         }
                         _ => cdr(&ChangeStateResponse { success: true }),
                     };
@@ -113,20 +126,21 @@ fn the_first_get_state_is_answered_and_its_sequence_number_is_an_int64() {
     let bridge = bridge(63, stop.clone());
     // Every node configured: each answered its get_state.
     wait_until("a configure to every node", || {
-        asked.lock().unwrap().iter().filter(|(_, s, _)| *s == "change_state").count() >= NODES.len()
+        asked.lock().unwrap().iter().filter(|a| a.1 == "change_state").count() >= NODES.len()
     });
     stop.store(true, Ordering::Relaxed);
     let report = bridge.join().unwrap();
     servers.join().unwrap();
     let asked = asked.lock().unwrap().clone();
     for (node, name) in NODES.iter().enumerate() {
-        let seqs = |service: &str| -> Vec<i64> {
-            asked.iter().filter(|(n, s, _)| *n == node && *s == service).map(|a| a.2).collect()
+        let seqs = |service: &str| -> Vec<(i64, u8)> {
+            asked.iter().filter(|a| a.0 == node && a.1 == service).map(|a| (a.2, a.3)).collect()
         };
         // One request, the first written (sequence number 1): the bridge
-        // wrote nothing the server could not answer.
-        assert_eq!(seqs("get_state"), [1], "{name}: {asked:?}");
-        assert_eq!(seqs("change_state"), [1], "{name}: {asked:?}");
+        // wrote nothing the server could not answer; and it took its own
+        // answer (unconfigured: configure), not the other client's.
+        assert_eq!(seqs("get_state"), [(1, 0)], "{name}: {asked:?}");
+        assert_eq!(seqs("change_state"), [(1, 1)], "{name}: {asked:?}");
     }
     assert_eq!(report.get_state_sent, [1, 1, 1, 1], "{asked:?}");
 }
