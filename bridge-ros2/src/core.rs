@@ -7,6 +7,7 @@
 //! Time is nanoseconds since the Unix epoch, as in the real-time stack.
 
 use crate::msgs::{level, DiagnosticArray, DiagnosticStatus, Header, KeyValue, Time};
+use crate::xcdr2;
 use situ_compiler::bundle::{Content, Mode, Value};
 use situ_compiler::model::Model;
 use situ_grammar::diag::{Diagnostic, FileId};
@@ -178,10 +179,28 @@ impl Core {
     }
 
     /// One message of `topic` (its CDR bytes, encapsulation header included)
-    /// that arrived at `now`.
+    /// that arrived at `now`. XCDR2 is read into plain CDR first
+    /// ([`crate::xcdr2`]).
     pub fn on_message(&mut self, topic: &str, cdr: &[u8], now: u64) -> Vec<Output> {
         let mut out = Vec::new();
         self.counters.messages += 1;
+        let ty = self.translator.topics().find(|(t, _)| *t == topic).map(|(_, ty)| ty);
+        let plain;
+        let cdr = match ty {
+            Some(ty) if xcdr2::is_xcdr2(cdr) => match xcdr2::to_xcdr1(ty, cdr) {
+                Ok(bytes) => {
+                    plain = bytes;
+                    &plain[..]
+                }
+                Err(e) => {
+                    let short = ty.rsplit('/').next().unwrap_or(ty);
+                    self.counters.refused += 1;
+                    self.problem(topic, format!("{short}: XCDR2: {e}"));
+                    return out;
+                }
+            },
+            _ => cdr,
+        };
         let outcome = self.translator.on_message(topic, cdr);
         if !outcome.problems.is_empty() {
             self.counters.refused += outcome.problems.len() as u64;
@@ -190,15 +209,29 @@ impl Core {
                     Some(e) => format!("{e}: {}", p.message),
                     None => p.message,
                 };
-                let slot = self.problems.entry(p.topic).or_insert((0, String::new()));
-                slot.0 += 1;
-                slot.1 = what;
+                self.problem(&p.topic, what);
             }
         }
         for e in outcome.produced {
             self.post(e.agent, e.event, &e.payload, now, &mut out);
         }
         out
+    }
+
+    /// A sample of `topic` that the middleware could not hand over (an
+    /// encapsulation it does not name): counted as a message refused, its
+    /// `reason` reported with the topic's problems.
+    pub fn on_unreadable(&mut self, topic: &str, reason: &str) {
+        self.counters.messages += 1;
+        self.counters.refused += 1;
+        self.problem(topic, reason.to_string());
+    }
+
+    /// One more problem of `topic`, the last one `what`.
+    fn problem(&mut self, topic: &str, what: String) {
+        let slot = self.problems.entry(topic.to_string()).or_insert((0, String::new()));
+        slot.0 += 1;
+        slot.1 = what;
     }
 
     /// The clock: staleness, the timeout of the request in flight, the

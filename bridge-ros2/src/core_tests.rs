@@ -210,6 +210,60 @@ fn bad_messages_are_counted_and_reported_once_a_second() {
 }
 
 #[test]
+fn a_sample_the_middleware_could_not_hand_over_is_counted_and_reported() {
+    let mut core = started();
+    core.on_unreadable("/scan", "not read: unknown representation id 00 0c");
+    core.on_unreadable("/scan", "not read: unknown representation id 00 0c");
+    assert_eq!((core.counters().messages, core.counters().refused), (2, 2));
+    let out = core.on_tick(T0 + 2 * S);
+    let Some(Output::Diagnostics(a)) = out.iter().find(|o| matches!(o, Output::Diagnostics(_))) else {
+        panic!("no diagnostics in {out:?}")
+    };
+    let scan = a.status.iter().find(|s| s.name == "situ: /scan").expect("a status for /scan");
+    assert_eq!(
+        (scan.message.as_str(), scan.values[0].value.as_str()),
+        ("not read: unknown representation id 00 0c", "2")
+    );
+}
+
+#[test]
+fn an_xcdr2_scan_is_read_as_its_xcdr1() {
+    // A LaserScan has no 8-byte field and no sequence of structures: its
+    // XCDR2 (`00 07`) is its XCDR1 under another header.
+    let mut core = started();
+    let mut bytes = scan(0.2);
+    bytes[1] = 7;
+    core.on_message("/scan", &bytes, T0 + S);
+    assert_eq!((core.counters().messages, core.counters().refused, core.counters().events), (1, 0, 1));
+}
+
+#[test]
+fn encapsulations_not_read_are_refused_with_their_identifier() {
+    let mut core = started();
+    let mut mutable = scan(2.0);
+    mutable[1] = 0x0b; // PL_CDR2: mutable types, not read
+    assert!(core.on_message("/scan", &mutable, T0 + S).is_empty());
+    let mut cut = scan(2.0);
+    cut[1] = 7;
+    cut.truncate(30); // XCDR2 cut short
+    assert!(core.on_message("/scan", &cut, T0 + S).is_empty());
+    assert_eq!((core.counters().messages, core.counters().refused), (2, 2));
+    let reported = |core: &mut Core, t: u64| {
+        let out = core.on_tick(t);
+        let Some(Output::Diagnostics(a)) = out.into_iter().find(|o| matches!(o, Output::Diagnostics(_))) else {
+            panic!("no diagnostics")
+        };
+        a.status.into_iter().find(|s| s.name == "situ: /scan").expect("a status for /scan")
+    };
+    let last = reported(&mut core, T0 + 2 * S);
+    assert_eq!(last.values[0].value, "2");
+    assert!(last.message.starts_with("LaserScan: XCDR2: "), "{last:?}");
+    core.on_message("/scan", &mutable, T0 + 3 * S);
+    let last = reported(&mut core, T0 + 4 * S);
+    assert!(last.message.contains("encapsulation 00 0b"), "{last:?}");
+}
+
+#[test]
 fn the_agents_say_mode_function_links_and_lifecycle() {
     let mut core = started();
     let out = core.on_message("/goal_pose", &goal(4.0, 2.0), T0 + S);

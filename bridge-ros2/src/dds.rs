@@ -9,9 +9,9 @@ use crate::core::{Core, Counters, Output};
 use crate::msgs::{
     ChangeStateRequest, ChangeStateResponse, DiagnosticArray, GetStateRequest, GetStateResponse, StringMsg, Transition,
 };
-use ros2_client::service::{Client, ServiceMapping};
+use crate::service::ServiceClient;
+use ros2_client::QosProfile;
 use ros2_client::{Context, ContextOptions, MessageTypeName, Name, Node, NodeName, NodeOptions, Publisher};
-use ros2_client::{QosProfile, ServiceTypeName};
 use rustdds::mio1::{Events, Interest, Poll, Token};
 use rustdds::no_key::{self, DataReader};
 use rustdds::{QosPolicyBuilder, ReadCondition, RepresentationIdentifier};
@@ -27,15 +27,6 @@ pub enum Rmw {
     CycloneDds,
     /// `rmw_fastrtps_cpp` (ROS 2's default): the request id in inline QoS.
     FastRtps,
-}
-
-impl Rmw {
-    fn mapping(self) -> ServiceMapping {
-        match self {
-            Rmw::CycloneDds => ServiceMapping::Cyclone,
-            Rmw::FastRtps => ServiceMapping::Enhanced,
-        }
-    }
 }
 
 #[derive(Debug, Clone)]
@@ -87,6 +78,8 @@ pub struct Report {
     pub busy: Duration,
     /// The recording's first error, after which nothing more was recorded.
     pub record_error: Option<String>,
+    /// The `get_state` requests written, per node of the map.
+    pub get_state_sent: Vec<u64>,
 }
 
 /// Where what came and went is recorded, if anywhere.
@@ -124,16 +117,33 @@ impl fmt::Display for Never {
 
 impl std::error::Error for Never {}
 
-/// Every encapsulation: one the map's decoder does not read is refused
-/// and counted there, not dropped unseen.
-const ENCODINGS: [RepresentationIdentifier; 6] = [
-    RepresentationIdentifier::CDR_LE,
-    RepresentationIdentifier::CDR_BE,
-    RepresentationIdentifier::PL_CDR_LE,
-    RepresentationIdentifier::PL_CDR_BE,
-    RepresentationIdentifier::CDR2_LE,
-    RepresentationIdentifier::CDR2_BE,
-];
+/// Every encapsulation RTPS and XTypes name (XCDR2 is `00 06`/`00 07`,
+/// its delimited and parameter-list forms `00 08` to `00 0b`; RustDDS's
+/// `CDR2_LE` is `00 11`): one the map's decoder does not read is refused
+/// and counted there, not dropped by RustDDS unseen. A sample of another
+/// identifier fails `take`, which the loop counts as refused.
+const ENCODINGS: [RepresentationIdentifier; 17] = {
+    use RepresentationIdentifier as R;
+    [
+        R::CDR_BE,
+        R::CDR_LE,
+        R::PL_CDR_BE,
+        R::PL_CDR_LE,
+        R::XML,
+        R::XCDR2_BE,
+        R::XCDR2_LE,
+        R::D_CDR2_BE,
+        R::D_CDR2_LE,
+        R::PL_XCDR2_BE,
+        R::PL_XCDR2_LE,
+        R::CDR2_BE,
+        R::CDR2_LE,
+        R::PL_CDR2_BE,
+        R::PL_CDR2_LE,
+        R::D_CDR_BE,
+        R::D_CDR_LE,
+    ]
+};
 
 impl no_key::DeserializerAdapter<Raw> for RawAdapter {
     type Error = Never;
@@ -181,10 +191,10 @@ fn now_ns() -> u64 {
 }
 
 struct Lifecycle {
-    change: Client<ChangeStateRequest, ChangeStateResponse>,
-    get: Client<GetStateRequest, GetStateResponse>,
-    change_id: Option<ros2_client::service::RmwRequestId>,
-    get_id: Option<ros2_client::service::RmwRequestId>,
+    change: ServiceClient<ChangeStateRequest, ChangeStateResponse>,
+    get: ServiceClient<GetStateRequest, GetStateResponse>,
+    /// How long a request may wait for its reply path (the node's timeout).
+    patience: Duration,
 }
 
 struct Shell {
@@ -240,29 +250,23 @@ fn open(core: &Core, options: &Options) -> Result<Shell, DdsError> {
             subscriber.create_datareader_no_key::<Raw, RawAdapter>(&t, Some(read_qos.clone())).map_err(dds(&topic))?;
         readers.push((topic, reader));
     }
-    let service_qos = QosProfile::publisher_default().history(ros2_client::qos::History::KeepLast { depth: 10 });
     let mut lifecycle = Vec::new();
+    let participant = context.domain_participant();
     for n in core.nodes() {
-        let name = |service: &str| Name::new(&n.name, service).map_err(dds(&n.name));
-        let change = node
-            .create_client(
-                options.rmw.mapping(),
-                &name("change_state")?,
-                &ServiceTypeName::new("lifecycle_msgs", "ChangeState"),
-                service_qos.clone(),
-                service_qos.clone(),
+        let service = |s: &str| format!("{}/{s}", n.name);
+        lifecycle.push(Lifecycle {
+            change: ServiceClient::new(
+                &participant,
+                options.rmw,
+                &service("change_state"),
+                "lifecycle_msgs",
+                "ChangeState",
             )
-            .map_err(dds(&n.name))?;
-        let get = node
-            .create_client(
-                options.rmw.mapping(),
-                &name("get_state")?,
-                &ServiceTypeName::new("lifecycle_msgs", "GetState"),
-                service_qos.clone(),
-                service_qos.clone(),
-            )
-            .map_err(dds(&n.name))?;
-        lifecycle.push(Lifecycle { change, get, change_id: None, get_id: None });
+            .map_err(DdsError)?,
+            get: ServiceClient::new(&participant, options.rmw, &service("get_state"), "lifecycle_msgs", "GetState")
+                .map_err(DdsError)?,
+            patience: n.timeout,
+        });
     }
     Ok(Shell { _node: node, state, agents, diagnostics, readers, lifecycle })
 }
@@ -291,16 +295,15 @@ impl Shell {
                     drop(self.diagnostics.publish(d));
                 }
                 Output::ChangeState { node, transition } => {
-                    let l = &mut self.lifecycle[node];
                     let request = ChangeStateRequest {
                         transition: Transition { id: transition.id(), label: transition.label().to_string() },
                     };
-                    l.change_id = l.change.send_request(request).ok();
-                    requested = true;
+                    let l = &mut self.lifecycle[node];
+                    l.change.request(request, Instant::now());
+                    requested = !l.change.holding();
                 }
                 Output::GetState { node } => {
-                    let l = &mut self.lifecycle[node];
-                    l.get_id = l.get.send_request(GetStateRequest::default()).ok();
+                    self.lifecycle[node].get.request(GetStateRequest::default(), Instant::now());
                 }
             }
         }
@@ -323,8 +326,9 @@ pub fn run(mut core: Core, options: &Options, bag: Option<Bag>) -> Result<Report
     }
     let base = readers.len();
     for (i, l) in shell.lifecycle.iter_mut().enumerate() {
-        poll.registry().register(&mut l.change, Token(base + 2 * i), Interest::READABLE).map_err(dds("poll"))?;
-        poll.registry().register(&mut l.get, Token(base + 2 * i + 1), Interest::READABLE).map_err(dds("poll"))?;
+        let (change, get) = (l.change.reader_mut(), l.get.reader_mut());
+        poll.registry().register(change, Token(base + 2 * i), Interest::READABLE).map_err(dds("poll"))?;
+        poll.registry().register(get, Token(base + 2 * i + 1), Interest::READABLE).map_err(dds("poll"))?;
     }
     let started = Instant::now();
     let out = core.start(now_ns());
@@ -342,10 +346,22 @@ pub fn run(mut core: Core, options: &Options, bag: Option<Bag>) -> Result<Report
         let _ = poll.poll(&mut events, Some(wait));
         for (topic, reader) in &mut readers {
             // In batches: one take per sample walks the reader's cache each time.
-            while let Ok(samples) = reader.take(256, ReadCondition::not_read()) {
-                if samples.is_empty() {
-                    break;
-                }
+            let mut failed = 0;
+            loop {
+                let samples = match reader.take(256, ReadCondition::not_read()) {
+                    Ok(s) if s.is_empty() => break,
+                    Ok(s) => s,
+                    // The sample that failed is consumed: count it, read on
+                    // (a bounded number of times: the next poll reads on).
+                    Err(e) => {
+                        core.on_unreadable(topic, &format!("not read: {e}"));
+                        failed += 1;
+                        if failed >= 256 {
+                            break;
+                        }
+                        continue;
+                    }
+                };
                 for sample in samples {
                     let taken = Instant::now();
                     let bytes = sample.into_value().0;
@@ -360,23 +376,15 @@ pub fn run(mut core: Core, options: &Options, bag: Option<Bag>) -> Result<Report
             }
         }
         for i in 0..shell.lifecycle.len() {
-            loop {
-                let l = &mut shell.lifecycle[i];
-                let Ok(Some((id, answer))) = l.change.receive_response() else { break };
-                if l.change_id != Some(id) {
-                    continue; // an answer to a request given up on
-                }
-                l.change_id = None;
+            let l = &mut shell.lifecycle[i];
+            l.change.flush(l.patience, Instant::now());
+            l.get.flush(l.patience, Instant::now());
+            if let Some(answer) = l.change.reply() {
                 let out = core.on_change_state(i, answer.success, now_ns());
                 shell.send(out, &mut recording);
             }
-            loop {
-                let l = &mut shell.lifecycle[i];
-                let Ok(Some((id, answer))) = l.get.receive_response() else { break };
-                if l.get_id != Some(id) {
-                    continue;
-                }
-                l.get_id = None;
+            let l = &mut shell.lifecycle[i];
+            if let Some(answer) = l.get.reply() {
                 let out = core.on_get_state(i, answer.current_state.id, now_ns());
                 shell.send(out, &mut recording);
             }
@@ -391,5 +399,14 @@ pub fn run(mut core: Core, options: &Options, bag: Option<Bag>) -> Result<Report
     recording.keep(|b| b.finish().map(drop));
     let counters = core.counters();
     let rate = counters.messages as f64 / started.elapsed().as_secs_f64().max(1e-9);
-    Ok(Report { state: core.state_name().to_string(), counters, latencies, rate, busy, record_error: recording.error })
+    let get_state_sent = shell.lifecycle.iter().map(|l| l.get.sent()).collect();
+    Ok(Report {
+        state: core.state_name().to_string(),
+        counters,
+        latencies,
+        rate,
+        busy,
+        record_error: recording.error,
+        get_state_sent,
+    })
 }

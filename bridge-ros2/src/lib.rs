@@ -8,9 +8,13 @@
 //! - [`dds`]: the DDS shell (ros2-client on RustDDS): readers of the raw
 //!   CDR samples, the publishers, the lifecycle service clients, the loop;
 //! - [`bag`]: the recording, a ROS 2 bag (MCAP storage) of what came and went;
-//! - [`msgs`]: the ROS 2 messages and services it writes, as serde types.
+//! - [`msgs`]: the ROS 2 messages and services it writes, as serde types;
+//! - [`service`]: its service client (lifecycle requests) on RustDDS;
+//! - [`xcdr2`]: XCDR2 samples read into the XCDR1 the map's decoder reads.
 
 pub mod bag;
 pub mod core;
 pub mod dds;
 pub mod msgs;
+pub mod service;
+pub mod xcdr2;

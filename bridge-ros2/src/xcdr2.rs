@@ -1,0 +1,233 @@
+//! XCDR2 (DDS-XTypes 1.3, §7.4.3) read into the XCDR1 the map's decoder
+//! reads, for the types of the catalogue: a sample in `00 06`/`00 07`
+//! (final types) or `00 08`/`00 09` (appendable: delimited) becomes the
+//! same message in plain little-endian CDR (`00 01`).
+//!
+//! What differs from XCDR1 for these types: 8-byte primitives align to 4; a
+//! sequence or array of strings or of structures starts with a DHEADER (a
+//! `u32` byte length); in the delimited form, every structure does too
+//! (and may end with members a newer definition added, skipped here). The
+//! parameter-list form (`00 0a`/`00 0b`, mutable types) is not read.
+//!
+//! Bounded like the decoder: nothing is allocated beyond what the input
+//! holds, and a length or count past its end is an error.
+
+use situ_ros2::msgs::{self, FieldType, CATALOGUE};
+
+/// Whether `cdr`'s encapsulation is one [`to_xcdr1`] reads.
+pub fn is_xcdr2(cdr: &[u8]) -> bool {
+    matches!(cdr, [0, 6..=9, ..])
+}
+
+/// The message `ty` (a full name of the catalogue) of the XCDR2 sample
+/// `cdr` (its encapsulation header included), as plain little-endian CDR.
+pub fn to_xcdr1(ty: &'static str, cdr: &[u8]) -> Result<Vec<u8>, String> {
+    let Some((header, body)) = cdr.split_first_chunk::<4>() else {
+        return Err(format!("{} bytes, too short for the 4-byte encapsulation header", cdr.len()));
+    };
+    let (little, delimited) = match (header[0], header[1]) {
+        (0, 6) => (false, false),
+        (0, 7) => (true, false),
+        (0, 8) => (false, true),
+        (0, 9) => (true, true),
+        (a, b) => return Err(format!("encapsulation {a:02x} {b:02x} is not XCDR2")),
+    };
+    let mut t = Transcoder { input: body, pos: 0, little, delimited, out: vec![0, 1, 0, 0] };
+    t.msg(ty)?;
+    Ok(t.out)
+}
+
+struct Transcoder<'a> {
+    input: &'a [u8],
+    pos: usize,
+    little: bool,
+    delimited: bool,
+    out: Vec<u8>,
+}
+
+/// The size of a primitive named as in the catalogue; a string's length is 4.
+fn width(ty: &str) -> usize {
+    match ty {
+        "bool" | "byte" | "char" | "int8" | "uint8" => 1,
+        "int16" | "uint16" => 2,
+        "int64" | "uint64" | "float64" => 8,
+        _ => 4,
+    }
+}
+
+impl Transcoder<'_> {
+    /// `n` bytes aligned to `align` (at most 4 in XCDR2).
+    fn read(&mut self, n: usize, align: usize) -> Result<&[u8], String> {
+        let align = align.min(4);
+        let start = self.pos.next_multiple_of(align);
+        let bytes = self.input.get(start..).and_then(|b| b.get(..n));
+        let bytes =
+            bytes.ok_or_else(|| format!("{n} bytes needed at {start}, {} left", self.input.len() - self.pos))?;
+        self.pos = start + n;
+        Ok(bytes)
+    }
+
+    fn u32(&mut self) -> Result<u32, String> {
+        let little = self.little;
+        let b: [u8; 4] = self.read(4, 4)?.try_into().map_err(|_| "a u32")?;
+        Ok(if little { u32::from_le_bytes(b) } else { u32::from_be_bytes(b) })
+    }
+
+    /// Writes `bytes` (as read, of `width` bytes each) little-endian,
+    /// aligned to `width` from the start of the body (XCDR1).
+    fn write(&mut self, bytes: &[u8], width: usize) {
+        let at = (self.out.len() - 4).next_multiple_of(width) + 4;
+        self.out.resize(at, 0);
+        for chunk in bytes.chunks(width) {
+            if self.little {
+                self.out.extend_from_slice(chunk);
+            } else {
+                self.out.extend(chunk.iter().rev());
+            }
+        }
+    }
+
+    fn write_u32(&mut self, v: u32) {
+        let at = (self.out.len() - 4).next_multiple_of(4) + 4;
+        self.out.resize(at, 0);
+        self.out.extend(v.to_le_bytes());
+    }
+
+    /// A DHEADER: the end of what it delimits.
+    fn dheader(&mut self) -> Result<usize, String> {
+        let len = self.u32()? as usize;
+        let end = self.pos.checked_add(len).filter(|&e| e <= self.input.len());
+        end.ok_or_else(|| format!("a DHEADER of {len} bytes, {} left", self.input.len() - self.pos))
+    }
+
+    fn msg(&mut self, ty: &'static str) -> Result<(), String> {
+        let end = if self.delimited { Some(self.dheader()?) } else { None };
+        let text = CATALOGUE.iter().find(|(n, _)| *n == ty).map(|(_, t)| *t).ok_or(ty)?;
+        if text.trim().is_empty() {
+            // The DDS type of an empty ROS 2 message has one octet.
+            let octet = self.read(1, 1)?.to_vec();
+            self.write(&octet, 1);
+        }
+        let names = text.lines().map(str::trim).filter(|l| !l.is_empty()).filter_map(|l| l.split_once(' '));
+        for ((written, _), (_, field)) in names.zip(msgs::fields(ty)) {
+            let base = written.split('[').next().unwrap_or(written);
+            self.field(base, &field)?;
+        }
+        if let Some(end) = end {
+            if self.pos > end {
+                return Err(format!("`{ty}` runs past its DHEADER"));
+            }
+            self.pos = end; // members a newer definition appended
+        }
+        Ok(())
+    }
+
+    fn field(&mut self, base: &str, field: &FieldType) -> Result<(), String> {
+        match field {
+            FieldType::Prim(msgs::Prim::String) => {
+                let len = self.u32()?;
+                self.write_u32(len);
+                let bytes = self.read(len as usize, 1)?.to_vec();
+                self.out.extend(bytes);
+            }
+            FieldType::Prim(_) => {
+                let w = width(base);
+                let bytes = self.read(w, w)?.to_vec();
+                self.write(&bytes, w);
+            }
+            FieldType::Msg(m) => self.msg(m)?,
+            FieldType::Array(elem, size) => {
+                let plain = matches!(**elem, FieldType::Prim(p) if p != msgs::Prim::String);
+                let end = if plain { None } else { Some(self.dheader()?) };
+                let count = match size {
+                    Some(n) => *n,
+                    None => {
+                        let count = self.u32()?;
+                        self.write_u32(count);
+                        count as usize
+                    }
+                };
+                if count > self.input.len() - self.pos {
+                    return Err(format!("{count} elements, {} bytes left", self.input.len() - self.pos));
+                }
+                if count == 0 {
+                    // Nothing, not even the padding before the elements.
+                } else if plain {
+                    // A run of primitives: one read, one write.
+                    let w = width(base);
+                    let bytes = self.read(w * count, w)?.to_vec();
+                    self.write(&bytes, w);
+                } else {
+                    for _ in 0..count {
+                        self.field(base, elem)?;
+                    }
+                }
+                if let Some(end) = end {
+                    if self.pos > end {
+                        return Err("a sequence runs past its DHEADER".into());
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_appendable_point_loses_its_dheader_and_its_padding() {
+        // Point { x: 1.0, y: 2.0, z: 3.0 }, appendable, little-endian, with
+        // 4 bytes of a member a newer definition added.
+        let mut v2 = vec![0, 9, 0, 0];
+        v2.extend(28u32.to_le_bytes());
+        for x in [1.0f64, 2.0, 3.0] {
+            v2.extend(x.to_le_bytes());
+        }
+        v2.extend([0xaa; 4]);
+        let v1 = to_xcdr1("geometry_msgs/msg/Point", &v2).unwrap();
+        let mut expected = vec![0, 1, 0, 0];
+        for x in [1.0f64, 2.0, 3.0] {
+            expected.extend(x.to_le_bytes());
+        }
+        assert_eq!(v1, expected);
+    }
+
+    #[test]
+    fn lengths_past_the_end_are_errors() {
+        let mut v2 = vec![0, 9, 0, 0];
+        v2.extend(u32::MAX.to_le_bytes());
+        let e = to_xcdr1("geometry_msgs/msg/Point", &v2).unwrap_err();
+        assert!(e.contains("DHEADER of 4294967295 bytes"), "{e}");
+        let mut v2 = vec![0, 7, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0];
+        v2.extend(4_000_000_000u32.to_le_bytes());
+        assert!(to_xcdr1("diagnostic_msgs/msg/DiagnosticArray", &v2).is_err());
+        assert!(to_xcdr1("std_msgs/msg/Bool", &[0, 7]).is_err());
+        assert!(to_xcdr1("std_msgs/msg/Bool", &[0, 1, 0, 0, 1]).unwrap_err().contains("00 01 is not XCDR2"));
+    }
+
+    #[test]
+    fn no_input_panics_or_grows_more_than_the_alignment_it_adds() {
+        // A small xorshift: the same inputs every run.
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        for ty in msgs::names() {
+            for round in 0..300 {
+                let len = (next() % 96) as usize;
+                let mut v2 = vec![0, 6 + (round % 4) as u8, 0, 0];
+                // Small numbers mostly, so counts and lengths often fit.
+                v2.extend((0..len).map(|_| if next() % 3 == 0 { next() as u8 } else { (next() % 4) as u8 }));
+                if let Ok(v1) = to_xcdr1(ty, &v2) {
+                    assert!(v1.len() <= 2 * v2.len() + 8, "{ty}: {v2:02x?}");
+                }
+            }
+        }
+    }
+}
