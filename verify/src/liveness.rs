@@ -1,0 +1,242 @@
+//! Proofs of liveness for runs of any length: `always (P -> eventually Q)`
+//! without a bound, by the liveness-to-safety reduction (Biere, Artho,
+//! Schuppan 2002) of the [`Model`]'s circuit, checked by [`ic3`].
+//!
+//! The property is broken by an infinite run with a point where P holds
+//! and no point from there on where Q holds. The circuit keeps the
+//! obligation ([`Obligation`]): `now` is whether it is pending after the
+//! current point (¬Q ∧ (pending ∨ P)). The reduction adds to the circuit
+//!
+//! - a free input `save` and a latch `saved`: at the first cycle where
+//!   `save` holds, a shadow latch copies each latch of the abstract state
+//!   ([`Model::system`]: the state, FSM states, facts with their run
+//!   lengths and capped ages, the order of reports);
+//! - a latch that holds while the obligation was pending after every point
+//!   since the save (`now` at the save and at each later point);
+//!
+//! and its bad output is: saved, pending since, and the abstract state
+//! equal to its shadow — a loop of one or more points along which the
+//! obligation stays pending — or a cascade (which breaks every property,
+//! as in the explorer).
+//!
+//! **Why a loop of the circuit is an infinite run of the engine.** The
+//! circuit's next state is a function of its abstract state and its inputs
+//! (a letter and a gap); the predicates P and Q are functions of the
+//! abstract state (the tests of [`Model::simulate`] check both against
+//! the engine, point by point). Time is exact, not sampled: an age is a
+//! number of nanoseconds capped just past the largest duration that
+//! concerns the agent, and past the cap every threshold is crossed alike;
+//! a gap is any number of nanoseconds (longer gaps act as the longest).
+//! So if the run u v reaches the abstract state s after u and again after
+//! u v, then u v v v … reaches s after every copy of v on the engine too,
+//! with the same predicates at the same places of each copy: the real ages
+//! grow past the cap, which the capped ones stand for. Q fails at every
+//! point of the loop, so the obligation, pending after u and at every
+//! point of v, stays pending for ever. The run may keep time still (every
+//! gap of v zero): the engine takes events at the same time, and no
+//! fairness on time is assumed, as in the explorer. Conversely a run that
+//! breaks the property has finitely many abstract states, so one repeats
+//! while the obligation is pending: the circuit has the loop. Hence IC3's
+//! invariant (no such loop is reachable) proves the property on every
+//! infinite run of the abstraction — of every run when the abstraction is
+//! exact (payload classes, [`prove::sampled`]).
+//!
+//! A loop that IC3 finds is confirmed on the real engine: the prefix, then
+//! the loop three times, must keep the obligation pending from the loop's
+//! first point on and come back to the same abstract state
+//! ([`Alphabet::key`]) after each copy; otherwise the verdict is
+//! [`Verdict::Disagree`], never a proof.
+
+use super::abstraction::Alphabet;
+use super::aig::{lit_value, not, Aig, Lit};
+use super::ic3::{self, Limits, Outcome};
+use super::model::{Model, Obligation};
+use super::monitor::{Monitor, MonitorState};
+use super::prove;
+use super::random;
+use super::{Counterexample, RunStep, System, Verdict};
+use situ_compiler::bundle::Content;
+use situ_compiler::spec::PropertySpec;
+use std::cell::Cell;
+use std::sync::Arc;
+
+/// How many times a loop is replayed on the engine to confirm it.
+const CONFIRM: usize = 3;
+
+/// The liveness-to-safety circuit of one property.
+pub struct Reduction {
+    pub aig: Aig,
+    /// A cascade, or a loop along which the obligation stays pending.
+    pub bad: Lit,
+    save: Lit,
+    saved: Lit,
+}
+
+impl Reduction {
+    /// The model's circuit with the loop detector of `ob`.
+    pub fn new(model: &Model, ob: Obligation) -> Reduction {
+        let mut aig = model.aig.clone();
+        let save = aig.input("l2s.save");
+        let saved = aig.latch("l2s.saved");
+        let since = aig.latch("l2s.pending_since");
+        let first = aig.and(save, not(saved));
+        let saved_next = aig.or(saved, save);
+        aig.set_next(saved, saved_next);
+        let kept = aig.and(since, ob.now);
+        let since_next = aig.mux(first, ob.now, kept);
+        aig.set_next(since, since_next);
+        let mut same = Vec::with_capacity(model.system.len());
+        for (i, &l) in model.system.iter().enumerate() {
+            let shadow = aig.latch(&format!("l2s.shadow{i}"));
+            let next = aig.mux(first, l, shadow);
+            aig.set_next(shadow, next);
+            let differ = aig.xor(l, shadow);
+            same.push(not(differ));
+        }
+        let same = aig.and_all(same);
+        let looped = aig.and_all([saved, since, same]);
+        let bad = aig.or(looped, model.err);
+        Reduction { aig, bad, save, saved }
+    }
+
+    /// The cycle at which a run of these inputs saved its state, if it did.
+    fn saved_at(&self, inputs: &[Vec<bool>]) -> Option<usize> {
+        let mut latches = vec![false; self.aig.latches().len()];
+        for (t, ins) in inputs.iter().enumerate() {
+            let val = self.aig.eval(ins, &latches);
+            if lit_value(&val, self.save) && !lit_value(&val, self.saved) {
+                return Some(t);
+            }
+            latches = (0..latches.len()).map(|i| lit_value(&val, self.aig.next_of(i))).collect();
+        }
+        None
+    }
+}
+
+/// Proves liveness property `index` of the model on every infinite run, or
+/// finds a lasso (replayed on the engine), or says where IC3 gave up;
+/// `None` when the circuit keeps no obligation for it (not a liveness
+/// property, or a predicate the circuit cannot say).
+pub fn check(
+    content: &Arc<Content>,
+    alphabet: &Arc<Alphabet>,
+    model: &Model,
+    index: usize,
+    property: &PropertySpec,
+    limits: Limits,
+) -> Option<Verdict> {
+    let ob = model.live.get(index).copied().flatten()?;
+    let r = Reduction::new(model, ob);
+    Some(match ic3::check(&r.aig, r.bad, limits) {
+        Outcome::Proved { frames, clauses } => {
+            Verdict::Inductive { frames, clauses, sampled: prove::sampled(alphabet) }
+        }
+        Outcome::Unknown { depth, work, stop } => Verdict::GaveUp { depth, work, stop },
+        Outcome::Counterexample(inputs) => {
+            let run: Vec<RunStep> = inputs
+                .iter()
+                .map(|i| {
+                    let (l, gap) = model.choice(i);
+                    let letter = &alphabet.letters[l];
+                    RunStep { event: letter.event, payload: letter.payload.clone(), gap }
+                })
+                .collect();
+            // The liveness monitor fails at no point: a failure is a cascade.
+            if random::check_run(content, property, &run, &Cell::new(0)).is_err() {
+                return Some(cascade(content, alphabet, property, run));
+            }
+            match r.saved_at(&inputs) {
+                Some(start) if start < run.len() => lasso(content, alphabet, property, &run, start),
+                _ => Verdict::Disagree { events: run.len() },
+            }
+        }
+    })
+}
+
+/// A run that breaks the property at a point (a cascade), shrunk.
+fn cascade(content: &Arc<Content>, alphabet: &Arc<Alphabet>, property: &PropertySpec, run: Vec<RunStep>) -> Verdict {
+    match random::check_run(content, property, &run, &Cell::new(0)) {
+        Err((point, _)) => {
+            let run = random::shrink(content, alphabet, property, run[..point].to_vec());
+            let (point, reason) =
+                random::check_run(content, property, &run, &Cell::new(0)).err().unwrap_or((run.len(), String::new()));
+            Verdict::Failed(Counterexample::replay(content, &run[..point.min(run.len())], point, reason))
+        }
+        Ok(()) => Verdict::Disagree { events: run.len() },
+    }
+}
+
+/// The lasso `run[..start]` then `run[start..]` for ever, if the engine
+/// confirms it.
+fn lasso(
+    content: &Arc<Content>,
+    alphabet: &Alphabet,
+    property: &PropertySpec,
+    run: &[RunStep],
+    start: usize,
+) -> Verdict {
+    let (prefix, cycle) = run.split_at(start);
+    if !confirmed(content, alphabet, property, prefix, cycle) {
+        return Verdict::Disagree { events: run.len() };
+    }
+    let reason = format!(
+        "the premise held and the consequent never comes: events {} to {} repeat forever",
+        start + 1,
+        run.len()
+    );
+    Verdict::Failed(Counterexample::replay(content, run, run.len(), reason))
+}
+
+/// Whether the engine, after `prefix` then `cycle` [`CONFIRM`] times,
+/// keeps the obligation pending from the end of the prefix on (the cycle's
+/// first point is the prefix's last), no event refused and no cascade, and
+/// comes back to the prefix's abstract state after each copy of the cycle.
+pub fn confirmed(
+    content: &Arc<Content>,
+    alphabet: &Alphabet,
+    property: &PropertySpec,
+    prefix: &[RunStep],
+    cycle: &[RunStep],
+) -> bool {
+    if cycle.is_empty() {
+        return false;
+    }
+    let monitor = Monitor::new(property);
+    let mut sys = System::new(content.clone());
+    let mut st = MonitorState::default();
+    let (p, q) = sys.point(property);
+    if monitor.step(&mut st, p, q, 0).is_some() {
+        return false;
+    }
+    let mut time = 0u64;
+    let mut post = |sys: &mut System, st: &mut MonitorState, s: &RunStep| -> bool {
+        time = time.saturating_add(s.gap);
+        if sys.post(s.event, time, &s.payload).is_err() {
+            return false;
+        }
+        let (p, q) = sys.point(property);
+        monitor.step(st, p, q, s.gap).is_none()
+    };
+    for s in prefix {
+        if !post(&mut sys, &mut st, s) {
+            return false;
+        }
+    }
+    let (mut home, mut key) = (Vec::new(), Vec::new());
+    alphabet.key(&sys, &mut home);
+    if !st.pending {
+        return false;
+    }
+    for _ in 0..CONFIRM {
+        for s in cycle {
+            if !post(&mut sys, &mut st, s) || !st.pending {
+                return false;
+            }
+        }
+        alphabet.key(&sys, &mut key);
+        if key != home {
+            return false;
+        }
+    }
+    true
+}
