@@ -45,7 +45,10 @@
 //! the loop three times, must keep the obligation pending from the loop's
 //! first point on and come back to the same abstract state
 //! ([`Alphabet::key`]) after each copy; otherwise the verdict is
-//! [`Verdict::Disagree`], never a proof.
+//! [`Verdict::Disagree`], never a proof. A confirmed lasso is simplified
+//! (events of the prefix removed, the prefix's gaps made 0 or whole
+//! milliseconds, the loop's whole milliseconds but not 0), each step
+//! confirmed again.
 
 use super::abstraction::Alphabet;
 use super::aig::{lit_value, not, Aig, Lit};
@@ -179,12 +182,63 @@ fn lasso(
     if !confirmed(content, alphabet, property, prefix, cycle) {
         return Verdict::Disagree { events: run.len() };
     }
+    let (prefix, cycle) = simplify(content, alphabet, property, prefix.to_vec(), cycle.to_vec());
+    let start = prefix.len();
+    let mut run = prefix;
+    run.extend(cycle);
     let reason = format!(
         "the premise held and the consequent never comes: events {} to {} repeat forever",
         start + 1,
         run.len()
     );
-    Verdict::Failed(Counterexample::replay(content, run, run.len(), reason))
+    Verdict::Failed(Counterexample::replay(content, &run, run.len(), reason))
+}
+
+/// A confirmed lasso made easier to read, each change kept only if the
+/// engine still confirms it: events of the prefix removed one at a time,
+/// then each gap made 0, or else rounded down to the millisecond.
+fn simplify(
+    content: &Arc<Content>,
+    alphabet: &Alphabet,
+    property: &PropertySpec,
+    mut prefix: Vec<RunStep>,
+    mut cycle: Vec<RunStep>,
+) -> (Vec<RunStep>, Vec<RunStep>) {
+    let ok = |p: &[RunStep], c: &[RunStep]| confirmed(content, alphabet, property, p, c);
+    let mut i = 0;
+    while i < prefix.len() {
+        let mut fewer = prefix.clone();
+        fewer.remove(i);
+        if ok(&fewer, &cycle) {
+            prefix = fewer;
+        } else {
+            i += 1;
+        }
+    }
+    for k in 0..prefix.len() + cycle.len() {
+        let in_cycle = k >= prefix.len();
+        let gap = if in_cycle { cycle[k - prefix.len()].gap } else { prefix[k].gap };
+        let ms = gap / 1_000_000 * 1_000_000;
+        // A gap of the cycle stays positive: the loop does not stop time
+        // where IC3's did not.
+        let candidates: &[u64] = if in_cycle { &[ms] } else { &[0, ms] };
+        for &g in candidates {
+            if g == gap || (in_cycle && g == 0) {
+                break;
+            }
+            let (mut p, mut c) = (prefix.clone(), cycle.clone());
+            if k < p.len() {
+                p[k].gap = g;
+            } else {
+                c[k - p.len()].gap = g;
+            }
+            if ok(&p, &c) {
+                (prefix, cycle) = (p, c);
+                break;
+            }
+        }
+    }
+    (prefix, cycle)
 }
 
 /// Whether the engine, after `prefix` then `cycle` [`CONFIRM`] times,

@@ -14,20 +14,20 @@ use situ_verify::ic3;
 use situ_verify::liveness;
 use situ_verify::model::Model;
 use situ_verify::monitor::Monitor;
-use situ_verify::property::{self, Checker, Conclusion, Engines, Options};
+use situ_verify::property::{self, Checker, Conclusion, Engines, Options, Premise};
 use situ_verify::random::Search;
 use situ_verify::{RunStep, Verdict};
 use std::path::Path;
 use std::sync::Arc;
 
-/// A job that a lapse of its sensor or any report ends: once busy, it is
-/// done at the next event, whatever its gap.
+/// A job that a lapse of its sensor or any new report ends: once busy, it
+/// is done at the next event, whatever its gap.
 const ENDS: &str = r#"
 states { Idle initial Busy Done }
-agent Job sensor { stale after 100ms event START event STOP }
-rule start { when state == Idle and START then Busy }
-rule stop { when state == Busy and STOP then Done }
-rule retry { when state == Busy and START then Done }
+agent Job sensor { stale after 100ms event PING event PONG }
+rule start { when state == Idle and PING then Busy }
+rule again { when state == Busy and PING x2 then Done }
+rule pong { when state == Busy and PONG then Done }
 rule lapse { when state == Busy and stale Job then Done }
 property "a busy job ends" { always (state == Busy -> eventually state == Done) }
 "#;
@@ -90,6 +90,8 @@ fn a_true_liveness_property_with_durations_is_proved() {
         }
         other => panic!("came to {other:?}"),
     }
+    // Of something: a busy job is reachable.
+    assert!(matches!(r.premise, Some(Premise::Reachable(_))), "{:?}", r.premise);
 }
 
 /// The prefix and the cycle of a lasso, from its events' times and the
@@ -127,11 +129,16 @@ fn a_false_liveness_property_gets_a_lasso_that_the_engine_confirms() {
         }
         other => panic!("came to {other:?}"),
     }
-    // And through the policy, the verdict is a violation with a lasso.
-    let (_, reports) = property::check_all(&content, &refs, &options());
+    // Through the policy, with an exploration too shallow to close the
+    // loop: IC3's lasso is the violation.
+    let mut shallow = options();
+    shallow.limits.depth = 1;
+    let (_, reports) = property::check_all(&content, &refs, &shallow);
+    assert!(matches!(reports[0].exhaustive, Some(Verdict::Bounded { .. })), "{:?}", reports[0].exhaustive);
     match &reports[0].conclusion {
-        Conclusion::Violated { counterexample, .. } => {
-            assert!(counterexample.reason.contains("repeat forever"))
+        Conclusion::Violated { by: Checker::Symbolic, how, counterexample } => {
+            assert!(counterexample.reason.contains("repeat forever"), "{}", counterexample.reason);
+            assert!(how.contains("lasso"), "{how}");
         }
         other => panic!("came to {other:?}"),
     }
