@@ -41,6 +41,11 @@
 //! infinite run of the abstraction — of every run when the abstraction is
 //! exact (payload classes, [`prove::sampled`]).
 //!
+//! Before the reduction, IC3 spends a tenth of the budget on the model's
+//! circuit alone on whether the obligation can arise at all: where Q holds
+//! wherever P does, that settles it, and the shadow latches make the same
+//! fact much harder for IC3 to find.
+//!
 //! A loop that IC3 finds is confirmed on the real engine: the prefix, then
 //! the loop three times, must keep the obligation pending from the loop's
 //! first point on and come back to the same abstract state
