@@ -44,7 +44,11 @@
 //! Before the reduction, IC3 spends a tenth of the budget on the model's
 //! circuit alone on whether the obligation can arise at all: where Q holds
 //! wherever P does, that settles it, and the shadow latches make the same
-//! fact much harder for IC3 to find.
+//! fact much harder for IC3 to find. Then short loops are looked for by
+//! bounded model checking of the loop circuit (up to [`BMC_DEPTH`] cycles,
+//! another tenth of the budget): IC3 finds a loop slowly, because a bad
+//! state fixes every latch and its shadow and IC3 walks back from it one
+//! state at a time.
 //!
 //! A loop that IC3 finds is confirmed on the real engine: the prefix, then
 //! the loop three times, must keep the obligation pending from the loop's
@@ -56,6 +60,7 @@
 //! confirmed again.
 
 use super::abstraction::Alphabet;
+use super::aig::Lit as ALit;
 use super::aig::{lit_value, not, Aig, Lit};
 use super::ic3::{self, Limits, Outcome};
 use super::model::{Model, Obligation};
@@ -63,6 +68,7 @@ use super::monitor::{Monitor, MonitorState};
 use super::prove;
 use super::random;
 use super::{Counterexample, RunStep, System, Verdict};
+use batsat::{lbool, BasicSolver, Lit as SLit, SolverInterface};
 use situ_compiler::bundle::Content;
 use situ_compiler::spec::PropertySpec;
 use std::cell::Cell;
@@ -71,6 +77,9 @@ use std::sync::Arc;
 /// The share of the budget (1 / QUICK) spent first on whether the
 /// obligation can arise at all.
 const QUICK: u64 = 10;
+
+/// The most cycles of the loop circuit unrolled to look for a short loop.
+const BMC_DEPTH: usize = 12;
 
 /// How many times a loop is replayed on the engine to confirm it.
 const CONFIRM: usize = 3;
@@ -147,7 +156,12 @@ pub fn check(
         return Some(Verdict::Inductive { frames, clauses, sampled: prove::sampled(alphabet) });
     }
     let r = Reduction::new(model, ob);
-    Some(match ic3::check(&r.aig, r.bad, limits) {
+    // Short loops first: IC3 walks back from a loop one state at a time.
+    let outcome = match bmc(&r.aig, r.bad, BMC_DEPTH, limits.work / QUICK) {
+        Some(inputs) => Outcome::Counterexample(inputs),
+        None => ic3::check(&r.aig, r.bad, limits),
+    };
+    Some(match outcome {
         Outcome::Proved { frames, clauses } => {
             Verdict::Inductive { frames, clauses, sampled: prove::sampled(alphabet) }
         }
@@ -171,6 +185,53 @@ pub fn check(
             }
         }
     })
+}
+
+/// Bounded model checking: the inputs of a run of at most `depth` cycles
+/// from the initial state to a `bad` state, looked for one depth after the
+/// other until `work` SAT propagations are spent.
+fn bmc(aig: &Aig, bad: Lit, depth: usize, work: u64) -> Option<Vec<Vec<bool>>> {
+    let mut s = BasicSolver::default();
+    let f = SLit::new(s.new_var_default(), true);
+    s.add_clause_reuse(&mut vec![!f]);
+    let lit = |frame: &[SLit], l: ALit| if l & 1 == 1 { !frame[(l >> 1) as usize] } else { frame[(l >> 1) as usize] };
+    let mut frames: Vec<Vec<SLit>> = Vec::new();
+    let start = s.num_propagations();
+    for t in 0..=depth {
+        let mut m = vec![f; aig.len()];
+        for &v in aig.inputs() {
+            m[v as usize] = SLit::new(s.new_var_default(), true);
+        }
+        for (i, &v) in aig.latches().iter().enumerate() {
+            m[v as usize] = match frames.last() {
+                None => f,
+                Some(prev) => lit(prev, aig.next_of(i)),
+            };
+        }
+        for v in 0..aig.len() as u32 {
+            if let Some((a, b)) = aig.gate(v) {
+                let x = SLit::new(s.new_var_default(), true);
+                let (la, lb) = (lit(&m, a), lit(&m, b));
+                s.add_clause_reuse(&mut vec![!x, la]);
+                s.add_clause_reuse(&mut vec![!x, lb]);
+                s.add_clause_reuse(&mut vec![x, !la, !lb]);
+                m[v as usize] = x;
+            }
+        }
+        let b = lit(&m, bad);
+        frames.push(m);
+        if s.solve_limited(&[b]) == lbool::TRUE {
+            let inputs = frames[..t]
+                .iter()
+                .map(|m| aig.inputs().iter().map(|&v| s.value_lit(m[v as usize]) == lbool::TRUE).collect())
+                .collect();
+            return Some(inputs);
+        }
+        if s.num_propagations() - start > work {
+            return None;
+        }
+    }
+    None
 }
 
 /// A run that breaks the property at a point (a cascade), shrunk.
@@ -310,4 +371,32 @@ pub fn confirmed(
         }
     }
     true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A two-bit counter that counts while its input holds: 3 is bad.
+    fn counter() -> (Aig, Lit) {
+        let mut g = Aig::new();
+        let go = g.input("go");
+        let b0 = g.latch("b0");
+        let b1 = g.latch("b1");
+        let n0 = g.xor(b0, go);
+        let carry = g.and(b0, go);
+        let n1 = g.xor(b1, carry);
+        g.set_next(b0, n0);
+        g.set_next(b1, n1);
+        let bad = g.and(b0, b1);
+        (g, bad)
+    }
+
+    #[test]
+    fn bounded_search_finds_the_shortest_run_within_its_depth() {
+        let (g, bad) = counter();
+        assert_eq!(bmc(&g, bad, 2, u64::MAX), None);
+        let run = bmc(&g, bad, 5, u64::MAX).expect("a run");
+        assert_eq!(run, vec![vec![true]; 3]);
+    }
 }
