@@ -204,8 +204,15 @@ fn cross_check(content: &Arc<bundle::Content>, props: &[PropertySpec]) -> usize 
         let proved = prover(content, &refs, i);
         match (&explored, &proved) {
             (Verdict::Proved { .. }, Some(Verdict::Inductive { .. })) => {}
-            (Verdict::Failed(_), Some(Verdict::Failed(c))) => {
-                assert!(c.reason.contains("repeat forever") || !c.steps.is_empty(), "{}: {c:?}", p.name)
+            (Verdict::Failed(e), Some(Verdict::Failed(c))) => {
+                // Both a lasso, or both a cascade.
+                let lasso = c.reason.contains("repeat forever");
+                assert_eq!(lasso, e.reason.contains("repeat forever"), "{}: {c:?} / {e:?}", p.name);
+                if lasso {
+                    let alphabet = Alphabet::new(content, &refs);
+                    let (prefix, cycle) = split(c);
+                    assert!(liveness::confirmed(content, &alphabet, p, &prefix, &cycle), "{}: {c:?}", p.name);
+                }
             }
             _ => panic!("{}: the exploration says {explored:?}, the prover {proved:?}", p.name),
         }
