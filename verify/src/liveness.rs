@@ -73,6 +73,7 @@ use situ_compiler::bundle::Content;
 use situ_compiler::spec::PropertySpec;
 use std::cell::Cell;
 use std::sync::Arc;
+use std::time::Instant;
 
 /// The share of the budget (1 / QUICK) spent first on whether the
 /// obligation can arise at all.
@@ -157,7 +158,7 @@ pub fn check(
     }
     let r = Reduction::new(model, ob);
     // Short loops first: IC3 walks back from a loop one state at a time.
-    let outcome = match bmc(&r.aig, r.bad, BMC_DEPTH, limits.work / QUICK) {
+    let outcome = match bmc(&r.aig, r.bad, BMC_DEPTH, Limits { work: limits.work / QUICK, ..limits }) {
         Some(inputs) => Outcome::Counterexample(inputs),
         None => ic3::check(&r.aig, r.bad, limits),
     };
@@ -189,8 +190,9 @@ pub fn check(
 
 /// Bounded model checking: the inputs of a run of at most `depth` cycles
 /// from the initial state to a `bad` state, looked for one depth after the
-/// other until `work` SAT propagations are spent.
-fn bmc(aig: &Aig, bad: Lit, depth: usize, work: u64) -> Option<Vec<Vec<bool>>> {
+/// other until the limits' work (SAT propagations) is spent or their
+/// deadline passed (checked between depths).
+fn bmc(aig: &Aig, bad: Lit, depth: usize, limits: Limits) -> Option<Vec<Vec<bool>>> {
     let mut s = BasicSolver::default();
     let f = SLit::new(s.new_var_default(), true);
     s.add_clause_reuse(&mut vec![!f]);
@@ -227,7 +229,8 @@ fn bmc(aig: &Aig, bad: Lit, depth: usize, work: u64) -> Option<Vec<Vec<bool>>> {
                 .collect();
             return Some(inputs);
         }
-        if s.num_propagations() - start > work {
+        let late = limits.deadline.is_some_and(|d| Instant::now() >= d);
+        if s.num_propagations() - start > limits.work || late {
             return None;
         }
     }
@@ -395,8 +398,8 @@ mod tests {
     #[test]
     fn bounded_search_finds_the_shortest_run_within_its_depth() {
         let (g, bad) = counter();
-        assert_eq!(bmc(&g, bad, 2, u64::MAX), None);
-        let run = bmc(&g, bad, 5, u64::MAX).expect("a run");
+        assert_eq!(bmc(&g, bad, 2, Limits::frames(0)), None);
+        let run = bmc(&g, bad, 5, Limits::frames(0)).expect("a run");
         assert_eq!(run, vec![vec![true]; 3]);
     }
 }

@@ -240,3 +240,19 @@ fn the_prover_agrees_with_the_exploration_where_it_settles() {
     compared += cross_check(&content, &props);
     assert!(compared >= 4, "only {compared} liveness properties settled by the exploration");
 }
+
+#[test]
+fn a_false_liveness_property_is_never_proved_at_any_budget() {
+    let (content, props) = load(TICKS);
+    let refs: Vec<&PropertySpec> = props.iter().collect();
+    for effort in [0, 1, 10, 100, 1_000, 10_000, 100_000] {
+        let mut opts = options();
+        opts.limits.depth = 1;
+        opts.effort = effort;
+        let (_, reports) = property::check_all(&content, &refs, &opts);
+        match &reports[0].conclusion {
+            Conclusion::Undecided { .. } | Conclusion::Violated { .. } => {}
+            other => panic!("effort {effort}: came to {other:?}"),
+        }
+    }
+}
