@@ -14,8 +14,9 @@
 //! - a latch that holds while the obligation was pending after every point
 //!   since the save (`now` at the save and at each later point);
 //!
-//! and its bad output is: saved, pending since, and the abstract state
-//! equal to its shadow — a loop of one or more points along which the
+//! and its bad output is: saved, pending since (and so the `pending` latch,
+//! said as well, so that IC3 can block a loop by the obligation alone), and
+//! the abstract state equal to its shadow — a loop of one or more points along which the
 //! obligation stays pending — or a cascade (which breaks every property,
 //! as in the explorer).
 //!
@@ -50,7 +51,8 @@
 //! state fixes every latch and its shadow and IC3 walks back from it one
 //! state at a time.
 //!
-//! A loop that IC3 finds is confirmed on the real engine: the prefix, then
+//! A loop that IC3 or the bounded search finds is confirmed on the real
+//! engine (as the explorer's lassos, up to its abstract state): the prefix, then
 //! the loop three times, must keep the obligation pending from the loop's
 //! first point on and come back to the same abstract state
 //! ([`Alphabet::key`]) after each copy; otherwise the verdict is
