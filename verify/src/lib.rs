@@ -23,6 +23,7 @@ pub mod abstraction;
 pub mod aig;
 pub mod explore;
 pub mod ic3;
+pub mod liveness;
 pub mod model;
 pub mod monitor;
 pub mod promela;

@@ -4,13 +4,14 @@
 //!
 //! - **Violated**: some checker found a run that breaks the property on the
 //!   real engine (the exploration's shortest first, then IC3's, then the
-//!   random search's; IC3's and the random search's are shrunk).
+//!   random search's; IC3's and the random search's are shrunk, IC3's
+//!   lassos confirmed on the engine).
 //! - **Proved**: the exploration closed an exact abstraction (every run,
 //!   liveness included), or IC3 closed an inductive invariant of an exact
-//!   abstraction (every run of any length, with any gaps).
+//!   abstraction (every run of any length, with any gaps; for an unbounded
+//!   `eventually`, of its liveness-to-safety circuit, [`liveness`]).
 //! - **Undecided**: everything else, with what each checker reached. A
-//!   bounded search, a sampled abstraction, a budget run out or an unbounded
-//!   `eventually` that only the exploration looked at are not proofs.
+//!   bounded search, a sampled abstraction or a budget run out are not proofs.
 //!
 //! Budgets are deterministic: the exploration counts states and events,
 //! IC3 frames and SAT propagations, the random search runs and events. The
@@ -25,6 +26,7 @@
 use super::abstraction::Alphabet;
 use super::explore::{Graph, Limits};
 use super::ic3;
+use super::liveness;
 use super::model::Model;
 use super::monitor::Monitor;
 use super::prove;
@@ -213,11 +215,14 @@ fn check_one(content: &Arc<Content>, s: &Session, i: usize, p: &PropertySpec, op
     let (symbolic, symbolic_note) = match &s.model {
         None => (None, None),
         Some(_) if settled => (None, None),
-        Some(_) if liveness => (
-            None,
-            Some("not run: an unbounded `eventually` is a liveness property, which IC3 does not prove here".into()),
-        ),
         Some(Err(why)) => (None, Some(format!("not run (no circuit: {why})"))),
+        Some(Ok(m)) if liveness => {
+            let start = Instant::now();
+            let v = liveness::check(content, &s.alphabet, m, i, p, limits(opts));
+            ic3_time = Some(start.elapsed());
+            let note = v.is_none().then(|| "not run: the circuit cannot say this property's predicates".to_string());
+            (v, note)
+        }
         Some(Ok(m)) => {
             let start = Instant::now();
             let v = prove::prove(content, &s.alphabet, m, i, p, limits(opts));
@@ -262,11 +267,12 @@ fn conclude(r: &Report, liveness: bool) -> Conclusion {
         return Conclusion::Violated { by: Checker::Exhaustive, how, counterexample: c };
     }
     if let Some(c) = failed(&r.symbolic) {
-        return Conclusion::Violated {
-            by: Checker::Symbolic,
-            how: "replayed on the engine, shrunk",
-            counterexample: c,
+        let how = if c.reason.contains("repeat forever") {
+            "a lasso, confirmed on the engine"
+        } else {
+            "replayed on the engine, shrunk"
         };
+        return Conclusion::Violated { by: Checker::Symbolic, how, counterexample: c };
     }
     if let Some(c) = failed(&r.random) {
         return Conclusion::Violated { by: Checker::Random, how: "shrunk", counterexample: c };
@@ -277,8 +283,15 @@ fn conclude(r: &Report, liveness: bool) -> Conclusion {
     if let Some(v @ Verdict::Proved { .. }) = &r.exhaustive {
         return Conclusion::Proved { by: Checker::Exhaustive, what: v.summary() };
     }
-    if let Some(v @ Verdict::Inductive { sampled: None, .. }) = &r.symbolic {
-        return Conclusion::Proved { by: Checker::Symbolic, what: v.summary() };
+    if let Some(v @ Verdict::Inductive { sampled: None, frames, clauses }) = &r.symbolic {
+        let what = if liveness {
+            format!(
+                "proved on every infinite run (IC3 on the liveness-to-safety circuit: an inductive invariant of {clauses} clauses at frame {frames})"
+            )
+        } else {
+            v.summary()
+        };
+        return Conclusion::Proved { by: Checker::Symbolic, what };
     }
     let mut reasons = Vec::new();
     for (name, v) in [("exhaustive", &r.exhaustive), ("symbolic", &r.symbolic), ("random", &r.random)] {
@@ -289,9 +302,10 @@ fn conclude(r: &Report, liveness: bool) -> Conclusion {
     if let Some(n) = &r.symbolic_note {
         reasons.push(format!("symbolic: {n}"));
     }
-    if liveness && !matches!(r.exhaustive, Some(Verdict::Proved { .. })) {
-        reasons
-            .push("an unbounded `eventually` is proved only by an exploration that closes an exact abstraction".into());
+    if liveness {
+        reasons.push(
+            "an unbounded `eventually` is proved by an exploration that closes an exact abstraction, or by IC3 on the liveness-to-safety circuit of an exact abstraction".into(),
+        );
     }
     Conclusion::Undecided { reasons }
 }

@@ -30,8 +30,11 @@
 //! - [`recency`]: the order of reports.
 //!
 //! Each property's bad-state output is its monitor failing at the point,
-//! or a cascade error. Unbounded `eventually` is a liveness property and
-//! has no bad-state output: only the explorer searches it.
+//! or a cascade error. Unbounded `always (P -> eventually Q)` is a
+//! liveness property and has no bad-state output: the circuit keeps its
+//! obligation ([`Obligation`], P seen and Q not yet), which
+//! [`liveness`](super::liveness) turns into a safety check of a larger
+//! circuit.
 //!
 //! The circuit is checked against the real engine by
 //! [`Model::simulate`]: the tests walk random runs on both and compare the
@@ -42,7 +45,7 @@ mod recency;
 mod rules;
 
 use super::abstraction::Alphabet;
-use super::aig::{lit_value, not, Aig, Lit, Word, FALSE, TRUE};
+use super::aig::{lit_value, not, Aig, Lit, Word, FALSE};
 use super::monitor::Monitor;
 use recency::Recency;
 use situ_compiler::bundle::{Behaviour, Content, Trigger};
@@ -91,6 +94,14 @@ pub struct Model {
     pub aig: Aig,
     /// Per property: its bad-state output (`None`: a liveness property).
     pub bad: Vec<Option<Lit>>,
+    /// Per property: the obligation of `always (P -> eventually Q)` without
+    /// a bound (`None` for every other property).
+    pub live: Vec<Option<Obligation>>,
+    /// The latches of the abstract state, on which every later point
+    /// depends: not the monitors, the last gap or the cascade latch.
+    pub system: Vec<Lit>,
+    /// The cascade latch: a cascade happened on the way to this point.
+    pub err: Lit,
     letter_in: Word,
     gap_in: Word,
     state: Word,
@@ -100,8 +111,16 @@ pub struct Model {
     fsm_code: Vec<Vec<usize>>,
     slots: Vec<Slot>,
     order: Recency,
-    err: Lit,
     n_letters: usize,
+}
+
+/// The pending obligation of a liveness property in the circuit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Obligation {
+    /// The latch: pending after the previous point.
+    pub pending: Lit,
+    /// Pending after this point: ¬Q ∧ (pending ∨ P), a function of the latches.
+    pub now: Lit,
 }
 
 /// Why a program has no circuit.
@@ -189,25 +208,22 @@ impl Model {
         // The point's predicates and monitors.
         let now: Vec<SlotVal> = slots.iter().map(|s| s.val()).collect();
         let mut bad = Vec::new();
+        let mut live = Vec::new();
         let mut monitor_next: Vec<(Word, Word)> = Vec::new();
         for (k, p) in properties.iter().enumerate() {
             let m = Monitor::new(p);
             if m.is_liveness() {
                 bad.push(None);
+                // A predicate the circuit cannot say leaves the property to the explorer.
+                let ob = match m.never {
+                    true => None,
+                    false => b.preds_of(p, &state, &state_code, &fsm, &fsm_code, &slots, &now).ok(),
+                };
+                live.push(ob.map(|(premise, q)| b.obligation(k, premise, q)));
                 continue;
             }
-            let (premise, q) = {
-                let mut preds = p.preds();
-                let premise = match &p.premise {
-                    Some(_) => {
-                        let pred = preds.next().expect("a premise");
-                        b.pred(pred, &state, &state_code, &fsm, &fsm_code, &slots, &now)?
-                    }
-                    None => TRUE,
-                };
-                let pred = preds.last().expect("a consequent");
-                (premise, b.pred(pred, &state, &state_code, &fsm, &fsm_code, &slots, &now)?)
-            };
+            live.push(None);
+            let (premise, q) = b.preds_of(p, &state, &state_code, &fsm, &fsm_code, &slots, &now)?;
             let (fail, latches, next) = b.monitor(k, m, premise, q, &last_gap)?;
             monitor_next.push((latches, next));
             let bad_k = b.aig.or(fail, err);
@@ -310,7 +326,30 @@ impl Model {
             set_word(aig, latches, next);
         }
         let aig = b.aig;
-        Ok(Model { aig, bad, letter_in, gap_in, state, state_code, fsm, fsm_code, slots, order, err, n_letters })
+        let mut system = state.bits.clone();
+        system.extend(fsm.iter().flatten().flat_map(|w| w.bits.iter().copied()));
+        for s in &slots {
+            for w in [&s.kind, &s.letter, &s.run, &s.age] {
+                system.extend(&w.bits);
+            }
+        }
+        system.extend(&order.newer);
+        Ok(Model {
+            aig,
+            bad,
+            live,
+            system,
+            err,
+            letter_in,
+            gap_in,
+            state,
+            state_code,
+            fsm,
+            fsm_code,
+            slots,
+            order,
+            n_letters,
+        })
     }
 
     /// The inputs that choose `letter` after a gap of `gap` ns (capped).
@@ -323,9 +362,11 @@ impl Model {
         v
     }
 
-    /// Which letter (out-of-range values read as 0) and gap the inputs choose.
+    /// Which letter (out-of-range values read as 0) and gap the inputs choose
+    /// (inputs past the model's own, added by a larger circuit, are ignored).
     pub fn choice(&self, inputs: &[bool]) -> (usize, u64) {
         let n = self.letter_in.bits.len();
+        let inputs = &inputs[..(n + self.gap_in.bits.len()).min(inputs.len())];
         let l = inputs[..n].iter().enumerate().map(|(i, &b)| (b as usize) << i).sum::<usize>();
         let g = inputs[n..].iter().enumerate().map(|(i, &b)| (b as u64) << i).sum::<u64>();
         (if l < self.n_letters { l } else { 0 }, g)

@@ -1,13 +1,50 @@
 //! The properties in the circuit: their predicates at the point the
 //! latches hold, and their monitors ([`Monitor`]) as latches.
 
-use super::{Builder, Slot, SlotVal, Unsupported, STALE};
+use super::{Builder, Obligation, Slot, SlotVal, Unsupported, STALE};
 use crate::aig::{not, Aig, Lit, Word, FALSE, TRUE};
 use crate::monitor::{Kind, Monitor};
 use situ_compiler::bundle::{Behaviour, Mode};
-use situ_compiler::spec::Pred;
+use situ_compiler::spec::{Pred, PropertySpec};
 
 impl Builder<'_> {
+    /// A property's premise (true without one) and consequent's predicate
+    /// at the point the latches hold.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn preds_of(
+        &mut self,
+        p: &PropertySpec,
+        state: &Word,
+        codes: &[usize],
+        fsm: &[Option<Word>],
+        fsm_code: &[Vec<usize>],
+        slots: &[Slot],
+        mem: &[SlotVal],
+    ) -> Result<(Lit, Lit), Unsupported> {
+        let mut preds = p.preds();
+        let premise = match &p.premise {
+            Some(_) => {
+                let pred = preds.next().expect("a premise");
+                self.pred(pred, state, codes, fsm, fsm_code, slots, mem)?
+            }
+            None => TRUE,
+        };
+        let pred = preds.last().expect("a consequent");
+        Ok((premise, self.pred(pred, state, codes, fsm, fsm_code, slots, mem)?))
+    }
+
+    /// The obligation of `always (p -> eventually q)` without a bound, as
+    /// [`Monitor::step`] keeps it: pending after a point where p held and q
+    /// did not, until a point where q holds.
+    pub(super) fn obligation(&mut self, k: usize, p: Lit, q: Lit) -> Obligation {
+        let aig = &mut self.aig;
+        let pending = aig.latch(&format!("p{k}.pending"));
+        let either = aig.or(pending, p);
+        let now = aig.and(either, not(q));
+        aig.set_next(pending, now);
+        Obligation { pending, now }
+    }
+
     /// A predicate of a property at the point the latches hold.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn pred(
