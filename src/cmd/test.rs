@@ -16,7 +16,7 @@ use situ_compiler::render;
 use situ_compiler::spec::{self, PropertySpec, TestSpec};
 use situ_grammar::diag::Diagnostic;
 use situ_verify::explore::Limits;
-use situ_verify::property::{self, Conclusion, Engines, Premise, Report};
+use situ_verify::property::{self, Checker, Conclusion, Engines, Premise, Report};
 use situ_verify::random::Search;
 use situ_verify::{scenario, show_event, Counterexample, Verdict};
 use std::path::PathBuf;
@@ -274,8 +274,13 @@ fn print_property(content: &Content, p: &PropertySpec, r: &Report) {
     };
     println!("property \"{}\" ... {head}", p.name);
     for (name, v) in [("exhaustive", &r.exhaustive), ("symbolic", &r.symbolic), ("random", &r.random)] {
-        if let Some(v) = v {
-            println!("    {name}: {}", v.summary());
+        match (&r.conclusion, v) {
+            // A liveness proof says what it covers (every infinite run).
+            (Conclusion::Proved { by: Checker::Symbolic, what }, Some(_)) if name == "symbolic" => {
+                println!("    {name}: {what}")
+            }
+            (_, Some(v)) => println!("    {name}: {}", v.summary()),
+            (_, None) => {}
         }
     }
     if let Some(n) = &r.symbolic_note {
