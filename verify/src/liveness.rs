@@ -170,14 +170,7 @@ pub fn check(
         }
         Outcome::Unknown { depth, work, stop } => Verdict::GaveUp { depth, work, stop },
         Outcome::Counterexample(inputs) => {
-            let run: Vec<RunStep> = inputs
-                .iter()
-                .map(|i| {
-                    let (l, gap) = model.choice(i);
-                    let letter = &alphabet.letters[l];
-                    RunStep { event: letter.event, payload: letter.payload.clone(), gap }
-                })
-                .collect();
+            let run: Vec<RunStep> = model.run_of(alphabet, &inputs);
             // The liveness monitor fails at no point: a failure is a cascade.
             if random::check_run(content, property, &run, &Cell::new(0)).is_err() {
                 return Some(cascade(content, alphabet, property, run));

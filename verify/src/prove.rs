@@ -46,14 +46,7 @@ pub fn prove(
         Outcome::Proved { frames, clauses } => Some(Verdict::Inductive { frames, clauses, sampled: sampled(alphabet) }),
         Outcome::Unknown { depth, work, stop } => Some(Verdict::GaveUp { depth, work, stop }),
         Outcome::Counterexample(inputs) => {
-            let run: Vec<RunStep> = inputs
-                .iter()
-                .map(|i| {
-                    let (l, gap) = model.choice(i);
-                    let letter = &alphabet.letters[l];
-                    RunStep { event: letter.event, payload: letter.payload.clone(), gap }
-                })
-                .collect();
+            let run: Vec<RunStep> = model.run_of(alphabet, &inputs);
             Some(match random::check_run(content, property, &run, &Cell::new(0)) {
                 Err((point, _)) => {
                     let run = random::shrink(content, alphabet, property, run[..point].to_vec());

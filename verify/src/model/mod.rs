@@ -372,6 +372,18 @@ impl Model {
         (if l < self.n_letters { l } else { 0 }, g)
     }
 
+    /// The run that a circuit's inputs choose, one event per cycle.
+    pub fn run_of(&self, alphabet: &Alphabet, inputs: &[Vec<bool>]) -> Vec<crate::RunStep> {
+        inputs
+            .iter()
+            .map(|i| {
+                let (l, gap) = self.choice(i);
+                let letter = &alphabet.letters[l];
+                crate::RunStep { event: letter.event, payload: letter.payload.clone(), gap }
+            })
+            .collect()
+    }
+
     /// One cycle: the latches after these inputs, and the value of every variable now.
     pub fn simulate(&self, latches: &[bool], inputs: &[bool]) -> (Vec<bool>, Vec<bool>) {
         let val = self.aig.eval(inputs, latches);
