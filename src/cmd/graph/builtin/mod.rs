@@ -210,13 +210,7 @@ fn path_d(pts: &[(f64, f64)], lr: bool) -> String {
         let (a, b) = (w[0], w[1]);
         if i % 2 == 1 {
             // A gap crossing: control points half-way along the rank axis.
-            let (c1, c2) = if lr {
-                let m = (a.0 + b.0) / 2.0;
-                ((m, a.1), (m, b.1))
-            } else {
-                let m = (a.1 + b.1) / 2.0;
-                ((a.0, m), (b.0, m))
-            };
+            let (c1, c2) = place::crossing_controls(a, b, lr);
             let _ = write!(d, " C{:.2},{:.2} {:.2},{:.2} {:.2},{:.2}", c1.0, c1.1, c2.0, c2.1, b.0, b.1);
         } else {
             let _ = write!(d, " L{:.2},{:.2}", b.0, b.1);

@@ -362,15 +362,22 @@ fn squeeze(layers: &[Vec<Item>], across: &mut [Vec<f64>], extent: &dyn Fn(&Item)
     }
 }
 
-/// A point of the gap crossing from `a` to `b` (the curve the SVG draws there).
-fn on_crossing(a: (f64, f64), b: (f64, f64), t: f64, lr: bool) -> (f64, f64) {
-    let (c1, c2) = if lr {
+/// The control points of the cubic that crosses a gap from `a` to `b`:
+/// half-way along the rank axis. The SVG draws it (`path_d`) and labels are
+/// kept off it (`on_crossing`) with these same points.
+pub(super) fn crossing_controls(a: (f64, f64), b: (f64, f64), lr: bool) -> ((f64, f64), (f64, f64)) {
+    if lr {
         let m = (a.0 + b.0) / 2.0;
         ((m, a.1), (m, b.1))
     } else {
         let m = (a.1 + b.1) / 2.0;
         ((a.0, m), (b.0, m))
-    };
+    }
+}
+
+/// A point of the gap crossing from `a` to `b` (the curve the SVG draws there).
+fn on_crossing(a: (f64, f64), b: (f64, f64), t: f64, lr: bool) -> (f64, f64) {
+    let (c1, c2) = crossing_controls(a, b, lr);
     let u = 1.0 - t;
     let f = |p: f64, q: f64, r: f64, s: f64| u * u * u * p + 3.0 * u * u * t * q + 3.0 * u * t * t * r + t * t * t * s;
     (f(a.0, c1.0, c2.0, b.0), f(a.1, c1.1, c2.1, b.1))
