@@ -689,3 +689,36 @@ pub struct ScriptEvent {
     pub arguments: Vec<Argument>,
     pub span: Span,
 }
+
+/// A file's AST as JSON with its places left out: every `span` and `*_span`
+/// key dropped, every other span (as in `initial: Some(span)`) replaced by a
+/// marker so that its presence still counts. Two texts that mean the same
+/// have the same shape; the formatter's round trip and the layout tests
+/// compare it.
+pub fn shape(file: &File) -> serde_json::Value {
+    let mut v = serde_json::to_value(file).expect("the AST serializes to JSON");
+    strip_spans(&mut v);
+    v
+}
+
+/// Whether a JSON value is a serialized `Span`.
+fn is_span(v: &serde_json::Value) -> bool {
+    use serde_json::Value;
+    matches!(v, Value::Object(m) if m.len() == 2 && m.get("start").is_some_and(Value::is_u64) && m.get("end").is_some_and(Value::is_u64))
+}
+
+fn strip_spans(v: &mut serde_json::Value) {
+    use serde_json::Value;
+    if is_span(v) {
+        *v = Value::String("<span>".into());
+        return;
+    }
+    match v {
+        Value::Object(m) => {
+            m.retain(|k, _| k != "span" && !k.ends_with("_span"));
+            m.values_mut().for_each(strip_spans);
+        }
+        Value::Array(a) => a.iter_mut().for_each(strip_spans),
+        _ => {}
+    }
+}

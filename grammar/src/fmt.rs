@@ -415,11 +415,7 @@ fn code_end(src: &str, span: Span) -> usize {
                 continue;
             }
             b'"' => {
-                i += 1;
-                while i < bytes.len() && bytes[i] != b'"' && bytes[i] != b'\n' {
-                    i += if bytes[i] == b'\\' { 2 } else { 1 };
-                }
-                i = (i + 1).min(bytes.len());
+                i = crate::lex::skip_string(bytes, i);
                 end = i;
                 continue;
             }

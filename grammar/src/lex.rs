@@ -59,7 +59,7 @@ fn next_line_starts_item(bytes: &[u8], newline: usize) -> bool {
 
 /// Skips a string literal that starts at `i` (a `"`); returns the index after
 /// its closing quote, or after the end of the line if it is not closed.
-fn skip_string(bytes: &[u8], mut i: usize) -> usize {
+pub(crate) fn skip_string(bytes: &[u8], mut i: usize) -> usize {
     i += 1;
     while i < bytes.len() {
         match bytes[i] {

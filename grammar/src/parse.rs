@@ -12,6 +12,7 @@ use std::sync::{Mutex, Once};
 
 mod hints;
 mod report;
+mod vocab;
 
 use report::syntax_error;
 

@@ -88,11 +88,7 @@ fn code_len(text: &str) -> usize {
                 }
             }
             b'"' => {
-                i += 1;
-                while i < bytes.len() && bytes[i] != b'"' && bytes[i] != b'\n' {
-                    i += if bytes[i] == b'\\' { 2 } else { 1 };
-                }
-                i = (i + 1).min(bytes.len());
+                i = crate::lex::skip_string(bytes, i);
                 end = i;
             }
             c if c.is_ascii_whitespace() => i += 1,

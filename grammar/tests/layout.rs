@@ -81,24 +81,6 @@ fn reindent(src: &str, seed: u64) -> String {
     out
 }
 
-/// Whether a JSON value is a serialized `Span`.
-fn is_span(v: &Value) -> bool {
-    matches!(v, Value::Object(m) if m.len() == 2 && m.get("start").is_some_and(Value::is_u64) && m.get("end").is_some_and(Value::is_u64))
-}
-
-/// Replaces every span by a marker.
-fn strip_spans(v: &mut Value) {
-    if is_span(v) {
-        *v = Value::String("<span>".into());
-        return;
-    }
-    match v {
-        Value::Object(m) => m.values_mut().for_each(strip_spans),
-        Value::Array(a) => a.iter_mut().for_each(strip_spans),
-        _ => {}
-    }
-}
-
 /// The 1-based line of a byte offset.
 fn line(src: &str, at: usize) -> usize {
     src[..at.min(src.len())].matches('\n').count() + 1
@@ -109,8 +91,7 @@ fn line(src: &str, at: usize) -> usize {
 /// lines (not the columns) they point at.
 fn meaning(src: &str) -> (Value, Vec<String>, Vec<String>) {
     let parsed = parse(src, FileId(0));
-    let mut ast = serde_json::to_value(&parsed.file).expect("the AST serializes");
-    strip_spans(&mut ast);
+    let ast = situ_grammar::ast::shape(&parsed.file);
     let comments = parsed.comments.iter().map(|c| format!("{}: {}", line(src, c.span.start), c.text)).collect();
     let diagnostics = parsed
         .errors

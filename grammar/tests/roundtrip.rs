@@ -31,33 +31,9 @@ fn situ_files(dir: &Path) -> Vec<PathBuf> {
     out
 }
 
-/// Whether a JSON value is a serialized `Span`.
-fn is_span(v: &Value) -> bool {
-    matches!(v, Value::Object(m) if m.len() == 2 && m.get("start").is_some_and(Value::is_u64) && m.get("end").is_some_and(Value::is_u64))
-}
-
-/// Removes every `span` and `*_span` key, and replaces every other span (as in
-/// `initial: Some(span)`) by a marker, so that presence still counts.
-fn strip_spans(v: &mut Value) {
-    if is_span(v) {
-        *v = Value::String("<span>".into());
-        return;
-    }
-    match v {
-        Value::Object(m) => {
-            m.retain(|k, _| k != "span" && !k.ends_with("_span"));
-            m.values_mut().for_each(strip_spans);
-        }
-        Value::Array(a) => a.iter_mut().for_each(strip_spans),
-        _ => {}
-    }
-}
-
 /// The AST of a source, as JSON without spans.
 fn ast(src: &str) -> Value {
-    let mut v = serde_json::to_value(&parse(src, FileId(0)).file).expect("the AST serializes");
-    strip_spans(&mut v);
-    v
+    situ_grammar::ast::shape(&parse(src, FileId(0)).file)
 }
 
 /// The comment texts of a source, sorted.

@@ -222,6 +222,39 @@ pub(crate) fn symbol_enums(events: &[&bundle::EventDef]) -> Vec<String> {
     unique(names)
 }
 
+/// The type of every field of `events`, event by event, as a language names
+/// it: `scalars` gives the names of `f64`, `i64` and `bool`; a symbol field's
+/// type is its enum (named by `symbol_enums`), whose definition `write_enum`
+/// appends to `out` (with the enum's name, the event, the field and its
+/// symbols) where the walk meets it. One walk for both code generators.
+pub(crate) fn field_types(
+    out: &mut String,
+    events: &[&bundle::EventDef],
+    scalars: [&str; 3],
+    mut write_enum: impl FnMut(&mut String, &str, &bundle::EventDef, &bundle::FieldDef, &[String]),
+) -> Vec<Vec<String>> {
+    let enum_names = symbol_enums(events);
+    let mut enums = enum_names.iter();
+    let mut all = Vec::with_capacity(events.len());
+    for e in events {
+        let mut types = Vec::with_capacity(e.fields.len());
+        for f in &e.fields {
+            types.push(match &f.ty {
+                bundle::FieldType::F64 => scalars[0].to_string(),
+                bundle::FieldType::I64 => scalars[1].to_string(),
+                bundle::FieldType::Bool => scalars[2].to_string(),
+                bundle::FieldType::Symbols(symbols) => {
+                    let name = enums.next().cloned().unwrap_or_default();
+                    write_enum(out, &name, e, f, symbols);
+                    name
+                }
+            });
+        }
+        all.push(types);
+    }
+    all
+}
+
 /// Makes every name of `names` unique by appending a number to repeats.
 pub(crate) fn unique(names: Vec<String>) -> Vec<String> {
     let mut seen: Vec<String> = Vec::new();

@@ -14,7 +14,7 @@
 //! settings): one item per line with trailing commas wherever a line could
 //! grow past 88 characters.
 
-use super::{links_out, one_line, quote, snake, symbol_enums, table_actions, unique, Header};
+use super::{field_types, links_out, one_line, quote, snake, table_actions, unique, Header};
 use crate::bundle::{Action, AgentDef, Behaviour, Content, FieldType, Mode, Trigger};
 use std::fmt::Write;
 
@@ -83,31 +83,15 @@ pub(crate) fn generate(content: &Content, me: u32, header: &Header<'_>) -> Strin
 
     // An enum per symbol field, a function per event.
     let events: Vec<&crate::bundle::EventDef> = def.events.iter().map(|&e| &content.events[e as usize]).collect();
-    let enum_names = symbol_enums(&events);
-    let mut enums = enum_names.iter();
-    let mut field_types: Vec<Vec<String>> = Vec::new();
-    for e in &events {
-        let mut types = Vec::new();
-        for f in &e.fields {
-            types.push(match &f.ty {
-                FieldType::F64 => "float".to_string(),
-                FieldType::I64 => "int".to_string(),
-                FieldType::Bool => "bool".to_string(),
-                FieldType::Symbols(symbols) => {
-                    let name = enums.next().cloned().unwrap_or_default();
-                    let _ = writeln!(out, "class {name}(_enum.Enum):");
-                    let _ = writeln!(out, "    \"\"\"The symbols of `{}.{}`.\"\"\"\n", e.name, f.name);
-                    let members = unique(symbols.iter().map(|s| s.to_uppercase()).collect());
-                    for (m, s) in members.iter().zip(symbols) {
-                        let _ = writeln!(out, "    {} = {}", ident(m.clone()), quote(s));
-                    }
-                    out.push_str("\n\n");
-                    name
-                }
-            });
+    let field_types = field_types(&mut out, &events, ["float", "int", "bool"], |out, name, e, f, symbols| {
+        let _ = writeln!(out, "class {name}(_enum.Enum):");
+        let _ = writeln!(out, "    \"\"\"The symbols of `{}.{}`.\"\"\"\n", e.name, f.name);
+        let members = unique(symbols.iter().map(|s| s.to_uppercase()).collect());
+        for (m, s) in members.iter().zip(symbols) {
+            let _ = writeln!(out, "    {} = {}", ident(m.clone()), quote(s));
         }
-        field_types.push(types);
-    }
+        out.push_str("\n\n");
+    });
     let event_fns = unique(events.iter().map(|e| ident(snake(&e.name))).collect());
     for ((e, types), fname) in events.iter().zip(&field_types).zip(&event_fns) {
         let params: Vec<String> =

@@ -8,7 +8,7 @@
 //! 120, `use_small_heuristics = "Max"`): code lines are kept short, and the
 //! data tables carry `#[rustfmt::skip]`, one entry a line.
 
-use super::{camel, one_line, quote, snake, symbol_enums, table_actions, unique, Header};
+use super::{camel, field_types, one_line, quote, snake, table_actions, unique, Header};
 use crate::bundle::{Action, AgentDef, Behaviour, Content, FieldType, Mode, Trigger};
 use std::fmt::Write;
 
@@ -183,40 +183,24 @@ pub struct Transition {
     }
 
     // An enum per symbol field.
-    let enum_names = symbol_enums(&events);
-    let mut enums = enum_names.iter();
-    let mut field_types: Vec<Vec<String>> = Vec::new();
-    for e in &events {
-        let mut types = Vec::new();
-        for f in &e.fields {
-            types.push(match &f.ty {
-                FieldType::F64 => "f64".to_string(),
-                FieldType::I64 => "i64".to_string(),
-                FieldType::Bool => "bool".to_string(),
-                FieldType::Symbols(symbols) => {
-                    let name = enums.next().cloned().unwrap_or_default();
-                    let variants = unique(symbols.iter().map(|s| camel(s)).collect());
-                    let _ = writeln!(out, "/// The symbols of `{}.{}`.", e.name, f.name);
-                    out.push_str("#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]\n");
-                    let _ = writeln!(out, "pub enum {name} {{");
-                    for v in &variants {
-                        let _ = writeln!(out, "    {v},");
-                    }
-                    let _ = writeln!(out, "}}\n\nimpl {name} {{");
-                    out.push_str("    /// The symbol as the rules write it.\n");
-                    out.push_str("    pub fn name(self) -> &'static str {\n        match self {\n");
-                    for (v, s) in variants.iter().zip(symbols) {
-                        let _ = writeln!(out, "            {name}::{v} => {},", quote(s));
-                    }
-                    out.push_str("        }\n    }\n\n");
-                    out.push_str("    /// Its index in the field's type (a payload's `Value::Symbol`).\n");
-                    out.push_str("    pub fn index(self) -> u32 {\n        self as u32\n    }\n}\n\n");
-                    name
-                }
-            });
+    let field_types = field_types(&mut out, &events, ["f64", "i64", "bool"], |out, name, e, f, symbols| {
+        let variants = unique(symbols.iter().map(|s| camel(s)).collect());
+        let _ = writeln!(out, "/// The symbols of `{}.{}`.", e.name, f.name);
+        out.push_str("#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]\n");
+        let _ = writeln!(out, "pub enum {name} {{");
+        for v in &variants {
+            let _ = writeln!(out, "    {v},");
         }
-        field_types.push(types);
-    }
+        let _ = writeln!(out, "}}\n\nimpl {name} {{");
+        out.push_str("    /// The symbol as the rules write it.\n");
+        out.push_str("    pub fn name(self) -> &'static str {\n        match self {\n");
+        for (v, s) in variants.iter().zip(symbols) {
+            let _ = writeln!(out, "            {name}::{v} => {},", quote(s));
+        }
+        out.push_str("        }\n    }\n\n");
+        out.push_str("    /// Its index in the field's type (a payload's `Value::Symbol`).\n");
+        out.push_str("    pub fn index(self) -> u32 {\n        self as u32\n    }\n}\n\n");
+    });
 
     // The user trait: one method per function.
     let _ = writeln!(out, "/// Your code for `{}`: one method per function of its table or FSM.", def.name);

@@ -323,7 +323,7 @@ pub(super) fn wrong_word(cx: &Cx) -> Option<Advice> {
     if !t.word() || t.start != cx.pos {
         return None;
     }
-    let implied = cx.exp.rules.iter().flat_map(|r| crate::parse::report::implied(*r).iter().copied());
+    let implied = cx.exp.rules.iter().flat_map(|r| crate::parse::vocab::implied(*r).iter().copied());
     let words: Vec<&str> = cx
         .exp
         .literals
