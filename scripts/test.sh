@@ -34,7 +34,7 @@ echo "== situ, CLIPS and the hand-written matcher reach the same states"
 PROFILE=debug EVENTS=200000 bash bench/vs-clips.sh
 
 echo "== spin and situ agree on the properties (Promela export)"
-bash verify/spin-check.sh
+SITU=target/debug/situ bash verify/spin-check.sh
 
 echo "== ABC and situ agree on the properties (AIGER export of the circuit; pdr and int)"
 SITU=target/debug/situ bash verify/abc-check.sh
