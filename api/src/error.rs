@@ -1,0 +1,34 @@
+//! The one error type of the facade: each variant says what failed and
+//! where, and keeps what a client needs to show it (the findings of a
+//! source that does not check, the bundle's own error).
+
+use situ_compiler::bundle::{sign::TrustError, LoadError};
+use situ_compiler::{Checked, RootError};
+use std::path::PathBuf;
+
+/// Why an operation of the facade did not complete.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A file could not be read (missing, not a regular file, too large).
+    #[error("cannot read `{}`: {source}", path.display())]
+    Read { path: PathBuf, source: std::io::Error },
+    /// The root file of a check could not be loaded at all.
+    #[error(transparent)]
+    Root(#[from] RootError),
+    /// The source has errors (or warnings, when they are denied): the
+    /// findings are in `checked`.
+    #[error("`{name}` has {errors} error(s) and {warnings} warning(s)")]
+    Findings { name: String, errors: usize, warnings: usize, checked: Box<Checked> },
+    /// Formatting refused a source with syntax errors.
+    #[error("the source has {} syntax error(s): it is not formatted", .0.len())]
+    Syntax(Vec<situ_compiler::Diagnostic>),
+    /// A source was given where only signed bundles are trusted.
+    #[error("`{}` is a source, which carries no signature: with --trust only bundles signed by a trusted key run", path.display())]
+    UnsignedSource { path: PathBuf },
+    /// A bundle is damaged, of another format version, or was changed.
+    #[error(transparent)]
+    Bundle(#[from] LoadError),
+    /// A bundle is not signed by a trusted key.
+    #[error(transparent)]
+    Trust(#[from] TrustError),
+}
