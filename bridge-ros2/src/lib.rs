@@ -9,6 +9,7 @@
 //!   CDR samples, the publishers, the lifecycle service clients, the loop;
 //! - [`bag`]: the recording, a ROS 2 bag (MCAP storage) of what came and went;
 //! - [`msgs`]: the ROS 2 messages and services it writes, as serde types;
+//! - [`raw`]: a sample's bytes as they came, the reader type of every topic;
 //! - [`service`]: its service client (lifecycle requests) on RustDDS;
 //! - [`xcdr2`]: XCDR2 samples read into the XCDR1 the map's decoder reads.
 
@@ -16,5 +17,6 @@ pub mod bag;
 pub mod core;
 pub mod dds;
 pub mod msgs;
+pub mod raw;
 pub mod service;
 pub mod xcdr2;

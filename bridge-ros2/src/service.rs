@@ -16,7 +16,7 @@
 //!   32-bit halves, high first (`service/wrappers.rs`, `CycloneHeader`),
 //!   which an `int64` reader reads as `2 << 32` for 2. Here it is one `i64`.
 
-use crate::dds::{Raw, RawAdapter, Rmw};
+use crate::raw::{Never, Raw, RawAdapter};
 use rustdds::bytes::Bytes;
 use rustdds::no_key::{self, DataReader, DataWriter};
 use rustdds::{DomainParticipant, QosPolicies, RepresentationIdentifier, SampleIdentity, TopicKind};
@@ -26,6 +26,15 @@ use serde::Serialize;
 use std::marker::PhantomData;
 use std::time::{Duration, Instant};
 
+/// How the lifecycle services are carried: the RMW of the nodes' ROS 2.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Rmw {
+    /// `rmw_cyclonedds_cpp`: a request header in the payload.
+    CycloneDds,
+    /// `rmw_fastrtps_cpp` (ROS 2's default): the request id in inline QoS.
+    FastRtps,
+}
+
 /// A request's bytes as they go on the wire, after the encapsulation header.
 pub struct Payload(pub Vec<u8>);
 
@@ -33,7 +42,7 @@ pub struct Payload(pub Vec<u8>);
 pub struct PayloadAdapter;
 
 impl no_key::SerializerAdapter<Payload> for PayloadAdapter {
-    type Error = crate::dds::Never;
+    type Error = Never;
 
     fn output_encoding() -> RepresentationIdentifier {
         RepresentationIdentifier::CDR_LE

@@ -8,8 +8,9 @@
 use rustdds::no_key::{DataReader, DataWriter};
 use rustdds::{DomainParticipant, QosPolicyBuilder, RepresentationIdentifier, StatusEvented, TopicKind};
 use situ_bridge_ros2::core::Core;
-use situ_bridge_ros2::dds::{self, Never, Options, Raw, RawAdapter, Report, Rmw};
+use situ_bridge_ros2::dds::{self, Options, Report, Rmw};
 use situ_bridge_ros2::msgs::{self, ChangeStateResponse, DiagnosticArray, GetStateResponse, Header, LaserScan, State};
+use situ_bridge_ros2::raw::{Never, Raw, RawAdapter};
 use situ_bridge_ros2::service::{self, Payload, PayloadAdapter};
 use situ_compiler::{bundle, check_source};
 use situ_grammar::diag::FileId;
