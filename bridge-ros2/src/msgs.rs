@@ -73,9 +73,9 @@ pub struct LaserScan {
 
 /// A message's CDR bytes as ROS 2 sends them: the little-endian
 /// encapsulation header, then the fields.
-pub fn to_cdr<T: Serialize>(msg: &T) -> Result<Vec<u8>, String> {
+pub fn to_cdr<T: Serialize>(msg: &T) -> Result<Vec<u8>, rustdds::cdr_encoding::Error> {
     let mut bytes = vec![0, 1, 0, 0];
-    bytes.extend(rustdds::cdr_encoding::to_vec::<T, byteorder::LittleEndian>(msg).map_err(|e| e.to_string())?);
+    bytes.extend(rustdds::cdr_encoding::to_vec::<T, byteorder::LittleEndian>(msg)?);
     Ok(bytes)
 }
 

@@ -19,18 +19,39 @@ pub fn is_xcdr2(cdr: &[u8]) -> bool {
     matches!(cdr, [0, 6..=9, ..])
 }
 
+/// Why a sample is not read as XCDR2.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum Xcdr2Error {
+    #[error("{len} bytes, too short for the 4-byte encapsulation header")]
+    TooShort { len: usize },
+    #[error("encapsulation {0:02x} {1:02x} is not XCDR2")]
+    NotXcdr2(u8, u8),
+    #[error("`{0}` is not a message type of the catalogue")]
+    UnknownType(&'static str),
+    #[error("{needed} bytes needed at {at}, {left} left")]
+    Truncated { needed: usize, at: usize, left: usize },
+    #[error("a DHEADER of {len} bytes, {left} left")]
+    Dheader { len: usize, left: usize },
+    #[error("`{0}` runs past its DHEADER")]
+    PastDheader(&'static str),
+    #[error("{count} elements, {left} bytes left")]
+    Elements { count: usize, left: usize },
+    #[error("a sequence runs past its DHEADER")]
+    SequencePastDheader,
+}
+
 /// The message `ty` (a full name of the catalogue) of the XCDR2 sample
 /// `cdr` (its encapsulation header included), as plain little-endian CDR.
-pub fn to_xcdr1(ty: &'static str, cdr: &[u8]) -> Result<Vec<u8>, String> {
+pub fn to_xcdr1(ty: &'static str, cdr: &[u8]) -> Result<Vec<u8>, Xcdr2Error> {
     let Some((header, body)) = cdr.split_first_chunk::<4>() else {
-        return Err(format!("{} bytes, too short for the 4-byte encapsulation header", cdr.len()));
+        return Err(Xcdr2Error::TooShort { len: cdr.len() });
     };
     let (little, delimited) = match (header[0], header[1]) {
         (0, 6) => (false, false),
         (0, 7) => (true, false),
         (0, 8) => (false, true),
         (0, 9) => (true, true),
-        (a, b) => return Err(format!("encapsulation {a:02x} {b:02x} is not XCDR2")),
+        (a, b) => return Err(Xcdr2Error::NotXcdr2(a, b)),
     };
     let mut t = Transcoder { input: body, pos: 0, little, delimited, out: vec![0, 1, 0, 0] };
     t.msg(ty)?;
@@ -57,19 +78,19 @@ fn width(ty: &str) -> usize {
 
 impl Transcoder<'_> {
     /// `n` bytes aligned to `align` (at most 4 in XCDR2).
-    fn read(&mut self, n: usize, align: usize) -> Result<&[u8], String> {
+    fn read(&mut self, n: usize, align: usize) -> Result<&[u8], Xcdr2Error> {
         let align = align.min(4);
         let start = self.pos.next_multiple_of(align);
         let bytes = self.input.get(start..).and_then(|b| b.get(..n));
-        let bytes =
-            bytes.ok_or_else(|| format!("{n} bytes needed at {start}, {} left", self.input.len() - self.pos))?;
+        let bytes = bytes.ok_or(Xcdr2Error::Truncated { needed: n, at: start, left: self.input.len() - self.pos })?;
         self.pos = start + n;
         Ok(bytes)
     }
 
-    fn u32(&mut self) -> Result<u32, String> {
+    fn u32(&mut self) -> Result<u32, Xcdr2Error> {
         let little = self.little;
-        let b: [u8; 4] = self.read(4, 4)?.try_into().map_err(|_| "a u32")?;
+        let b = self.read(4, 4)?;
+        let b = [b[0], b[1], b[2], b[3]];
         Ok(if little { u32::from_le_bytes(b) } else { u32::from_be_bytes(b) })
     }
 
@@ -94,15 +115,15 @@ impl Transcoder<'_> {
     }
 
     /// A DHEADER: the end of what it delimits.
-    fn dheader(&mut self) -> Result<usize, String> {
+    fn dheader(&mut self) -> Result<usize, Xcdr2Error> {
         let len = self.u32()? as usize;
         let end = self.pos.checked_add(len).filter(|&e| e <= self.input.len());
-        end.ok_or_else(|| format!("a DHEADER of {len} bytes, {} left", self.input.len() - self.pos))
+        end.ok_or(Xcdr2Error::Dheader { len, left: self.input.len() - self.pos })
     }
 
-    fn msg(&mut self, ty: &'static str) -> Result<(), String> {
+    fn msg(&mut self, ty: &'static str) -> Result<(), Xcdr2Error> {
         let end = if self.delimited { Some(self.dheader()?) } else { None };
-        let text = CATALOGUE.iter().find(|(n, _)| *n == ty).map(|(_, t)| *t).ok_or(ty)?;
+        let text = CATALOGUE.iter().find(|(n, _)| *n == ty).map(|(_, t)| *t).ok_or(Xcdr2Error::UnknownType(ty))?;
         if text.trim().is_empty() {
             // The DDS type of an empty ROS 2 message has one octet.
             let octet = self.read(1, 1)?.to_vec();
@@ -115,14 +136,14 @@ impl Transcoder<'_> {
         }
         if let Some(end) = end {
             if self.pos > end {
-                return Err(format!("`{ty}` runs past its DHEADER"));
+                return Err(Xcdr2Error::PastDheader(ty));
             }
             self.pos = end; // members a newer definition appended
         }
         Ok(())
     }
 
-    fn field(&mut self, base: &str, field: &FieldType) -> Result<(), String> {
+    fn field(&mut self, base: &str, field: &FieldType) -> Result<(), Xcdr2Error> {
         match field {
             FieldType::Prim(msgs::Prim::String) => {
                 let len = self.u32()?;
@@ -148,7 +169,7 @@ impl Transcoder<'_> {
                     }
                 };
                 if count > self.input.len() - self.pos {
-                    return Err(format!("{count} elements, {} bytes left", self.input.len() - self.pos));
+                    return Err(Xcdr2Error::Elements { count, left: self.input.len() - self.pos });
                 }
                 if count == 0 {
                     // Nothing, not even the padding before the elements.
@@ -164,7 +185,7 @@ impl Transcoder<'_> {
                 }
                 if let Some(end) = end {
                     if self.pos > end {
-                        return Err("a sequence runs past its DHEADER".into());
+                        return Err(Xcdr2Error::SequencePastDheader);
                     }
                 }
             }
@@ -200,12 +221,15 @@ mod tests {
         let mut v2 = vec![0, 9, 0, 0];
         v2.extend(u32::MAX.to_le_bytes());
         let e = to_xcdr1("geometry_msgs/msg/Point", &v2).unwrap_err();
-        assert!(e.contains("DHEADER of 4294967295 bytes"), "{e}");
+        assert!(e.to_string().contains("DHEADER of 4294967295 bytes"), "{e}");
         let mut v2 = vec![0, 7, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0];
         v2.extend(4_000_000_000u32.to_le_bytes());
         assert!(to_xcdr1("diagnostic_msgs/msg/DiagnosticArray", &v2).is_err());
         assert!(to_xcdr1("std_msgs/msg/Bool", &[0, 7]).is_err());
-        assert!(to_xcdr1("std_msgs/msg/Bool", &[0, 1, 0, 0, 1]).unwrap_err().contains("00 01 is not XCDR2"));
+        assert!(to_xcdr1("std_msgs/msg/Bool", &[0, 1, 0, 0, 1])
+            .unwrap_err()
+            .to_string()
+            .contains("00 01 is not XCDR2"));
     }
 
     #[test]

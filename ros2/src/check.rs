@@ -460,7 +460,7 @@ pub fn bad_nodes(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
         if let (Some(t), Err(reason)) = (&n.timeout, n.timeout()) {
             out.push(bad(
                 t,
-                reason,
+                reason.to_string(),
                 "not a timeout",
                 "write a whole number of `ms` or `s`, e.g. `timeout = \"500ms\"`",
             ));

@@ -229,20 +229,31 @@ fn binary<'a>(op: BinOp, l: &'a Expr, r: &'a Expr, msg: &'a cdr::Value, range: R
     }
 }
 
+/// Why a value does not fit a payload field.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PayloadError {
+    #[error("is {0}, not a finite number")]
+    NotFinite(f64),
+    #[error("`{value}` is not one of {symbols}")]
+    NotASymbol { value: String, symbols: String },
+    #[error("is {found}, not {expected}")]
+    WrongType { found: &'static str, expected: String },
+}
+
 /// A value as the runtime takes it for a payload field of type `ty`.
-pub fn to_payload(v: Val<'_>, ty: &Type) -> Result<Value, String> {
+pub fn to_payload(v: Val<'_>, ty: &Type) -> Result<Value, PayloadError> {
     match (ty, v) {
         (Type::F64, Val::Int(i)) => Ok(Value::F64(i as f64)),
         (Type::F64, Val::Float(f)) if f.is_finite() => Ok(Value::F64(f)),
-        (Type::F64, Val::Float(f)) => Err(format!("is {f}, not a finite number")),
+        (Type::F64, Val::Float(f)) => Err(PayloadError::NotFinite(f)),
         (Type::I64, Val::Int(i)) => Ok(Value::I64(i)),
         (Type::I64, Val::Float(f)) if f.fract() == 0.0 && f.abs() <= EXACT => Ok(Value::I64(f as i64)),
         (Type::Bool, Val::Bool(b)) => Ok(Value::Bool(b)),
         (Type::Symbols(symbols), Val::Str(s)) => match symbols.iter().position(|x| x == s) {
             Some(i) => Ok(Value::Symbol(u32::try_from(i).unwrap_or(u32::MAX))),
-            None => Err(format!("`{s}` is not one of {}", symbols.join(", "))),
+            None => Err(PayloadError::NotASymbol { value: s.to_string(), symbols: symbols.join(", ") }),
         },
-        (ty, v) => Err(format!("is {}, not {}", describe(&v), ty.describe())),
+        (ty, v) => Err(PayloadError::WrongType { found: describe(&v), expected: ty.describe() }),
     }
 }
 
@@ -543,11 +554,11 @@ mod tests {
     fn payload_values() {
         let sym = Type::Symbols(vec!["warn".into(), "error".into()]);
         assert_eq!(to_payload(Val::Str("error"), &sym), Ok(Value::Symbol(1)));
-        assert_eq!(to_payload(Val::Str("fatal"), &sym), Err("`fatal` is not one of warn, error".into()));
+        assert_eq!(to_payload(Val::Str("fatal"), &sym).unwrap_err().to_string(), "`fatal` is not one of warn, error");
         assert_eq!(to_payload(Val::Int(3), &Type::F64), Ok(Value::F64(3.0)));
         assert_eq!(to_payload(Val::Int(3), &Type::I64), Ok(Value::I64(3)));
         assert_eq!(to_payload(Val::Bool(true), &Type::Bool), Ok(Value::Bool(true)));
-        assert!(to_payload(Val::Float(f64::INFINITY), &Type::F64).unwrap_err().contains("inf"));
+        assert!(to_payload(Val::Float(f64::INFINITY), &Type::F64).unwrap_err().to_string().contains("inf"));
         assert!(to_payload(Val::Float(0.5), &Type::I64).is_err());
     }
 

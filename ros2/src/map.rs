@@ -66,7 +66,7 @@ pub const DEFAULT_NODE_TIMEOUT: Duration = Duration::from_secs(1);
 impl NodeEntry {
     /// The node's answer timeout: the map's, or [`DEFAULT_NODE_TIMEOUT`];
     /// `Err` with the reason when the map's is not a duration.
-    pub fn timeout(&self) -> Result<Duration, String> {
+    pub fn timeout(&self) -> Result<Duration, DurationError> {
         match &self.timeout {
             None => Ok(DEFAULT_NODE_TIMEOUT),
             Some(t) => parse_duration(&t.value),
@@ -74,24 +74,30 @@ impl NodeEntry {
     }
 }
 
+/// Why a map's timeout is not a duration.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum DurationError {
+    #[error("`{0}` is not a duration: write a whole number and `ms` or `s`")]
+    NotADuration(String),
+    #[error("`{0}` is out of range: a timeout is more than 0 and at most 1 hour")]
+    OutOfRange(String),
+}
+
 /// A duration as the rules write one: a whole number and `ms` or `s`,
 /// greater than zero and at most an hour.
-pub fn parse_duration(text: &str) -> Result<Duration, String> {
+pub fn parse_duration(text: &str) -> Result<Duration, DurationError> {
     let text = text.trim();
     let (digits, unit) = match text.strip_suffix("ms") {
         Some(d) => (d, 1u64),
         None => match text.strip_suffix('s') {
             Some(d) => (d, 1000u64),
-            None => return Err(format!("`{text}` is not a duration: write a whole number and `ms` or `s`")),
+            None => return Err(DurationError::NotADuration(text.to_string())),
         },
     };
-    let n: u64 = digits
-        .trim()
-        .parse()
-        .map_err(|_| format!("`{text}` is not a duration: write a whole number and `ms` or `s`"))?;
+    let n: u64 = digits.trim().parse().map_err(|_| DurationError::NotADuration(text.to_string()))?;
     let ms = n.saturating_mul(unit);
     if ms == 0 || ms > 3_600_000 {
-        return Err(format!("`{text}` is out of range: a timeout is more than 0 and at most 1 hour"));
+        return Err(DurationError::OutOfRange(text.to_string()));
     }
     Ok(Duration::from_millis(ms))
 }
