@@ -1,15 +1,15 @@
 //! `situ graph FILE --view wiring|rete|states [--state S] [--format dot|svg]`:
 //! pictures. The compiler writes DOT (`situ_compiler::graph`); DOT is printed
-//! as is, SVG is laid out here ([`layout`]): by Graphviz's `dot` when it is
-//! on the PATH, else by the built-in layered layout ([`builtin`]).
+//! as is, SVG is laid out by `situ_pictures`: by Graphviz's `dot` when it
+//! is on the PATH, else by its built-in layered layout.
 //!
 //! Findings are drawn, not refused: the diagnostics of a source go to
 //! standard error, and the states view of a file with errors draws what
 //! resolved (exit 1, the picture written all the same). The wiring and Rete
 //! views come from a compiled program and need a file without errors.
 
-mod builtin;
-pub mod layout;
+// The layout, as the commands that draw name it.
+pub use situ_pictures as layout;
 
 use super::{FAILED, OK, USAGE};
 use situ_compiler::bundle::{self, Content};
@@ -141,7 +141,7 @@ pub fn run(file: &Path, view: View, state: Option<&str>, format: Format, out: Op
 
 /// The wiring of every state in SVG: one small picture per state in a grid,
 /// the legend last, laid out by one run of the engine.
-fn small_multiples(engine: &layout::Engine, c: &Content, name: &str) -> Result<String, String> {
+fn small_multiples(engine: &layout::Engine, c: &Content, name: &str) -> Result<String, layout::LayoutError> {
     let mut dots: Vec<String> = (0..c.states.len() as u32).map(|s| graph::wiring_cell(c, s)).collect();
     dots.push(graph::wiring_legend());
     let refs: Vec<&str> = dots.iter().map(String::as_str).collect();

@@ -397,7 +397,7 @@ fn state_graph(c: &Content, checked: Option<&Checked>, changes: &[Change]) -> St
         Ok(svg) => mark_states(&svg, c),
         Err(e) => {
             eprintln!("warning: cannot lay out the state graph: {e}");
-            format!("<svg xmlns=\"http://www.w3.org/2000/svg\"><text x=\"10\" y=\"20\">cannot lay out the state graph: {}</text></svg>", xml(&e))
+            format!("<svg xmlns=\"http://www.w3.org/2000/svg\"><text x=\"10\" y=\"20\">cannot lay out the state graph: {}</text></svg>", xml(&e.to_string()))
         }
     }
 }

@@ -12,6 +12,7 @@
 //! colour, dashes and labels. The SVG is shaped as Graphviz's (`class="node"`
 //! and `class="edge"` groups with a `<title>`), so one reader fits both.
 
+use crate::LayoutError;
 use layout::gv::parser::ast;
 use layout::gv::DotParser;
 use std::collections::HashMap;
@@ -72,8 +73,8 @@ fn node(id: &str, attrs: HashMap<String, String>) -> Node {
 
 /// Reads the DOT: the graph's title and direction, the nodes (with the
 /// `node [...]` defaults in scope), the edges, the legend's entries.
-fn read(dot: &str) -> Result<Picture, String> {
-    let tree = DotParser::new(dot).process()?;
+fn read(dot: &str) -> Result<Picture, LayoutError> {
+    let tree = DotParser::new(dot).process().map_err(LayoutError::Dot)?;
     let mut p = Picture { title: String::new(), lr: false, nodes: Vec::new(), edges: Vec::new(), legend: Vec::new() };
     let mut index: HashMap<String, usize> = HashMap::new();
     let mut edges: Vec<(String, String, HashMap<String, String>)> = Vec::new();
@@ -220,7 +221,7 @@ fn path_d(pts: &[(f64, f64)], lr: bool) -> String {
 }
 
 /// One DOT graph to SVG with the built-in layout.
-pub fn svg(dot: &str) -> Result<String, String> {
+pub fn svg(dot: &str) -> Result<String, LayoutError> {
     let p = read(dot)?;
     let placed = place(&p);
     let title_size = 18.0;

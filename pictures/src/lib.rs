@@ -1,15 +1,36 @@
-//! DOT to SVG. Graphviz's `dot` (Debian's `graphviz`) when it is on the
-//! PATH: its layered layout reduces crossings, keeps every label on its
-//! edge and draws every border style, which is what makes the pictures of
-//! a real rule file readable (`docs/tools.md`, "Pictures"). Without it,
-//! the built-in layered layout ([`super::builtin`]) lays the same DOT out,
-//! with its title, its legend and no edge over a box.
+//! DOT to SVG, for every picture situ draws (the compiler writes the DOT:
+//! `situ_compiler::graph`). Graphviz's `dot` (Debian's `graphviz`) when it
+//! is on the PATH: its layered layout reduces crossings, keeps every label
+//! on its edge and draws every border style, which is what makes the
+//! pictures of a real rule file readable (`docs/language.md` §10.13,
+//! "Pictures"). Without it, the built-in layered layout ([`builtin`]) lays
+//! the same DOT out, with its title, its legend and no edge over a box.
 //! `SITU_LAYOUT=builtin` chooses the built-in layout; `SITU_DOT=PATH`
 //! names the `dot` to run.
+
+pub mod builtin;
 
 use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::{Command, Stdio};
+
+/// Why a picture was not laid out.
+#[derive(Debug, thiserror::Error)]
+pub enum LayoutError {
+    /// The DOT text does not parse (the built-in layout's parser says why).
+    #[error("the DOT text does not parse: {0}")]
+    Dot(String),
+    #[error("cannot run `{}`: {source}", path.display())]
+    Spawn { path: PathBuf, source: std::io::Error },
+    #[error("`{}`: {source}", path.display())]
+    Wait { path: PathBuf, source: std::io::Error },
+    #[error("`{}` failed: {stderr}", path.display())]
+    Failed { path: PathBuf, stderr: String },
+    #[error("`{}` wrote non-UTF-8 SVG", path.display())]
+    NotUtf8 { path: PathBuf },
+    #[error("`{}` wrote {got} pictures for {asked} graphs", path.display())]
+    Count { path: PathBuf, got: usize, asked: usize },
+}
 
 /// Who lays the pictures out.
 pub enum Engine {
@@ -35,45 +56,42 @@ pub fn engine() -> Engine {
 }
 
 /// One DOT graph to SVG with the engine found by [`engine`].
-pub fn svg(dot: &str) -> Result<String, String> {
+pub fn svg(dot: &str) -> Result<String, LayoutError> {
     svgs(&engine(), &[dot]).map(|mut v| v.remove(0))
 }
 
 /// Several DOT graphs to SVG, one SVG document each (one run of `dot`).
-pub fn svgs(engine: &Engine, dots: &[&str]) -> Result<Vec<String>, String> {
+pub fn svgs(engine: &Engine, dots: &[&str]) -> Result<Vec<String>, LayoutError> {
     match engine {
-        Engine::Builtin(_) => dots.iter().map(|d| builtin(d)).collect(),
+        Engine::Builtin(_) => dots.iter().map(|d| builtin::svg(d)).collect(),
         Engine::Graphviz(path) => graphviz(path, dots),
     }
 }
 
-fn graphviz(path: &PathBuf, dots: &[&str]) -> Result<Vec<String>, String> {
+fn graphviz(path: &PathBuf, dots: &[&str]) -> Result<Vec<String>, LayoutError> {
     let mut child = Command::new(path)
         .arg("-Tsvg")
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
-        .map_err(|e| format!("cannot run `{}`: {e}", path.display()))?;
+        .map_err(|source| LayoutError::Spawn { path: path.clone(), source })?;
     let input: String = dots.concat();
     let mut stdin = child.stdin.take().expect("piped");
     // Written from a thread: `dot` may fill its output pipe before it has read all its input.
     let writer = std::thread::spawn(move || stdin.write_all(input.as_bytes()));
-    let output = child.wait_with_output().map_err(|e| format!("`{}`: {e}", path.display()))?;
+    let output = child.wait_with_output().map_err(|source| LayoutError::Wait { path: path.clone(), source })?;
     let _ = writer.join();
     if !output.status.success() {
-        return Err(format!("`{}` failed: {}", path.display(), String::from_utf8_lossy(&output.stderr).trim()));
+        let stderr = String::from_utf8_lossy(&output.stderr).trim().to_string();
+        return Err(LayoutError::Failed { path: path.clone(), stderr });
     }
-    let text = String::from_utf8(output.stdout).map_err(|_| format!("`{}` wrote non-UTF-8 SVG", path.display()))?;
+    let text = String::from_utf8(output.stdout).map_err(|_| LayoutError::NotUtf8 { path: path.clone() })?;
     let docs: Vec<String> = text.split("<?xml").filter(|d| !d.trim().is_empty()).map(|d| format!("<?xml{d}")).collect();
     if docs.len() != dots.len() {
-        return Err(format!("`{}` wrote {} pictures for {} graphs", path.display(), docs.len(), dots.len()));
+        return Err(LayoutError::Count { path: path.clone(), got: docs.len(), asked: dots.len() });
     }
     Ok(docs)
-}
-
-fn builtin(dot: &str) -> Result<String, String> {
-    super::builtin::svg(dot)
 }
 
 /// An SVG document's size (in its own units, `pt` or `px`), view box and
