@@ -261,6 +261,21 @@ impl World {
     }
 }
 
+/// A world with one open document, checked in full, for the features' tests.
+#[cfg(test)]
+pub fn world_of(name: &str, text: &str) -> (World, PathBuf) {
+    let path = PathBuf::from(format!("/nonexistent/situ-lsp/{name}.situ"));
+    let mut w = World::default();
+    w.open(path.clone(), Doc::new(path_to_uri(&path), text.into(), 1));
+    w.refresh_fully();
+    (w, path)
+}
+
+/// A small program for the features' tests: a comment, a table without a row
+/// for `RD` (W0311), an event nobody reads (`F`, W0308).
+#[cfg(test)]
+pub const SMALL: &str = "// a\n// b\nstates { IT initial RD final }\nagent A sensor {\n    event E\n    event F\n    function f\n    table {\n        IT => run f()\n    }\n}\nrule r { when state == IT and E then RD }\n";
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -317,18 +332,3 @@ mod tests {
         assert!(w.primary(&main).is_none());
     }
 }
-
-/// A world with one open document, checked in full, for the features' tests.
-#[cfg(test)]
-pub fn world_of(name: &str, text: &str) -> (World, PathBuf) {
-    let path = PathBuf::from(format!("/nonexistent/situ-lsp/{name}.situ"));
-    let mut w = World::default();
-    w.open(path.clone(), Doc::new(path_to_uri(&path), text.into(), 1));
-    w.refresh_fully();
-    (w, path)
-}
-
-/// A small program for the features' tests: a comment, a table without a row
-/// for `RD` (W0311), an event nobody reads (`F`, W0308).
-#[cfg(test)]
-pub const SMALL: &str = "// a\n// b\nstates { IT initial RD final }\nagent A sensor {\n    event E\n    event F\n    function f\n    table {\n        IT => run f()\n    }\n}\nrule r { when state == IT and E then RD }\n";
