@@ -226,6 +226,9 @@ fn lifecycle_and_garbage_get_error_answers_and_the_server_goes_on() {
     assert_eq!(early["error"]["code"], -32002, "{early}");
     let init = c.result("initialize", json!({ "capabilities": {} }));
     assert_eq!(init["serverInfo"]["name"], "situ");
+    // The crate's legend (the mower test decodes tokens with it) is the one announced.
+    let legend = &init["capabilities"]["semanticTokensProvider"]["legend"];
+    assert_eq!(legend["tokenTypes"], json!(situ_lsp::TOKEN_TYPES), "{legend}");
     c.notify("initialized", json!({}));
 
     // Not JSON.
@@ -493,20 +496,7 @@ fn mower_golden() {
     // Semantic tokens of the first rule, decoded: `line:column text type [declaration]`.
     assert_eq!(c.request("initialize", json!({}))["error"]["code"], -32600, "a second initialize is refused");
     let tokens = c.result("textDocument/semanticTokens/full", json!({ "textDocument": { "uri": uri } }));
-    let types = [
-        "keyword",
-        "string",
-        "number",
-        "comment",
-        "enumMember",
-        "class",
-        "event",
-        "property",
-        "function",
-        "method",
-        "variable",
-        "type",
-    ];
+    let types = situ_lsp::TOKEN_TYPES;
     let data: Vec<u64> = tokens["data"].as_array().unwrap().iter().map(|v| v.as_u64().unwrap()).collect();
     let lines: Vec<&str> = text.lines().collect();
     let (mut line, mut col) = (0u64, 0u64);

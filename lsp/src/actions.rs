@@ -2,15 +2,13 @@
 //! actions (the diagnostics' fixes, the missing table row, `#[allow(code)]`),
 //! and inlay hints.
 
-use crate::diagnostics::{of_file, to_lsp};
-use crate::nav::analysis;
-use crate::server::{invalid_params, Answer};
-use crate::world::{Analysis, World};
-use serde_json::{json, Value};
+use crate::data::{TextEdit, WorkspaceEdit};
+use crate::diagnostics::{finding, of_file, Finding};
+use crate::world::Analysis;
+use lsp_types::{InlayHintKind, Position};
 use situ_compiler::codes;
 use situ_grammar::ast::{self, AgentMember, Item, Span};
 use situ_grammar::diag::{Diagnostic, FileId, Severity};
-use std::collections::BTreeMap;
 
 /// The smallest edit that turns `old` into `new`: one replacement of what
 /// lies between their common prefix and suffix.
@@ -30,63 +28,67 @@ fn minimal_edit(old: &str, new: &str) -> Option<(Span, String)> {
     Some((Span::new(pre, old.len() - suf), new[pre..new.len() - suf].to_string()))
 }
 
-fn text_edit(a: &Analysis, file: FileId, span: Span, text: &str) -> Value {
-    json!({ "range": a.range(file, span), "newText": text })
+fn text_edit(a: &Analysis, file: FileId, span: Span, text: &str) -> TextEdit {
+    TextEdit { range: a.range(file, span), new_text: text.to_string() }
 }
 
-/// The whole document, formatted; no edit when it has syntax errors.
-pub fn formatting(world: &World, params: &Value) -> Answer {
-    let (a, file) = analysis(world, params)?;
+/// The whole document, formatted: one edit, or none when it is formatted
+/// already; `None` when it has syntax errors.
+pub fn formatting(a: &Analysis, file: FileId) -> Option<Vec<TextEdit>> {
     let text = a.text(file);
-    let Ok(formatted) = situ_grammar::format(text) else { return Ok(Value::Null) };
-    Ok(json!(minimal_edit(text, &formatted).map(|(s, t)| vec![text_edit(a, file, s, &t)]).unwrap_or_default()))
+    let formatted = situ_grammar::format(text).ok()?;
+    Some(minimal_edit(text, &formatted).map(|(s, t)| vec![text_edit(a, file, s, &t)]).unwrap_or_default())
 }
 
-/// The items the range touches, formatted.
-pub fn range_formatting(world: &World, params: &Value) -> Answer {
-    let (a, file) = analysis(world, params)?;
+/// The items `span` touches, formatted; `None` when they have syntax errors.
+pub fn range_formatting(a: &Analysis, file: FileId, span: Span) -> Option<Vec<TextEdit>> {
     let text = a.text(file);
-    let range = params.get("range").cloned().and_then(|r| serde_json::from_value(r).ok());
-    let span = range
-        .and_then(|r| a.lines[file.0 as usize].span(text, r))
-        .ok_or_else(|| invalid_params("no range, or a range outside the document"))?;
     let items: Vec<Span> = a.asts[file.0 as usize]
         .items
         .iter()
         .map(Item::span)
         .filter(|s| s.start <= span.end && span.start <= s.end)
         .collect();
-    let (Some(first), Some(last)) = (items.first(), items.last()) else { return Ok(json!([])) };
+    let (Some(first), Some(last)) = (items.first(), items.last()) else { return Some(Vec::new()) };
     let whole = Span::new(first.start, last.end);
-    let Some(slice) = text.get(whole.start..whole.end) else { return Ok(json!([])) };
-    let Ok(formatted) = situ_grammar::format(slice) else { return Ok(Value::Null) };
+    let Some(slice) = text.get(whole.start..whole.end) else { return Some(Vec::new()) };
+    let formatted = situ_grammar::format(slice).ok()?;
     let formatted = formatted.trim_end_matches('\n');
-    Ok(json!(minimal_edit(slice, formatted)
-        .map(|(s, t)| vec![text_edit(a, file, Span::new(whole.start + s.start, whole.start + s.end), &t)])
-        .unwrap_or_default()))
+    Some(
+        minimal_edit(slice, formatted)
+            .map(|(s, t)| vec![text_edit(a, file, Span::new(whole.start + s.start, whole.start + s.end), &t)])
+            .unwrap_or_default(),
+    )
 }
 
-fn action(a: &Analysis, d: &Diagnostic, title: String, edits: Vec<(FileId, Span, String)>, preferred: bool) -> Value {
-    let mut changes: BTreeMap<String, Vec<Value>> = BTreeMap::new();
+/// A quick fix of one finding.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CodeAction {
+    pub title: String,
+    /// The finding it fixes.
+    pub finding: Finding,
+    /// The first fix the compiler gives.
+    pub preferred: bool,
+    pub edit: WorkspaceEdit,
+}
+
+fn action(
+    a: &Analysis,
+    d: &Diagnostic,
+    title: String,
+    edits: Vec<(FileId, Span, String)>,
+    preferred: bool,
+) -> CodeAction {
+    let mut edit = WorkspaceEdit::new();
     for (file, span, text) in edits {
-        changes.entry(a.uri(file)).or_default().push(text_edit(a, file, span, &text));
+        edit.entry(a.uri(file)).or_default().push(text_edit(a, file, span, &text));
     }
-    json!({
-        "title": title,
-        "kind": "quickfix",
-        "diagnostics": [to_lsp(a, d)],
-        "isPreferred": preferred,
-        "edit": { "changes": changes },
-    })
+    CodeAction { title, finding: finding(a, d), preferred, edit }
 }
 
-pub fn code_actions(world: &World, params: &Value) -> Answer {
-    let (a, file) = analysis(world, params)?;
-    let text = a.text(file);
-    let range = params.get("range").cloned().and_then(|r| serde_json::from_value(r).ok());
-    let span = range
-        .and_then(|r| a.lines[file.0 as usize].span(text, r))
-        .ok_or_else(|| invalid_params("no range, or a range outside the document"))?;
+/// The fixes of the findings `span` touches: the compiler's own, the missing
+/// table row, and `#[allow(code)]` for a warning.
+pub fn code_actions(a: &Analysis, file: FileId, span: Span) -> Vec<CodeAction> {
     let mut out = Vec::new();
     for d in of_file(a, file).filter(|d| d.primary.span.start <= span.end && span.start <= d.primary.span.end) {
         for (i, fix) in d.fixes.iter().enumerate() {
@@ -116,7 +118,7 @@ pub fn code_actions(world: &World, params: &Value) -> Answer {
             }
         }
     }
-    Ok(json!(out))
+    out
 }
 
 /// The agent or rule around `offset`: its name and where its first line starts.
@@ -131,8 +133,9 @@ fn attributable(a: &Analysis, file: FileId, offset: usize) -> Option<(String, us
 }
 
 /// `STATES => sleep`, before the closing brace of the table W0311 is about.
-fn missing_row(a: &Analysis, file: FileId, d: &Diagnostic) -> Option<Value> {
-    let missing: Vec<&str> = d.witness.as_ref()?.get("missing")?.as_array()?.iter().filter_map(Value::as_str).collect();
+fn missing_row(a: &Analysis, file: FileId, d: &Diagnostic) -> Option<CodeAction> {
+    let missing: Vec<&str> =
+        d.witness.as_ref()?.get("missing")?.as_array()?.iter().filter_map(|v| v.as_str()).collect();
     if missing.is_empty() {
         return None;
     }
@@ -165,16 +168,23 @@ fn missing_row(a: &Analysis, file: FileId, d: &Diagnostic) -> Option<Value> {
     Some(action(a, d, format!("add the missing table row `{row}`"), vec![(file, span, insert)], false))
 }
 
-pub fn inlay_hints(world: &World, params: &Value) -> Answer {
-    let (a, file) = analysis(world, params)?;
+/// A note the editor shows inside the text.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct InlayHint {
+    pub position: Position,
+    pub label: String,
+    /// `Some(TYPE)` for what `_` stands for; none for a rule's length.
+    pub kind: Option<InlayHintKind>,
+    pub padding_left: bool,
+    pub tooltip: &'static str,
+}
+
+/// In `range` (the whole document when `None`): the states each table's `_`
+/// stands for, and the fewest events each rule needs.
+pub fn inlay_hints(a: &Analysis, file: FileId, range: Option<Span>) -> Vec<InlayHint> {
     let text = a.text(file);
     let lines = &a.lines[file.0 as usize];
-    let range = params
-        .get("range")
-        .cloned()
-        .and_then(|r| serde_json::from_value(r).ok())
-        .and_then(|r| lines.span(text, r))
-        .unwrap_or(Span::new(0, text.len()));
+    let range = range.unwrap_or(Span::new(0, text.len()));
     let inside = |o: usize| range.start <= o && o <= range.end;
     let states: Vec<String> = a
         .index
@@ -195,12 +205,13 @@ pub fn inlay_hints(world: &World, params: &Value) -> Answer {
         } else {
             covered.join(", ")
         };
-        out.push(json!({
-            "position": lines.position(text, w.span.end),
-            "label": format!(": {shown}"),
-            "kind": 1,
-            "tooltip": "the states `_` stands for",
-        }));
+        out.push(InlayHint {
+            position: lines.position(text, w.span.end),
+            label: format!(": {shown}"),
+            kind: Some(InlayHintKind::TYPE),
+            padding_left: false,
+            tooltip: "the states `_` stands for",
+        });
     }
     for item in &a.asts[file.0 as usize].items {
         let Item::Rule(r) = item else { continue };
@@ -218,14 +229,15 @@ pub fn inlay_hints(world: &World, params: &Value) -> Answer {
         if runs == 0 {
             continue;
         }
-        out.push(json!({
-            "position": lines.position(text, r.name.span.end),
-            "label": format!("needs {runs} event{}", if runs == 1 { "" } else { "s" }),
-            "paddingLeft": true,
-            "tooltip": "the fewest reports that can fire this rule: each pattern's run length, added",
-        }));
+        out.push(InlayHint {
+            position: lines.position(text, r.name.span.end),
+            label: format!("needs {runs} event{}", if runs == 1 { "" } else { "s" }),
+            kind: None,
+            padding_left: true,
+            tooltip: "the fewest reports that can fire this rule: each pattern's run length, added",
+        });
     }
-    Ok(json!(out))
+    out
 }
 
 #[cfg(test)]
@@ -238,5 +250,46 @@ mod tests {
         assert_eq!(minimal_edit("a  b", "a b"), Some((Span::new(2, 3), String::new())));
         assert_eq!(minimal_edit("xé", "xè"), Some((Span::new(1, 3), "è".into())));
         assert_eq!(minimal_edit("aa", "aaa"), Some((Span::new(2, 2), "a".into())));
+    }
+
+    #[test]
+    fn formatting_is_one_edit_or_none() {
+        let (w, path) = crate::world::world_of("actions-fmt", "states {   IT initial }\n");
+        let (a, file) = w.primary(&path).unwrap();
+        let edits = formatting(a, file).unwrap();
+        assert_eq!(edits.len(), 1);
+        assert_eq!(
+            (edits[0].range.start.character, edits[0].range.end.character, edits[0].new_text.as_str()),
+            (8, 22, "\n    IT initial\n")
+        );
+        let (w, path) = crate::world::world_of("actions-fmt-bad", "states { IT initial ");
+        let (a, file) = w.primary(&path).unwrap();
+        assert_eq!(formatting(a, file), None, "a syntax error: no edit");
+    }
+
+    #[test]
+    fn a_missing_row_and_an_allow_are_offered() {
+        let (w, path) = crate::world::world_of("actions-fix", crate::world::SMALL);
+        let (a, file) = w.primary(&path).unwrap();
+        let all = code_actions(a, file, Span::new(0, a.text(file).len()));
+        let row = all.iter().find(|c| c.title == "add the missing table row `RD => sleep`").expect("row");
+        assert_eq!(row.finding.code, codes::NO_TABLE_ENTRY);
+        let edit = &row.edit[&a.uri(file)][0];
+        assert_eq!((edit.range.start.line, edit.new_text.as_str()), (9, "        RD => sleep\n"));
+        assert!(all.iter().any(|c| c.title == format!("allow `{}` on `A`", codes::NO_TABLE_ENTRY)));
+        assert!(code_actions(a, file, Span::new(0, 3)).is_empty(), "nothing found in the comment");
+    }
+
+    #[test]
+    fn inlay_hints_count_events_and_name_wildcards() {
+        let text = "states { IT initial RD }\nagent A sensor { event E function f table { IT => run f() _ => sleep } }\nrule r { when E then RD }\n";
+        let (w, path) = crate::world::world_of("actions-hints", text);
+        let (a, file) = w.primary(&path).unwrap();
+        let hints = inlay_hints(a, file, None);
+        let labels: Vec<&str> = hints.iter().map(|h| h.label.as_str()).collect();
+        assert_eq!(labels, [": RD", "needs 1 event"]);
+        assert_eq!(hints[0].kind, Some(InlayHintKind::TYPE));
+        assert!(hints[1].padding_left && hints[1].kind.is_none());
+        assert!(inlay_hints(a, file, Some(Span::new(0, 5))).is_empty());
     }
 }

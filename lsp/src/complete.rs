@@ -2,24 +2,34 @@
 //! block it is in (`state in {…}`, a table, an FSM, a pattern's
 //! parentheses, a test, a script) and what came just before.
 
+use crate::data::TextEdit;
 use crate::index::{Index, Sym};
-use crate::nav::locate;
-use crate::server::Answer;
 use crate::tokens::{lex, Tok, Token};
-use crate::world::{Analysis, World};
-use serde_json::{json, Value};
+use crate::world::Analysis;
+use lsp_types::CompletionItemKind as Kind;
 use situ_grammar::ast::Span;
+use situ_grammar::diag::FileId;
 
-// The protocol's CompletionItemKind numbers.
-const METHOD: u32 = 2;
-const FUNCTION: u32 = 3;
-const FIELD: u32 = 5;
-const CLASS: u32 = 7;
-const UNIT: u32 = 11;
-const KEYWORD: u32 = 14;
-const SNIPPET: u32 = 15;
-const ENUM_MEMBER: u32 = 20;
-const EVENT: u32 = 23;
+const FUNCTION: Kind = Kind::FUNCTION;
+const FIELD: Kind = Kind::FIELD;
+const CLASS: Kind = Kind::CLASS;
+const UNIT: Kind = Kind::UNIT;
+const KEYWORD: Kind = Kind::KEYWORD;
+const SNIPPET: Kind = Kind::SNIPPET;
+const ENUM_MEMBER: Kind = Kind::ENUM_MEMBER;
+const EVENT: Kind = Kind::EVENT;
+
+/// One proposal: the edit puts `label` (or, for a snippet, its body) in place
+/// of the word being typed.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Item {
+    pub label: String,
+    pub kind: Kind,
+    pub detail: Option<String>,
+    pub edit: TextEdit,
+    /// The edit's text is a snippet, with `${1:…}` placeholders.
+    pub snippet: bool,
+}
 
 /// The block the cursor is in.
 #[derive(Debug, Clone, PartialEq)]
@@ -41,21 +51,23 @@ enum Frame {
 }
 
 struct Items<'a> {
-    out: Vec<Value>,
+    out: Vec<Item>,
     replace: lsp_types::Range,
     index: &'a Index,
 }
 
 impl Items<'_> {
-    fn add(&mut self, label: &str, kind: u32, detail: Option<&str>) {
-        if self.out.iter().any(|v| v["label"] == label) {
+    fn add(&mut self, label: &str, kind: Kind, detail: Option<&str>) {
+        if self.out.iter().any(|i| i.label == label) {
             return;
         }
-        let mut v = json!({ "label": label, "kind": kind, "textEdit": { "range": self.replace, "newText": label } });
-        if let Some(d) = detail {
-            v["detail"] = json!(d);
-        }
-        self.out.push(v);
+        self.out.push(Item {
+            label: label.into(),
+            kind,
+            detail: detail.map(str::to_string),
+            edit: TextEdit { range: self.replace, new_text: label.into() },
+            snippet: false,
+        });
     }
 
     fn keywords(&mut self, words: &[&str]) {
@@ -64,7 +76,7 @@ impl Items<'_> {
         }
     }
 
-    fn defs(&mut self, pick: impl Fn(&Sym) -> bool, kind: u32, detail: &str) {
+    fn defs(&mut self, pick: impl Fn(&Sym) -> bool, kind: Kind, detail: &str) {
         let names: Vec<String> =
             self.index.occurrences.iter().filter(|o| o.def && pick(&o.sym)).map(|o| o.sym.name().to_string()).collect();
         for n in names {
@@ -119,8 +131,13 @@ impl Items<'_> {
         }
     }
     fn snippet(&mut self, label: &str, body: &str) {
-        self.out.push(json!({ "label": label, "kind": SNIPPET, "insertTextFormat": 2,
-            "textEdit": { "range": self.replace, "newText": body } }));
+        self.out.push(Item {
+            label: label.into(),
+            kind: SNIPPET,
+            detail: None,
+            edit: TextEdit { range: self.replace, new_text: body.into() },
+            snippet: true,
+        });
     }
 }
 
@@ -205,12 +222,9 @@ fn list_head<'t>(text: &'t str, toks: &[Token]) -> &'t str {
     ""
 }
 
-pub fn completion(world: &World, params: &Value) -> Answer {
-    let (a, file, offset) = locate(world, params)?;
-    Ok(json!({ "isIncomplete": false, "items": items(a, file, offset) }))
-}
-
-fn items(a: &Analysis, file: situ_grammar::diag::FileId, offset: usize) -> Vec<Value> {
+/// What may be typed at `offset`, for the block it is in and the tokens
+/// before it.
+pub fn completion(a: &Analysis, file: FileId, offset: usize) -> Vec<Item> {
     let text = a.text(file);
     let mut offset = offset.min(text.len());
     while !text.is_char_boundary(offset) {
@@ -375,7 +389,6 @@ fn items(a: &Analysis, file: situ_grammar::diag::FileId, offset: usize) -> Vec<V
         },
         Some(Frame::Other) => it.keywords(&[]),
     }
-    let _ = METHOD;
     it.out
 }
 
@@ -393,49 +406,12 @@ mod tests {
         w.open(path.clone(), Doc::new("file:///tmp/situ-lsp-complete.situ".into(), text, 1));
         w.refresh_fully();
         let (a, file) = w.primary(&path).unwrap();
-        items(a, file, at).iter().map(|v| v["label"].as_str().unwrap().to_string()).collect()
+        completion(a, file, at).into_iter().map(|i| i.label).collect()
     }
 
     const DECLS: &str = "states { IT initial RS RO }\n\
         agent L sensor { event OBS { d: f64, side: {left, right} } event NOB function f function g\n\
           table { RS => run f() _ => sleep } }\n";
-
-    /// Every request at many places of the repository's rule files, and of
-    /// the same files cut short (as while typing): an answer, never a panic.
-    #[test]
-    fn every_place_gets_an_answer() {
-        for name in ["rules/outdoor.situ", "examples/mower/mower.situ"] {
-            let full = std::fs::read_to_string(format!("{}/../{name}", env!("CARGO_MANIFEST_DIR"))).unwrap();
-            let half = (full.len() / 2..).find(|i| full.is_char_boundary(*i)).unwrap_or(full.len());
-            for text in [full.clone(), full[..half].to_string()] {
-                let path = PathBuf::from("/tmp/situ-lsp-every-place.situ");
-                let uri = "file:///tmp/situ-lsp-every-place.situ";
-                let mut w = World::default();
-                w.open(path.clone(), Doc::new(uri.into(), text.clone(), 1));
-                w.refresh_fully();
-                let (a, file) = w.primary(&path).unwrap();
-                let lines = &a.lines[file.0 as usize];
-                for offset in (0..=text.len()).step_by(17).filter(|o| text.is_char_boundary(*o)) {
-                    let _ = items(a, file, offset);
-                    let params = json!({ "textDocument": { "uri": uri }, "position": lines.position(&text, offset), "newName": "Zz" });
-                    for f in [crate::nav::hover, crate::nav::definition, crate::nav::references, crate::nav::highlight]
-                    {
-                        assert!(f(&w, &params).is_ok(), "{name} at {offset}");
-                    }
-                    // Refused where there is no name, or where `Zz` is taken: never a panic.
-                    let _ = crate::nav::rename(&w, &params);
-                }
-                let doc = json!({ "textDocument": { "uri": uri } });
-                assert!(crate::tokens::semantic_tokens(&w, &doc).is_ok());
-                assert!(crate::tokens::folding(&w, &doc).is_ok());
-                assert!(crate::nav::document_symbols(&w, &doc).is_ok());
-                let everywhere = json!({ "textDocument": { "uri": uri }, "range": { "start": { "line": 0, "character": 0 }, "end": lines.position(&text, text.len()) } });
-                assert!(crate::actions::code_actions(&w, &everywhere).is_ok());
-                assert!(crate::actions::inlay_hints(&w, &everywhere).is_ok());
-                assert!(crate::actions::range_formatting(&w, &everywhere).is_ok());
-            }
-        }
-    }
 
     #[test]
     fn completion_knows_the_place() {
@@ -451,5 +427,24 @@ mod tests {
         assert_eq!(at("agent M processing { function h table { RS => run |"), ["h"]);
         assert_eq!(at("agent M processing { table { RS => run h() from |"), ["L", "M"]);
         assert!(at("rule r { when NOB then RO } // |").is_empty());
+    }
+
+    #[test]
+    fn an_item_replaces_the_word_being_typed() {
+        let text = format!("{DECLS}rule r {{ when OBS(side == le");
+        let (w, path) = crate::world::world_of("complete-edit", &text);
+        let (a, file) = w.primary(&path).unwrap();
+        let items = completion(a, file, text.len());
+        let left = items.iter().find(|i| i.label == "left").expect("a symbol of side");
+        assert_eq!((left.kind, left.detail.as_deref(), left.snippet), (ENUM_MEMBER, Some("symbol of OBS.side"), false));
+        let r = left.edit.range;
+        assert_eq!((r.start.line, r.start.character, r.end.character), (3, 26, 28));
+        assert_eq!(left.edit.new_text, "left");
+        let (w, path) = crate::world::world_of("complete-top", "");
+        let (a, file) = w.primary(&path).unwrap();
+        let top = completion(a, file, 0);
+        let rule = top.iter().find(|i| i.label == "rule …").expect("a snippet");
+        assert!(rule.snippet && rule.kind == SNIPPET && rule.detail.is_none());
+        assert!(rule.edit.new_text.starts_with("rule ${1:name}"), "{}", rule.edit.new_text);
     }
 }

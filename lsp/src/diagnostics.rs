@@ -1,54 +1,71 @@
-//! The compiler's findings as LSP diagnostics: the code, the primary place,
-//! every further label as related information, the help and the witness.
+//! The compiler's findings as the editor shows them: the code, the primary
+//! place, every further label as related information, the help and the
+//! witness.
 
+use crate::data::Location;
 use crate::world::{Analysis, World};
-use serde_json::{json, Value};
+use lsp_types::Range;
 use situ_compiler::codes;
 use situ_grammar::diag::{Diagnostic, FileId, Severity};
 use std::collections::BTreeMap;
 
-/// One finding for the file `file` of the analysis.
-pub fn to_lsp(a: &Analysis, d: &Diagnostic) -> Value {
+/// One finding, placed in the editor's terms.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Finding {
+    pub range: Range,
+    pub error: bool,
+    pub code: &'static str,
+    /// The message, with the help on a line of its own.
+    pub message: String,
+    /// The primary label, the secondary ones, the help and the witness, each
+    /// with its place.
+    pub related: Vec<(Location, String)>,
+    pub help: Option<String>,
+    /// The compiler's evidence, passed on as it gives it.
+    pub witness: Option<serde_json::Value>,
+    /// Shown faded: an event or a function nothing uses.
+    pub unnecessary: bool,
+}
+
+/// One finding of the analysis.
+pub fn finding(a: &Analysis, d: &Diagnostic) -> Finding {
     let file = d.primary.file;
     let mut related = Vec::new();
     if !d.primary.text.is_empty() {
-        related.push(json!({ "location": a.location(file, d.primary.span), "message": d.primary.text }));
+        related.push((a.location(file, d.primary.span), d.primary.text.clone()));
     }
     for l in &d.secondary {
         if (l.file.0 as usize) < a.paths.len() {
-            related.push(json!({ "location": a.location(l.file, l.span), "message": l.text }));
+            related.push((a.location(l.file, l.span), l.text.clone()));
         }
     }
     if let Some(help) = &d.help {
-        related.push(json!({ "location": a.location(file, d.primary.span), "message": format!("help: {help}") }));
+        related.push((a.location(file, d.primary.span), format!("help: {help}")));
     }
     if let Some(w) = &d.witness {
-        related.push(json!({ "location": a.location(file, d.primary.span), "message": format!("witness: {w}") }));
+        related.push((a.location(file, d.primary.span), format!("witness: {w}")));
     }
     let mut message = d.message.clone();
     if let Some(help) = &d.help {
         message.push_str("\nhelp: ");
         message.push_str(help);
     }
-    let mut out = json!({
-        "range": a.range(file, d.primary.span),
-        "severity": if d.severity == Severity::Error { 1 } else { 2 },
-        "code": d.code,
-        "source": "situ",
-        "message": message,
-        "relatedInformation": related,
-        "data": { "help": d.help, "witness": d.witness },
-    });
-    if [codes::UNUSED_EVENT, codes::UNUSED_FUNCTION].contains(&d.code) {
-        out["tags"] = json!([1]); // unnecessary: shown faded
+    Finding {
+        range: a.range(file, d.primary.span),
+        error: d.severity == Severity::Error,
+        code: d.code,
+        message,
+        related,
+        help: d.help.clone(),
+        witness: d.witness.clone(),
+        unnecessary: [codes::UNUSED_EVENT, codes::UNUSED_FUNCTION].contains(&d.code),
     }
-    out
 }
 
-/// The diagnostics of every covered file, by URI, with the version of the
-/// open document they were computed on; `None` for a file whose analysis
-/// waits for its static checks (what was published stays until they end).
-pub type Published = BTreeMap<String, Option<(Option<i32>, Vec<Value>)>>;
+/// The findings of every covered file, by URI, with the version of the open
+/// document they were computed on; `None` for a file whose analysis waits
+/// for its static checks (what was published stays until they end).
+pub type Published = BTreeMap<String, Option<(Option<i32>, Vec<Finding>)>>;
 
 pub fn all(world: &World) -> Published {
     let mut out = BTreeMap::new();
@@ -58,9 +75,9 @@ pub fn all(world: &World) -> Published {
             out.insert(a.uri(file), None);
             continue;
         }
-        let diags: Vec<Value> = a.checked.visible().filter(|d| d.primary.file == file).map(|d| to_lsp(a, d)).collect();
+        let found: Vec<Finding> = of_file(a, file).map(|d| finding(a, d)).collect();
         let version = world.docs.get(&path).map(|d| d.version);
-        out.insert(a.uri(file), Some((version, diags)));
+        out.insert(a.uri(file), Some((version, found)));
     }
     out
 }
@@ -68,4 +85,25 @@ pub fn all(world: &World) -> Published {
 /// The findings of `a` whose primary place is in `file`.
 pub fn of_file(a: &Analysis, file: FileId) -> impl Iterator<Item = &Diagnostic> {
     a.checked.visible().filter(move |d| d.primary.file == file)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn findings_of_a_file_with_their_places() {
+        let (w, path) = crate::world::world_of("diagnostics", crate::world::SMALL);
+        let published = all(&w);
+        let (version, found) = published.values().next().unwrap().clone().unwrap();
+        assert_eq!(version, Some(1));
+        let unused = found.iter().find(|f| f.code == codes::UNUSED_EVENT).expect("F is never read");
+        assert!(!unused.error && unused.unnecessary);
+        assert_eq!((unused.range.start.line, unused.range.start.character), (5, 10));
+        let row = found.iter().find(|f| f.code == codes::NO_TABLE_ENTRY).expect("RD has no row");
+        assert!(!row.unnecessary);
+        assert!(row.witness.is_some());
+        assert!(row.related.iter().any(|(_, m)| m.starts_with("witness: ")));
+        assert!(published.contains_key(&crate::text::path_to_uri(&path)));
+    }
 }

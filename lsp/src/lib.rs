@@ -6,12 +6,24 @@
 //! computed from the compiler's `Checked` result and an index of the names
 //! of the ASTs ([`index`]). The crate does the protocol; the compiler stays
 //! pure.
+//!
+//! Three layers, each importing only the ones below it:
+//! - [`server`] is the loop: it reads a frame ([`transport`]), hands it to
+//!   [`protocol`], writes what comes back, and publishes diagnostics;
+//! - [`protocol`] holds every piece of the protocol's JSON: params become
+//!   typed inputs, the features' answers become results, failures become
+//!   JSON-RPC errors;
+//! - the features ([`nav`], [`complete`], [`actions`], [`tokens`],
+//!   [`diagnostics`]) take an analysis and a place and return data in the
+//!   protocol's terms ([`data`]), with no JSON.
 
 pub mod actions;
 pub mod complete;
+pub mod data;
 pub mod diagnostics;
 pub mod index;
 pub mod nav;
+pub mod protocol;
 pub mod server;
 pub mod text;
 pub mod tokens;
@@ -19,6 +31,7 @@ pub mod transport;
 pub mod world;
 
 pub use server::serve;
+pub use tokens::{TOKEN_MODIFIERS, TOKEN_TYPES};
 
 /// Serves on standard input and output; the process's exit code.
 pub fn run_stdio() -> i32 {

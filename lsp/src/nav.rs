@@ -1,45 +1,30 @@
 //! Navigation: hover, definition, references, highlights, rename, and the
 //! document's and the workspace's symbols.
 
+use crate::data::{Location, Refusal, TextEdit, WorkspaceEdit};
 use crate::index::{Occurrence, Sym};
-use crate::server::{doc_path, invalid_params, refused, Answer};
 use crate::text::valid_name;
 use crate::world::{Analysis, World};
-use serde_json::{json, Value};
+use lsp_types::{Range, SymbolKind};
 use situ_compiler::model::{Behaviour, Model, StateId};
 use situ_grammar::ast::{self, Item, Span};
 use situ_grammar::diag::FileId;
-use std::collections::BTreeMap;
 
-/// The analysis, file and byte offset of `params.textDocument` and `params.position`.
-pub fn locate<'w>(world: &'w World, params: &Value) -> Result<(&'w Analysis, FileId, usize), (i32, String)> {
-    let (a, file) = analysis(world, params)?;
-    let pos: lsp_types::Position = params
-        .get("position")
-        .cloned()
-        .and_then(|p| serde_json::from_value(p).ok())
-        .ok_or_else(|| invalid_params("no position"))?;
-    let offset = a.lines[file.0 as usize]
-        .offset(a.text(file), pos)
-        .ok_or_else(|| invalid_params(format!("line {} is past the end of the document", pos.line)))?;
-    Ok((a, file, offset))
+/// What the name (or the table's `_`) under the cursor is: markdown.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Hover {
+    pub markdown: String,
+    pub range: Range,
 }
 
-/// The analysis and file of `params.textDocument`.
-pub fn analysis<'w>(world: &'w World, params: &Value) -> Result<(&'w Analysis, FileId), (i32, String)> {
-    let path = doc_path(params)?;
-    world.primary(&path).ok_or_else(|| invalid_params(format!("`{}` is not open", path.display())))
-}
-
-pub fn hover(world: &World, params: &Value) -> Answer {
-    let (a, file, offset) = locate(world, params)?;
+pub fn hover(a: &Analysis, file: FileId, offset: usize) -> Option<Hover> {
     let m = &a.checked.model;
     if let Some(w) = a.index.wildcard_at(file, offset) {
         let covered: Vec<&str> = declared_states(a).into_iter().filter(|s| !w.named.iter().any(|n| n == s)).collect();
         let text = format!("`_` in the table of `{}` covers {}", w.agent, list(&covered, "no state"));
-        return Ok(json!({ "contents": { "kind": "markdown", "value": text }, "range": a.range(file, w.span) }));
+        return Some(Hover { markdown: text, range: a.range(file, w.span) });
     }
-    let Some(o) = a.index.at(file, offset) else { return Ok(Value::Null) };
+    let o = a.index.at(file, offset)?;
     let text = match &o.sym {
         Sym::State(name) => state_hover(a, m, name),
         Sym::Agent(name) => agent_hover(a, m, name),
@@ -69,7 +54,7 @@ pub fn hover(world: &World, params: &Value) -> Answer {
             format!("**variable** `?{name}`{ty}")
         }
     };
-    Ok(json!({ "contents": { "kind": "markdown", "value": text }, "range": a.range(o.file, o.span) }))
+    Some(Hover { markdown: text, range: a.range(o.file, o.span) })
 }
 
 /// The states as declared, in order (from the index, so also with errors).
@@ -211,88 +196,114 @@ fn rule_hover(m: &Model, name: &str) -> String {
     out
 }
 
-fn location(a: &Analysis, o: &Occurrence) -> Value {
+fn location(a: &Analysis, o: &Occurrence) -> Location {
     a.location(o.file, o.span)
 }
 
-pub fn definition(world: &World, params: &Value) -> Answer {
-    let (a, file, offset) = locate(world, params)?;
-    let Some(o) = a.index.at(file, offset) else { return Ok(Value::Null) };
-    Ok(a.index.definition(&o.sym).map_or(Value::Null, |d| location(a, d)))
+/// Where the name under the cursor is declared.
+pub fn definition(a: &Analysis, file: FileId, offset: usize) -> Option<Location> {
+    let o = a.index.at(file, offset)?;
+    a.index.definition(&o.sym).map(|d| location(a, d))
 }
 
-pub fn references(world: &World, params: &Value) -> Answer {
-    let (a, file, offset) = locate(world, params)?;
-    let Some(o) = a.index.at(file, offset) else { return Ok(json!([])) };
-    let with_decl = params.pointer("/context/includeDeclaration").and_then(Value::as_bool).unwrap_or(true);
-    let refs: Vec<Value> = a.index.references(&o.sym).filter(|r| with_decl || !r.def).map(|r| location(a, r)).collect();
-    Ok(json!(refs))
+/// Every place of the name under the cursor (`with_declaration`: its
+/// declaration too).
+pub fn references(a: &Analysis, file: FileId, offset: usize, with_declaration: bool) -> Vec<Location> {
+    let Some(o) = a.index.at(file, offset) else { return Vec::new() };
+    a.index.references(&o.sym).filter(|r| with_declaration || !r.def).map(|r| location(a, r)).collect()
 }
 
-pub fn highlight(world: &World, params: &Value) -> Answer {
-    let (a, file, offset) = locate(world, params)?;
-    let Some(o) = a.index.at(file, offset) else { return Ok(json!([])) };
-    let out: Vec<Value> = a
-        .index
+/// A place of the name under the cursor in the same document.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Highlight {
+    pub range: Range,
+    /// Its declaration (shown as a write), not a use (a read).
+    pub declaration: bool,
+}
+
+pub fn highlight(a: &Analysis, file: FileId, offset: usize) -> Vec<Highlight> {
+    let Some(o) = a.index.at(file, offset) else { return Vec::new() };
+    a.index
         .references(&o.sym)
         .filter(|r| r.file == file)
-        .map(|r| json!({ "range": a.range(file, r.span), "kind": if r.def { 3 } else { 2 } }))
-        .collect();
-    Ok(json!(out))
+        .map(|r| Highlight { range: a.range(file, r.span), declaration: r.def })
+        .collect()
 }
 
-pub fn prepare_rename(world: &World, params: &Value) -> Answer {
-    let (a, file, offset) = locate(world, params)?;
-    let o = a.index.at(file, offset).ok_or_else(|| refused("no name to rename here"))?;
-    Ok(json!({ "range": a.range(file, o.span), "placeholder": o.sym.name() }))
+/// The name a rename would change, and its text.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RenamePlace {
+    pub range: Range,
+    pub placeholder: String,
 }
 
-pub fn rename(world: &World, params: &Value) -> Answer {
-    let (a, file, offset) = locate(world, params)?;
-    let new = params.get("newName").and_then(Value::as_str).ok_or_else(|| invalid_params("no newName"))?;
-    let o = a.index.at(file, offset).ok_or_else(|| refused("no name to rename here"))?;
-    valid_name(new).map_err(refused)?;
+pub fn prepare_rename(a: &Analysis, file: FileId, offset: usize) -> Result<RenamePlace, Refusal> {
+    let o = a.index.at(file, offset).ok_or_else(|| Refusal("no name to rename here".into()))?;
+    Ok(RenamePlace { range: a.range(file, o.span), placeholder: o.sym.name().to_string() })
+}
+
+/// Every place of the name under the cursor, renamed `new`; refused where
+/// there is no name, where `new` is not a name, or where it is taken.
+pub fn rename(a: &Analysis, file: FileId, offset: usize, new: &str) -> Result<WorkspaceEdit, Refusal> {
+    let o = a.index.at(file, offset).ok_or_else(|| Refusal("no name to rename here".into()))?;
+    valid_name(new).map_err(Refusal)?;
     if new != o.sym.name() && a.index.is_declared(&o.sym, new) {
         let what = o.sym.kind();
         let place = a.index.definition(&o.sym.renamed(new)).map(|d| {
             let (line, col) = a.checked.sources.get(d.file).line_col(d.span.start);
             format!(" at {}:{line}:{col}", a.checked.sources.get(d.file).name)
         });
-        return Err(refused(format!("there is already a {what} `{new}`{}", place.unwrap_or_default())));
+        return Err(Refusal(format!("there is already a {what} `{new}`{}", place.unwrap_or_default())));
     }
-    let mut changes: BTreeMap<String, Vec<Value>> = BTreeMap::new();
+    let mut changes = WorkspaceEdit::new();
     for r in a.index.references(&o.sym) {
-        changes.entry(a.uri(r.file)).or_default().push(json!({ "range": a.range(r.file, r.span), "newText": new }));
+        changes
+            .entry(a.uri(r.file))
+            .or_default()
+            .push(TextEdit { range: a.range(r.file, r.span), new_text: new.into() });
     }
-    Ok(json!({ "changes": changes }))
+    Ok(changes)
 }
 
-fn symbol(a: &Analysis, file: FileId, name: &str, kind: u32, span: Span, sel: Span, children: Vec<Value>) -> Value {
+/// A declaration of the document, with those it holds.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Symbol {
+    pub name: String,
+    pub kind: SymbolKind,
+    /// The whole declaration.
+    pub range: Range,
+    /// Its name.
+    pub selection: Range,
+    pub children: Vec<Symbol>,
+}
+
+fn symbol(
+    a: &Analysis,
+    file: FileId,
+    name: &str,
+    kind: SymbolKind,
+    span: Span,
+    sel: Span,
+    children: Vec<Symbol>,
+) -> Symbol {
     let name = if name.is_empty() { "?" } else { name };
-    json!({
-        "name": name,
-        "kind": kind,
-        "range": a.range(file, span),
-        "selectionRange": a.range(file, sel),
-        "children": children,
-    })
+    Symbol { name: name.to_string(), kind, range: a.range(file, span), selection: a.range(file, sel), children }
 }
 
-// The protocol's SymbolKind numbers.
-const FILE: u32 = 1;
-const MODULE: u32 = 2;
-const NAMESPACE: u32 = 3;
-const CLASS: u32 = 5;
-const METHOD: u32 = 6;
-const PROPERTY: u32 = 7;
-const FIELD: u32 = 8;
-const FUNCTION: u32 = 12;
-const ENUM_MEMBER: u32 = 22;
-const EVENT: u32 = 24;
-const OPERATOR: u32 = 25;
+const FILE: SymbolKind = SymbolKind::FILE;
+const MODULE: SymbolKind = SymbolKind::MODULE;
+const NAMESPACE: SymbolKind = SymbolKind::NAMESPACE;
+const CLASS: SymbolKind = SymbolKind::CLASS;
+const METHOD: SymbolKind = SymbolKind::METHOD;
+const PROPERTY: SymbolKind = SymbolKind::PROPERTY;
+const FIELD: SymbolKind = SymbolKind::FIELD;
+const FUNCTION: SymbolKind = SymbolKind::FUNCTION;
+const ENUM_MEMBER: SymbolKind = SymbolKind::ENUM_MEMBER;
+const EVENT: SymbolKind = SymbolKind::EVENT;
+const OPERATOR: SymbolKind = SymbolKind::OPERATOR;
 
-pub fn document_symbols(world: &World, params: &Value) -> Answer {
-    let (a, file) = analysis(world, params)?;
+/// The document's declarations, as a tree.
+pub fn document_symbols(a: &Analysis, file: FileId) -> Vec<Symbol> {
     let mut out = Vec::new();
     for item in &a.asts[file.0 as usize].items {
         let s = |name: &str, kind, sel| symbol(a, file, name, kind, item.span(), sel, Vec::new());
@@ -336,10 +347,10 @@ pub fn document_symbols(world: &World, params: &Value) -> Answer {
             Item::Script(sc) => s(&sc.name.value, MODULE, sc.name.span),
         });
     }
-    Ok(json!(out))
+    out
 }
 
-fn kind_of(sym: &Sym) -> u32 {
+fn kind_of(sym: &Sym) -> SymbolKind {
     match sym {
         Sym::State(_) | Sym::Symbol { .. } => ENUM_MEMBER,
         Sym::Agent(_) => CLASS,
@@ -348,7 +359,7 @@ fn kind_of(sym: &Sym) -> u32 {
         Sym::Function { .. } => FUNCTION,
         Sym::Rule(_) => METHOD,
         Sym::FsmState { .. } => ENUM_MEMBER,
-        Sym::Variable { .. } => 13,
+        Sym::Variable { .. } => SymbolKind::VARIABLE,
     }
 }
 
@@ -361,9 +372,20 @@ fn container(sym: &Sym) -> Option<String> {
     }
 }
 
-/// The declarations of every analysis whose name contains the query (any case).
-pub fn workspace_symbols(world: &World, params: &Value) -> Answer {
-    let query = params.get("query").and_then(Value::as_str).unwrap_or("").to_lowercase();
+/// A declaration found by a workspace search.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct WorkspaceSymbol {
+    pub name: String,
+    pub kind: SymbolKind,
+    pub location: Location,
+    /// The event, field or agent it belongs to.
+    pub container: Option<String>,
+}
+
+/// The declarations of every analysis whose name contains the query (any
+/// case); at most 1,000.
+pub fn workspace_symbols(world: &World, query: &str) -> Vec<WorkspaceSymbol> {
+    let query = query.to_lowercase();
     let mut seen = std::collections::BTreeSet::new();
     let mut out = Vec::new();
     for a in world.analyses.values() {
@@ -371,15 +393,93 @@ pub fn workspace_symbols(world: &World, params: &Value) -> Answer {
             if !o.sym.name().to_lowercase().contains(&query) || !seen.insert((a.uri(o.file), o.span.start)) {
                 continue;
             }
-            let mut v = json!({ "name": o.sym.name(), "kind": kind_of(&o.sym), "location": location(a, o) });
-            if let Some(c) = container(&o.sym) {
-                v["containerName"] = json!(c);
-            }
-            out.push(v);
+            out.push(WorkspaceSymbol {
+                name: o.sym.name().to_string(),
+                kind: kind_of(&o.sym),
+                location: location(a, o),
+                container: container(&o.sym),
+            });
             if out.len() >= 1000 {
-                return Ok(json!(out));
+                return out;
             }
         }
     }
-    Ok(json!(out))
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::world::{world_of, SMALL};
+
+    /// The offset of the `nth` `needle` of `SMALL`, `into` bytes in.
+    fn offset(needle: &str, nth: usize, into: usize) -> usize {
+        SMALL.match_indices(needle).nth(nth).unwrap().0 + into
+    }
+
+    #[test]
+    fn hover_says_what_a_name_is() {
+        let (w, path) = world_of("nav-hover", SMALL);
+        let (a, file) = w.primary(&path).unwrap();
+        let h = hover(a, file, offset("IT", 0, 1)).unwrap();
+        assert!(h.markdown.starts_with("**state** `IT` (initial)"), "{}", h.markdown);
+        assert_eq!((h.range.start.line, h.range.start.character, h.range.end.character), (2, 9, 11));
+        assert!(hover(a, file, offset("event F", 0, 7)).unwrap().markdown.starts_with("**event** `F` of `A`"));
+        assert_eq!(hover(a, file, offset("rule", 0, 4)), None, "a space is no name");
+    }
+
+    #[test]
+    fn definition_references_and_highlights_of_a_name() {
+        let (w, path) = world_of("nav-refs", SMALL);
+        let (a, file) = w.primary(&path).unwrap();
+        let use_of_e = offset(" E then", 0, 1);
+        let def = definition(a, file, use_of_e).unwrap();
+        assert_eq!((def.range.start.line, def.range.start.character), (4, 10));
+        assert!(def.uri.ends_with("/nav-refs.situ"), "{}", def.uri);
+        assert_eq!(references(a, file, use_of_e, true).len(), 2);
+        assert_eq!(references(a, file, use_of_e, false).len(), 1);
+        let marks = highlight(a, file, use_of_e);
+        assert_eq!(marks.iter().filter(|h| h.declaration).count(), 1);
+        assert_eq!(marks.len(), 2);
+        assert!(references(a, file, offset("//", 0, 1), true).is_empty());
+    }
+
+    #[test]
+    fn rename_edits_every_place_or_refuses() {
+        let (w, path) = world_of("nav-rename", SMALL);
+        let (a, file) = w.primary(&path).unwrap();
+        let it = offset("IT", 1, 0);
+        assert_eq!(prepare_rename(a, file, it).unwrap().placeholder, "IT");
+        let edit = rename(a, file, it, "IDLE").unwrap();
+        let edits = &edit[&a.uri(file)];
+        assert_eq!(edits.len(), 3, "{edits:?}");
+        assert!(edits.iter().all(|e| e.new_text == "IDLE"));
+        let taken = rename(a, file, it, "RD").unwrap_err();
+        assert!(taken.0.starts_with("there is already a state `RD` at "), "{}", taken.0);
+        assert!(rename(a, file, it, "state").unwrap_err().0.contains("keyword"));
+        assert_eq!(rename(a, file, offset("//", 0, 0), "X"), Err(Refusal("no name to rename here".into())));
+    }
+
+    #[test]
+    fn the_document_symbols_are_a_tree() {
+        let (w, path) = world_of("nav-symbols", SMALL);
+        let (a, file) = w.primary(&path).unwrap();
+        let symbols = document_symbols(a, file);
+        let names: Vec<(&str, SymbolKind)> = symbols.iter().map(|s| (s.name.as_str(), s.kind)).collect();
+        assert_eq!(names, [("states", NAMESPACE), ("A", CLASS), ("r", METHOD)]);
+        let states: Vec<&str> = symbols[0].children.iter().map(|s| s.name.as_str()).collect();
+        assert_eq!(states, ["IT", "RD"]);
+        let agent: Vec<&str> = symbols[1].children.iter().map(|s| s.name.as_str()).collect();
+        assert_eq!(agent, ["E", "F", "f", "table"]);
+        assert_eq!((symbols[1].range.start.line, symbols[1].range.end.line), (3, 10));
+        assert_eq!(symbols[1].selection.start.character, 6);
+    }
+
+    #[test]
+    fn workspace_symbols_match_any_case() {
+        let (w, _) = world_of("nav-workspace", SMALL);
+        let found: Vec<(String, Option<String>)> =
+            workspace_symbols(&w, "f").into_iter().map(|s| (s.name, s.container)).collect();
+        assert_eq!(found, [("F".to_string(), None), ("f".to_string(), Some("A".to_string()))]);
+    }
 }

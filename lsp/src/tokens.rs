@@ -2,10 +2,9 @@
 //! classified by the name index, and folding ranges.
 
 use crate::index::Sym;
-use crate::nav::analysis;
-use crate::server::Answer;
-use serde_json::{json, Value};
+use crate::world::Analysis;
 use situ_grammar::ast::{AgentMember, Item, Span};
+use situ_grammar::diag::FileId;
 use situ_grammar::parse::KEYWORDS;
 use std::collections::HashMap;
 
@@ -104,7 +103,9 @@ pub fn lex(text: &str) -> Vec<Token> {
     out
 }
 
-const TYPES: [&str; 12] = [
+/// The semantic token types, in the order of [`TokenType`]: the legend the
+/// server announces in its capabilities.
+pub const TOKEN_TYPES: [&str; 12] = [
     "keyword",
     "string",
     "number",
@@ -119,45 +120,82 @@ const TYPES: [&str; 12] = [
     "type",
 ];
 
-pub fn legend() -> Value {
-    json!({ "tokenTypes": TYPES, "tokenModifiers": ["declaration"] })
+/// The semantic token modifiers: bit 0 marks a declaration.
+pub const TOKEN_MODIFIERS: [&str; 1] = ["declaration"];
+
+/// What a token is shown as; its number is its place in [`TOKEN_TYPES`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TokenType {
+    Keyword,
+    String,
+    Number,
+    Comment,
+    EnumMember,
+    Class,
+    Event,
+    Property,
+    Function,
+    Method,
+    Variable,
+    Type,
 }
 
-fn type_of(sym: &Sym) -> usize {
-    match sym {
-        Sym::State(_) | Sym::Symbol { .. } | Sym::FsmState { .. } => 4,
-        Sym::Agent(_) => 5,
-        Sym::Event(_) => 6,
-        Sym::Field { .. } => 7,
-        Sym::Function { .. } => 8,
-        Sym::Rule(_) => 9,
-        Sym::Variable { .. } => 10,
+impl TokenType {
+    /// Its index in the legend.
+    pub fn index(self) -> u32 {
+        self as u32
     }
 }
 
-pub fn semantic_tokens(world: &crate::world::World, params: &Value) -> Answer {
-    let (a, file) = analysis(world, params)?;
+/// One classified token, on one line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SemanticToken {
+    pub line: u32,
+    /// The first UTF-16 column.
+    pub start: u32,
+    /// In UTF-16 code units.
+    pub length: u32,
+    pub ty: TokenType,
+    pub declaration: bool,
+}
+
+fn type_of(sym: &Sym) -> TokenType {
+    match sym {
+        Sym::State(_) | Sym::Symbol { .. } | Sym::FsmState { .. } => TokenType::EnumMember,
+        Sym::Agent(_) => TokenType::Class,
+        Sym::Event(_) => TokenType::Event,
+        Sym::Field { .. } => TokenType::Property,
+        Sym::Function { .. } => TokenType::Function,
+        Sym::Rule(_) => TokenType::Method,
+        Sym::Variable { .. } => TokenType::Variable,
+    }
+}
+
+/// The tokens of `file` worth colouring, in the order of the text: keywords,
+/// literals, comments, and the names the index knows.
+pub fn semantic_tokens(a: &Analysis, file: FileId) -> Vec<SemanticToken> {
     let text = a.text(file);
     let lines = &a.lines[file.0 as usize];
-    let names: HashMap<usize, (usize, bool)> = a
+    let names: HashMap<usize, (TokenType, bool)> = a
         .index
         .occurrences
         .iter()
         .filter(|o| o.file == file)
         .map(|o| (o.span.start, (type_of(&o.sym), o.def)))
         .collect();
-    let mut data = Vec::new();
-    let (mut last_line, mut last_col) = (0u32, 0u32);
+    let mut out = Vec::new();
     for t in lex(text) {
         let (span, ty, def) = match t.kind {
-            Tok::Keyword if ["f64", "i64", "bool"].contains(&&text[t.span.start..t.span.end]) => (t.span, 11, false),
-            Tok::Keyword => (t.span, 0, false),
-            Tok::Str => (t.span, 1, false),
-            Tok::Number => (t.span, 2, false),
-            Tok::Comment => (t.span, 3, false),
+            Tok::Keyword if ["f64", "i64", "bool"].contains(&&text[t.span.start..t.span.end]) => {
+                (t.span, TokenType::Type, false)
+            }
+            Tok::Keyword => (t.span, TokenType::Keyword, false),
+            Tok::Str => (t.span, TokenType::String, false),
+            Tok::Number => (t.span, TokenType::Number, false),
+            Tok::Comment => (t.span, TokenType::Comment, false),
             Tok::Variable => {
                 let span = Span::new(t.span.start + 1, t.span.end);
-                (span, 10, names.get(&span.start).is_some_and(|n| n.1))
+                (span, TokenType::Variable, names.get(&span.start).is_some_and(|n| n.1))
             }
             Tok::Name => match names.get(&t.span.start) {
                 Some(&(ty, def)) => (t.span, ty, def),
@@ -170,16 +208,29 @@ pub fn semantic_tokens(world: &crate::world::World, params: &Value) -> Answer {
         if end.line != start.line || end.character <= start.character {
             continue;
         }
-        let delta_line = start.line - last_line;
-        let delta_col = if delta_line == 0 { start.character - last_col } else { start.character };
-        data.extend([delta_line, delta_col, end.character - start.character, ty as u32, u32::from(def)]);
-        (last_line, last_col) = (start.line, start.character);
+        out.push(SemanticToken {
+            line: start.line,
+            start: start.character,
+            length: end.character - start.character,
+            ty,
+            declaration: def,
+        });
     }
-    Ok(json!({ "data": data }))
+    out
 }
 
-pub fn folding(world: &crate::world::World, params: &Value) -> Answer {
-    let (a, file) = analysis(world, params)?;
+/// A range of lines the editor may fold.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Fold {
+    pub start_line: u32,
+    pub end_line: u32,
+    /// A run of whole-line comments.
+    pub comment: bool,
+}
+
+/// The items, tables, FSMs and events of more than one line, then the runs of
+/// comments.
+pub fn folding(a: &Analysis, file: FileId) -> Vec<Fold> {
     let text = a.text(file);
     let lines = &a.lines[file.0 as usize];
     let mut spans = Vec::new();
@@ -197,10 +248,11 @@ pub fn folding(world: &crate::world::World, params: &Value) -> Answer {
     for span in spans {
         let (s, e) = (lines.position(text, span.start).line, lines.position(text, span.end).line);
         if e > s {
-            out.push(json!({ "startLine": s, "endLine": e }));
+            out.push(Fold { start_line: s, end_line: e, comment: false });
         }
     }
     // Runs of whole-line comments.
+    let comments = |s, e| Fold { start_line: s, end_line: e, comment: true };
     let mut run: Option<(u32, u32)> = None;
     for t in lex(text).into_iter().filter(|t| t.kind == Tok::Comment) {
         let line = lines.position(text, t.span.start).line;
@@ -208,7 +260,7 @@ pub fn folding(world: &crate::world::World, params: &Value) -> Answer {
             Some((s, e)) if e + 1 == line => Some((s, line)),
             Some((s, e)) => {
                 if e > s {
-                    out.push(json!({ "startLine": s, "endLine": e, "kind": "comment" }));
+                    out.push(comments(s, e));
                 }
                 Some((line, line))
             }
@@ -216,9 +268,9 @@ pub fn folding(world: &crate::world::World, params: &Value) -> Answer {
         };
     }
     if let Some((s, e)) = run.filter(|(s, e)| e > s) {
-        out.push(json!({ "startLine": s, "endLine": e, "kind": "comment" }));
+        out.push(comments(s, e));
     }
-    Ok(json!(out))
+    out
 }
 
 #[cfg(test)]
@@ -244,5 +296,31 @@ mod tests {
             let toks = lex(text);
             assert!(toks.iter().all(|t| t.span.end <= text.len() && t.span.start < t.span.end), "{text:?}");
         }
+    }
+
+    #[test]
+    fn semantic_tokens_classify_names_by_the_index() {
+        let (w, path) = crate::world::world_of("tokens", crate::world::SMALL);
+        let (a, file) = w.primary(&path).unwrap();
+        let tokens = semantic_tokens(a, file);
+        let at = |line, start| tokens.iter().find(|t| t.line == line && t.start == start).copied();
+        let t = |line, start, length, ty, declaration| Some(SemanticToken { line, start, length, ty, declaration });
+        assert_eq!(at(0, 0), t(0, 0, 4, TokenType::Comment, false));
+        assert_eq!(at(2, 0), t(2, 0, 6, TokenType::Keyword, false));
+        assert_eq!(at(2, 9), t(2, 9, 2, TokenType::EnumMember, true));
+        assert_eq!(at(3, 6), t(3, 6, 1, TokenType::Class, true));
+        assert_eq!(at(11, 5), t(11, 5, 1, TokenType::Method, true));
+        assert!(tokens.windows(2).all(|p| (p[0].line, p[0].start) < (p[1].line, p[1].start)), "in order");
+        assert_eq!(TOKEN_TYPES[TokenType::EnumMember.index() as usize], "enumMember");
+    }
+
+    #[test]
+    fn folds_cover_items_tables_and_comment_runs() {
+        let (w, path) = crate::world::world_of("folding", crate::world::SMALL);
+        let (a, file) = w.primary(&path).unwrap();
+        let folds: Vec<(u32, u32, bool)> =
+            folding(a, file).into_iter().map(|f| (f.start_line, f.end_line, f.comment)).collect();
+        // An event's span runs to the next member: `event E` folds down to `event F`.
+        assert_eq!(folds, [(3, 10, false), (4, 5, false), (5, 6, false), (7, 9, false), (0, 1, true)]);
     }
 }

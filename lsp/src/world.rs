@@ -6,6 +6,7 @@
 //! open file that includes it, if there is one (the names it uses may be
 //! declared there), otherwise its own.
 
+use crate::data::Location;
 use crate::index::Index;
 use crate::text::{path_to_uri, LineIndex};
 use situ_compiler::loader::{normalize, FsLoader, Loader};
@@ -141,8 +142,8 @@ impl Analysis {
         self.lines[file.0 as usize].range(self.text(file), span)
     }
 
-    pub fn location(&self, file: FileId, span: ast::Span) -> serde_json::Value {
-        serde_json::json!({ "uri": self.uri(file), "range": self.range(file, span) })
+    pub fn location(&self, file: FileId, span: ast::Span) -> Location {
+        Location { uri: self.uri(file), range: self.range(file, span) }
     }
 }
 
@@ -259,6 +260,21 @@ impl World {
         self.analyses.values().flat_map(|a| a.paths.iter().cloned()).collect()
     }
 }
+
+/// A world with one open document, checked in full, for the features' tests.
+#[cfg(test)]
+pub fn world_of(name: &str, text: &str) -> (World, PathBuf) {
+    let path = PathBuf::from(format!("/nonexistent/situ-lsp/{name}.situ"));
+    let mut w = World::default();
+    w.open(path.clone(), Doc::new(path_to_uri(&path), text.into(), 1));
+    w.refresh_fully();
+    (w, path)
+}
+
+/// A small program for the features' tests: a comment, a table without a row
+/// for `RD` (W0311), an event nobody reads (`F`, W0308).
+#[cfg(test)]
+pub const SMALL: &str = "// a\n// b\nstates { IT initial RD final }\nagent A sensor {\n    event E\n    event F\n    function f\n    table {\n        IT => run f()\n    }\n}\nrule r { when state == IT and E then RD }\n";
 
 #[cfg(test)]
 mod tests {
