@@ -246,7 +246,7 @@ pub fn prepare_rename(a: &Analysis, file: FileId, offset: usize) -> Result<Renam
 /// there is no name, where `new` is not a name, or where it is taken.
 pub fn rename(a: &Analysis, file: FileId, offset: usize, new: &str) -> Result<WorkspaceEdit, Refusal> {
     let o = a.index.at(file, offset).ok_or_else(|| Refusal("no name to rename here".into()))?;
-    valid_name(new).map_err(Refusal)?;
+    valid_name(new).map_err(|e| Refusal(e.to_string()))?;
     if new != o.sym.name() && a.index.is_declared(&o.sym, new) {
         let what = o.sym.kind();
         let place = a.index.definition(&o.sym.renamed(new)).map(|d| {

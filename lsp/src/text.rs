@@ -100,17 +100,26 @@ pub fn path_to_uri(path: &Path) -> String {
     out
 }
 
+/// Why a text cannot be a name.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum NameError {
+    #[error("`{0}` is not a name: a letter, then letters, digits and `_`")]
+    NotAName(String),
+    #[error("`{0}` is a keyword and cannot be a name")]
+    Keyword(String),
+}
+
 /// Whether `name` can name something: a letter, then letters, digits and `_`,
 /// not a keyword.
-pub fn valid_name(name: &str) -> Result<(), String> {
+pub fn valid_name(name: &str) -> Result<(), NameError> {
     let mut chars = name.chars();
     let ok =
         chars.next().is_some_and(|c| c.is_ascii_alphabetic()) && chars.all(|c| c.is_ascii_alphanumeric() || c == '_');
     if !ok {
-        return Err(format!("`{name}` is not a name: a letter, then letters, digits and `_`"));
+        return Err(NameError::NotAName(name.to_string()));
     }
     if situ_grammar::parse::KEYWORDS.contains(&name) {
-        return Err(format!("`{name}` is a keyword and cannot be a name"));
+        return Err(NameError::Keyword(name.to_string()));
     }
     Ok(())
 }
@@ -164,7 +173,7 @@ mod tests {
     #[test]
     fn names_are_checked() {
         assert!(valid_name("RS2").is_ok());
-        assert!(valid_name("state").unwrap_err().contains("keyword"));
+        assert!(valid_name("state").unwrap_err().to_string().contains("keyword"));
         assert!(valid_name("2x").is_err());
         assert!(valid_name("").is_err());
     }
