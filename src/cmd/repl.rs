@@ -34,6 +34,13 @@ impl Completer for Words {
     }
 }
 
+// The arguments of `situ repl`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// A `.situ` source or a bundle.
+    pub file: std::path::PathBuf,
+}
+
 pub fn run(file: &Path) -> u8 {
     let program = match super::program::load(file, false) {
         Ok(p) => p,

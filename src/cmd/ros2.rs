@@ -14,14 +14,28 @@ pub enum Rmw {
     Fastrtps,
 }
 
+// The arguments of `situ ros2`.
+#[derive(clap::Args)]
 pub struct Args {
+    /// The rules (a `.situ` source or a bundle).
     pub file: PathBuf,
+    /// The ROS 2 map (TOML): which topic each event comes from, which agents are lifecycle nodes.
+    #[arg(long)]
     pub map: PathBuf,
+    /// The DDS domain (default: ROS_DOMAIN_ID, else 0).
+    #[arg(long)]
     pub domain: Option<u16>,
+    /// The RMW of the robot's nodes: how their lifecycle services are carried.
+    #[arg(long, value_enum, default_value_t = Rmw::Fastrtps)]
     pub rmw: Rmw,
+    /// Stop after this many seconds (default: until Ctrl-C or SIGTERM).
+    #[arg(long)]
     pub duration: Option<f64>,
+    /// Record what came and went as a ROS 2 bag (a new directory; MCAP storage).
+    #[arg(long, value_name = "DIR")]
     pub record: Option<PathBuf>,
-    pub trust: Vec<PathBuf>,
+    #[command(flatten)]
+    pub trust: super::Trust,
 }
 
 const NO_BRIDGE: &str = "this situ was built without the ROS 2 bridge: `cargo build --features ros2` \
@@ -29,7 +43,7 @@ const NO_BRIDGE: &str = "this situ was built without the ROS 2 bridge: `cargo bu
 
 #[cfg(not(feature = "ros2"))]
 pub fn run(args: Args) -> u8 {
-    let _ = (&args.file, &args.map, args.domain, args.rmw, args.duration, &args.record, &args.trust, OK, FAILED);
+    let _ = (&args.file, &args.map, args.domain, args.rmw, args.duration, &args.record, &args.trust.trust, OK, FAILED);
     eprintln!("error: {NO_BRIDGE}");
     USAGE
 }
@@ -77,7 +91,7 @@ pub fn run(args: Args) -> u8 {
             return USAGE;
         }
     };
-    if let Err(code) = super::program::trust(&args.trust) {
+    if let Err(code) = super::program::trust(&args.trust.trust) {
         return code;
     }
     let program = match super::program::load(&args.file, false) {

@@ -43,21 +43,47 @@ pub enum Engine {
     Random,
 }
 
+// The arguments of `situ test`.
+#[derive(clap::Args)]
 pub struct Args {
+    #[arg(required = true)]
     pub files: Vec<PathBuf>,
+    /// Only the tests and properties whose name contains this.
+    #[arg(long)]
     pub filter: Option<String>,
+    #[arg(long, value_enum, default_value_t = Format::Human)]
     pub format: Format,
+    /// Which checkers look at the properties.
+    #[arg(long, value_enum, default_value_t = Engine::Both)]
     pub engine: Engine,
+    /// The seed of the random search.
+    #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Random runs per property.
+    #[arg(long, default_value_t = 256)]
     pub cases: u32,
+    /// Events per random run.
+    #[arg(long, default_value_t = 120)]
     pub length: usize,
+    /// The most events the exhaustive exploration goes from the start.
+    #[arg(long, default_value_t = 12)]
     pub depth: usize,
+    /// The most abstract states the exhaustive exploration makes.
+    #[arg(long, default_value_t = 20_000)]
     pub max_states: usize,
-    /// IC3's work budget per property (SAT propagations).
+    /// IC3's work budget per property, in SAT propagations: the same
+    /// budget gives the same verdict on any machine under any load.
+    #[arg(long, default_value_t = situ_verify::property::DEFAULT_EFFORT)]
     pub prove_effort: u64,
-    /// Wall-clock guard of IC3 per property, in seconds.
+    /// A wall-clock guard on IC3, in seconds per property; a property it
+    /// stops is undecided, and the output says it was the clock.
+    #[arg(long, default_value_t = 600.0)]
     pub prove_timeout: f64,
+    /// Exit 0 when no property is violated, even if some are undecided.
+    #[arg(long)]
     pub allow_undecided: bool,
+    /// Print the size and time of the exploration and the random search.
+    #[arg(long)]
     pub stats: bool,
 }
 
@@ -71,7 +97,7 @@ impl Engine {
     }
 }
 
-pub fn run(args: Args) -> u8 {
+pub fn run(args: &Args) -> super::Outcome {
     let (mut passed, mut failed, mut undecided) = (0usize, 0usize, 0usize);
     let mut io_failed = false;
     let human = matches!(args.format, Format::Human);
@@ -144,7 +170,7 @@ pub fn run(args: Args) -> u8 {
             }
         }
         if !props.is_empty() {
-            let reports = check_properties(&args, &content, &props, human);
+            let reports = check_properties(args, &content, &props, human);
             for (p, r) in props.iter().zip(&reports) {
                 if human {
                     print_property(&content, p, r);
@@ -209,13 +235,13 @@ pub fn run(args: Args) -> u8 {
                    "allow_undecided": args.allow_undecided})
         );
     }
-    if io_failed {
+    Ok(if io_failed {
         USAGE
     } else if failed > 0 || (undecided > 0 && !args.allow_undecided) {
         FAILED
     } else {
         OK
-    }
+    })
 }
 
 fn check_properties(args: &Args, content: &Arc<Content>, props: &[&PropertySpec], human: bool) -> Vec<Report> {

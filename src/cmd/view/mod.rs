@@ -26,12 +26,12 @@ pub mod data;
 pub mod guard;
 pub mod live;
 
-use super::USAGE;
+use super::{CliError, Outcome, USAGE};
 use guard::Guard;
 use live::Live;
 use std::io::Write as _;
 use std::net::TcpListener;
-use std::path::Path;
+use std::path::PathBuf;
 use std::sync::Arc;
 
 const INDEX: &str = include_str!("index.html");
@@ -42,23 +42,30 @@ const STYLE: &str = include_str!("style.css");
 /// of its own); one more is told to come back.
 const MAX_WAITING: usize = 64;
 
-pub fn run(file: &Path, rules: Option<&Path>, port: Option<u16>) -> u8 {
-    let site = match data::Site::load(file, rules) {
-        Ok(s) => s,
-        Err(code) => return code,
-    };
+// The arguments of `situ view`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// A `.situ` source, a bundle, or an MCAP recording of `situ run --record`.
+    pub file: PathBuf,
+    /// The rules of a recording (a `.situ` source or a bundle); default: the bundle attached to it. Refused (exit 2) when the recording was made on other rules.
+    #[arg(long, value_name = "FILE")]
+    pub rules: Option<PathBuf>,
+    /// The port to listen on (default: a free one); the URL is the first line on standard output.
+    #[arg(long)]
+    pub port: Option<u16>,
+}
+
+pub fn run(args: &Args) -> Outcome {
+    let site = data::Site::load(&args.file, args.rules.as_deref()).map_err(CliError::Reported)?;
     let host = "127.0.0.1";
-    let server = match listen(host, port.unwrap_or(0), "--port") {
-        Ok(s) => s,
-        Err(code) => return code,
-    };
+    let server = listen(host, args.port.unwrap_or(0), "--port").map_err(CliError::Reported)?;
     // Ctrl-C ends the server; nothing is half written, nothing to undo.
     let _ = ctrlc::set_handler(|| std::process::exit(0));
     println!("serving http://{}/", server.1);
     let _ = std::io::stdout().flush();
     eprintln!("{}; Ctrl-C stops", site.summary());
     serve(Arc::new(site), server.0, Guard::new(server.1, host), None);
-    super::OK
+    Ok(super::OK)
 }
 
 /// Serves a run's page live (`situ run … --serve [ADDR]`) from a thread of
