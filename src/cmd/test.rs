@@ -9,18 +9,18 @@
 
 use super::{FAILED, OK, USAGE};
 use serde_json::json;
-use situ_compiler::bundle::{self, Content};
+use situ_compiler::bundle::Content;
 use situ_compiler::codes;
 use situ_compiler::loader::FsLoader;
 use situ_compiler::render;
-use situ_compiler::spec::{self, PropertySpec, TestSpec};
+use situ_compiler::spec::{PropertySpec, TestSpec};
 use situ_grammar::diag::Diagnostic;
 use situ_verify::explore::Limits;
-use situ_verify::property::{self, Checker, Conclusion, Engines, Premise, Report};
+use situ_verify::property::{self, Checker, Conclusion, Engines, Premise, Report, Session};
 use situ_verify::random::Search;
+use situ_verify::suite::{self, FileOutcome, SuiteReport};
 use situ_verify::{scenario, show_event, Counterexample, Verdict};
 use std::path::PathBuf;
-use std::sync::Arc;
 use std::time::Duration;
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -97,197 +97,221 @@ impl Engine {
     }
 }
 
+impl Args {
+    /// The suite's options (`situ_verify::suite` holds the policy).
+    fn options(&self) -> suite::Options {
+        suite::Options {
+            filter: self.filter.clone(),
+            properties: property::Options {
+                engines: self.engine.engines(),
+                search: Search { seed: self.seed, cases: self.cases, length: self.length },
+                limits: Limits { depth: self.depth, max_states: self.max_states },
+                effort: self.prove_effort,
+                timeout: Some(Duration::from_secs_f64(self.prove_timeout.clamp(0.0, 86_400.0))),
+            },
+            allow_undecided: self.allow_undecided,
+        }
+    }
+}
+
 pub fn run(args: &Args) -> super::Outcome {
-    let (mut passed, mut failed, mut undecided) = (0usize, 0usize, 0usize);
-    let mut io_failed = false;
-    let human = matches!(args.format, Format::Human);
-    let sarif = matches!(args.format, Format::Sarif);
-    let json_lines = matches!(args.format, Format::Json);
-    let (mut sarif_checked, mut sarif_failures) = (Vec::new(), Vec::new());
-    for path in &args.files {
-        let mut checked = match situ_compiler::check(path, &FsLoader) {
-            Ok(c) => c,
-            Err(e) => {
+    let report = suite::run(&args.files, &FsLoader, &args.options());
+    let verdict = report.verdict();
+    match args.format {
+        Format::Human => human(args, &report),
+        Format::Json => json_lines(&report),
+        Format::Sarif => sarif(report),
+    }
+    Ok(match verdict {
+        suite::Verdict::Pass => OK,
+        suite::Verdict::Fail => FAILED,
+        suite::Verdict::Unreadable => USAGE,
+    })
+}
+
+/// A line per test and property, the failures of each file, a summary.
+fn human(args: &Args, report: &SuiteReport) {
+    for file in &report.files {
+        let path = file.path.display();
+        let r = match &file.outcome {
+            FileOutcome::Unreadable(e) => {
                 eprintln!("error: {e}");
-                io_failed = true;
-                sarif_failures.push(e);
                 continue;
             }
+            FileOutcome::Errors(checked) => {
+                print!("{}", render::human_all(checked, super::style()));
+                println!("{path}: {} error(s): no test or property was run", checked.errors());
+                continue;
+            }
+            FileOutcome::Ran(_, r) => r,
         };
-        if checked.errors() > 0 {
-            if human {
-                print!("{}", render::human_all(&checked, super::style()));
-                println!("{}: {} error(s): no test or property was run", path.display(), checked.errors());
-            } else if json_lines {
-                print!("{}", render::json_lines(&checked));
-            }
-            failed += 1;
-            sarif_checked.push(checked);
-            continue;
-        }
-        let content = Arc::new(bundle::build(&checked));
-        let spec = spec::lower(&checked);
-        let wanted = |name: &str| args.filter.as_deref().is_none_or(|f| name.contains(f));
-        let tests: Vec<&TestSpec> = spec.tests.iter().filter(|t| wanted(&t.name)).collect();
-        let props: Vec<&PropertySpec> = spec.properties.iter().filter(|p| wanted(&p.name)).collect();
-        if human {
-            println!(
-                "\nrunning {} and {} from {}",
-                count(tests.len(), "test"),
-                count(props.len(), "property"),
-                path.display()
-            );
-        }
+        println!(
+            "\nrunning {} and {} from {path}",
+            count(r.tests.len(), "test"),
+            count(r.properties.len(), "property"),
+        );
         let mut failures = Vec::new();
-        let mut verdicts = Vec::new();
-        for t in &tests {
-            let outcome = scenario::run(&content, t);
-            if human {
-                println!("test \"{}\" ... {}", t.name, if outcome.passed() { "ok" } else { "FAILED" });
-            } else if json_lines {
-                let list: Vec<_> = outcome
-                    .failures
-                    .iter()
-                    .map(|f| json!({"place": f.place.to_string(), "message": f.message}))
-                    .collect();
-                println!(
-                    "{}",
-                    json!({"kind": "test", "file": path.display().to_string(), "name": t.name,
-                           "place": t.place.to_string(), "passed": outcome.passed(), "events": outcome.events,
-                           "failures": list})
-                );
-            }
-            if outcome.passed() {
-                passed += 1;
-            } else {
-                failed += 1;
-                verdicts.push(test_diagnostic(t, &outcome));
-                let mut text = format!("---- test \"{}\" ({}) ----\n", t.name, t.place);
-                for f in &outcome.failures {
+        for t in &r.tests {
+            println!("test \"{}\" ... {}", t.spec.name, if t.outcome.passed() { "ok" } else { "FAILED" });
+            if !t.outcome.passed() {
+                let mut text = format!("---- test \"{}\" ({}) ----\n", t.spec.name, t.spec.place);
+                for f in &t.outcome.failures {
                     text.push_str(&format!("  {}: {}\n", f.place, f.message));
                 }
                 failures.push(text);
             }
         }
-        if !props.is_empty() {
-            let reports = check_properties(args, &content, &props, human);
-            for (p, r) in props.iter().zip(&reports) {
-                if human {
-                    print_property(&content, p, r);
-                } else if json_lines {
-                    println!("{}", property_json(&content, path, p, r));
-                }
-                verdicts.extend(property_diagnostics(&content, p, r));
-                match &r.conclusion {
-                    Conclusion::Proved { .. } => passed += 1,
-                    Conclusion::Undecided { .. } => undecided += 1,
-                    Conclusion::Violated { by, how, counterexample } => {
-                        failed += 1;
-                        let mut text = format!("---- property \"{}\" ({}) ----\n", p.name, p.place);
-                        text.push_str(&format!(
-                            "counterexample ({}, {how}, {} events):\n",
-                            by.name(),
-                            counterexample.steps.len()
-                        ));
-                        text.push_str(&counterexample.describe(&content));
-                        text.push_str("replay it as a test (paste it into the file):\n");
-                        text.push_str(&counterexample.as_test(&content, &p.name));
-                        failures.push(text);
-                    }
-                    Conclusion::Disagree { .. } => {
-                        failed += 1;
-                        failures.push(format!(
-                            "---- property \"{}\" ({}) ----\nIC3's counterexample does not replay on the engine: an error of situ, please report it\n",
-                            p.name, p.place
-                        ));
-                    }
-                }
+        if args.stats {
+            if let Some(session) = &r.session {
+                print_stats(session, &r.properties);
             }
         }
-        if human && !failures.is_empty() {
+        for p in &r.properties {
+            print_property(&r.content, &p.spec, &p.report);
+            if let Some(text) = property_failure(&r.content, &p.spec, &p.report) {
+                failures.push(text);
+            }
+        }
+        if !failures.is_empty() {
             println!("\nfailures:\n");
             for f in &failures {
                 println!("{f}");
             }
         }
-        if sarif {
-            checked.diagnostics.extend(verdicts);
-            sarif_checked.push(checked);
-        }
     }
-    if sarif {
-        let checks: Vec<&situ_compiler::Checked> = sarif_checked.iter().collect();
-        let failures: Vec<_> = sarif_failures.iter().collect();
-        println!("{}", render::sarif_with_failures(&checks, &failures));
+    let s = report.summary;
+    println!("\n{} passed, {} failed, {} undecided", s.passed, s.failed, s.undecided);
+    if s.undecided > 0 && !report.allow_undecided {
+        println!("undecided properties fail the run (E0502: `situ explain E0502`); `--allow-undecided` lets them pass");
     }
-    if human {
-        println!("\n{passed} passed, {failed} failed, {undecided} undecided");
-        if undecided > 0 && !args.allow_undecided {
-            println!(
-                "undecided properties fail the run (E0502: `situ explain E0502`); `--allow-undecided` lets them pass"
-            );
-        }
-    }
-    if json_lines {
-        println!(
-            "{}",
-            json!({"kind": "summary", "passed": passed, "failed": failed, "undecided": undecided,
-                   "allow_undecided": args.allow_undecided})
-        );
-    }
-    Ok(if io_failed {
-        USAGE
-    } else if failed > 0 || (undecided > 0 && !args.allow_undecided) {
-        FAILED
-    } else {
-        OK
-    })
 }
 
-fn check_properties(args: &Args, content: &Arc<Content>, props: &[&PropertySpec], human: bool) -> Vec<Report> {
-    let opts = property::Options {
-        engines: args.engine.engines(),
-        search: Search { seed: args.seed, cases: args.cases, length: args.length },
-        limits: Limits { depth: args.depth, max_states: args.max_states },
-        effort: args.prove_effort,
-        timeout: Some(Duration::from_secs_f64(args.prove_timeout.clamp(0.0, 86_400.0))),
-    };
-    let (session, reports) = property::check_all(content, props, &opts);
-    if args.stats && human {
-        if let Some(g) = &session.graph {
+/// A failed property's text in the failures, if it failed.
+fn property_failure(content: &Content, p: &PropertySpec, r: &Report) -> Option<String> {
+    match &r.conclusion {
+        Conclusion::Violated { by, how, counterexample } => {
+            let mut text = format!("---- property \"{}\" ({}) ----\n", p.name, p.place);
+            text.push_str(&format!(
+                "counterexample ({}, {how}, {} events):\n",
+                by.name(),
+                counterexample.steps.len()
+            ));
+            text.push_str(&counterexample.describe(content));
+            text.push_str("replay it as a test (paste it into the file):\n");
+            text.push_str(&counterexample.as_test(content, &p.name));
+            Some(text)
+        }
+        Conclusion::Disagree { .. } => Some(format!(
+            "---- property \"{}\" ({}) ----\nIC3's counterexample does not replay on the engine: an error of situ, please report it\n",
+            p.name, p.place
+        )),
+        Conclusion::Proved { .. } | Conclusion::Undecided { .. } => None,
+    }
+}
+
+/// One JSON object per test or property, one per line, and the summary.
+fn json_lines(report: &SuiteReport) {
+    for file in &report.files {
+        let path = &file.path;
+        let r = match &file.outcome {
+            FileOutcome::Unreadable(e) => {
+                eprintln!("error: {e}");
+                continue;
+            }
+            FileOutcome::Errors(checked) => {
+                print!("{}", render::json_lines(checked));
+                continue;
+            }
+            FileOutcome::Ran(_, r) => r,
+        };
+        for t in &r.tests {
+            let list: Vec<_> = t
+                .outcome
+                .failures
+                .iter()
+                .map(|f| json!({"place": f.place.to_string(), "message": f.message}))
+                .collect();
             println!(
-                "exploration: {} abstract states, {} edges, {} letters, {} gaps, complete to {} events{}, {:.3} s",
-                g.states(),
-                g.edges(),
-                g.alphabet.letters.len(),
-                g.alphabet.gaps.len(),
-                g.complete_depth,
-                if g.closed { " (closed)" } else { "" },
-                session.graph_time.as_secs_f64()
+                "{}",
+                json!({"kind": "test", "file": path.display().to_string(), "name": t.spec.name,
+                       "place": t.spec.place.to_string(), "passed": t.outcome.passed(), "events": t.outcome.events,
+                       "failures": list})
             );
         }
-        match &session.model {
-            Some(Ok(m)) => println!(
-                "circuit: {} latches, {} inputs, {} and-gates, {:.3} s",
-                m.aig.latches().len(),
-                m.aig.inputs().len(),
-                m.aig.len() - 1 - m.aig.latches().len() - m.aig.inputs().len(),
-                session.model_time.as_secs_f64()
-            ),
-            Some(Err(why)) => println!("circuit: not built ({why})"),
-            None => {}
+        for p in &r.properties {
+            println!("{}", property_json(&r.content, path, &p.spec, &p.report));
         }
-        for (p, r) in props.iter().zip(&reports) {
-            if let Some(t) = r.ic3_time {
-                println!("ic3 \"{}\": {:.3} s", p.name, t.as_secs_f64());
+    }
+    let s = report.summary;
+    println!(
+        "{}",
+        json!({"kind": "summary", "passed": s.passed, "failed": s.failed, "undecided": s.undecided,
+               "allow_undecided": report.allow_undecided})
+    );
+}
+
+/// One SARIF 2.1.0 log: each file's findings with its verdicts as findings.
+fn sarif(report: SuiteReport) {
+    let (mut checks, mut unreadable) = (Vec::new(), Vec::new());
+    for file in report.files {
+        match file.outcome {
+            FileOutcome::Unreadable(e) => {
+                eprintln!("error: {e}");
+                unreadable.push(e);
             }
-            if let (Some(t), Some(Verdict::NotFound { steps, .. })) = (r.random_time, &r.random) {
-                let s = t.as_secs_f64();
-                println!("random \"{}\": {steps} steps in {s:.3} s ({:.0} steps/s)", p.name, *steps as f64 / s);
+            FileOutcome::Errors(checked) => checks.push(checked),
+            FileOutcome::Ran(mut checked, r) => {
+                for t in r.tests.iter().filter(|t| !t.outcome.passed()) {
+                    checked.diagnostics.push(test_diagnostic(&t.spec, &t.outcome));
+                }
+                for p in &r.properties {
+                    checked.diagnostics.extend(property_diagnostics(&r.content, &p.spec, &p.report));
+                }
+                checks.push(checked);
             }
         }
     }
-    reports
+    let checks: Vec<&situ_compiler::Checked> = checks.iter().collect();
+    let failures: Vec<_> = unreadable.iter().collect();
+    println!("{}", render::sarif_with_failures(&checks, &failures));
+}
+
+/// `--stats`: the size and time of the exploration, the circuit, IC3 and
+/// the random search.
+fn print_stats(session: &Session, props: &[suite::PropertyResult]) {
+    if let Some(g) = &session.graph {
+        println!(
+            "exploration: {} abstract states, {} edges, {} letters, {} gaps, complete to {} events{}, {:.3} s",
+            g.states(),
+            g.edges(),
+            g.alphabet.letters.len(),
+            g.alphabet.gaps.len(),
+            g.complete_depth,
+            if g.closed { " (closed)" } else { "" },
+            session.graph_time.as_secs_f64()
+        );
+    }
+    match &session.model {
+        Some(Ok(m)) => println!(
+            "circuit: {} latches, {} inputs, {} and-gates, {:.3} s",
+            m.aig.latches().len(),
+            m.aig.inputs().len(),
+            m.aig.len() - 1 - m.aig.latches().len() - m.aig.inputs().len(),
+            session.model_time.as_secs_f64()
+        ),
+        Some(Err(why)) => println!("circuit: not built ({why})"),
+        None => {}
+    }
+    for p in props {
+        let (name, r) = (&p.spec.name, &p.report);
+        if let Some(t) = r.ic3_time {
+            println!("ic3 \"{name}\": {:.3} s", t.as_secs_f64());
+        }
+        if let (Some(t), Some(Verdict::NotFound { steps, .. })) = (r.random_time, &r.random) {
+            let s = t.as_secs_f64();
+            println!("random \"{name}\": {steps} steps in {s:.3} s ({:.0} steps/s)", *steps as f64 / s);
+        }
+    }
 }
 
 /// A property's line, each checker's answer, its premise.
