@@ -4,7 +4,8 @@
 //! [`McapRecorder`]: the channels, schemas and messages of the recording,
 //! as they are written, with or without a file.
 
-use super::view::{self, data::Site, live::Live};
+use super::view::{self, data::Site};
+use situ_runtime::record::live::{Live, PageTap};
 use situ_runtime::record::mcap::{McapRecorder, Tap};
 use std::io::Write as _;
 use std::sync::{Arc, Mutex};
@@ -48,7 +49,7 @@ impl Watchers {
             recorder.tap(Box::new(f.tap()));
         }
         if let Some((_, live)) = &self.page {
-            recorder.tap(Box::new(view::live::PageTap::new(live.clone())));
+            recorder.tap(Box::new(PageTap::new(live.clone())));
         }
     }
 

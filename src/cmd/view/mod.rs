@@ -24,11 +24,10 @@
 
 pub mod data;
 pub mod guard;
-pub mod live;
 
 use super::{CliError, Outcome, USAGE};
 use guard::Guard;
-use live::Live;
+use situ_runtime::record::live::Live;
 use std::io::Write as _;
 use std::net::TcpListener;
 use std::path::PathBuf;
@@ -56,7 +55,7 @@ pub struct Args {
 }
 
 pub fn run(args: &Args) -> Outcome {
-    let site = data::Site::load(&args.file, args.rules.as_deref()).map_err(CliError::Reported)?;
+    let site = data::Site::load(&args.file, args.rules.as_deref())?;
     let host = "127.0.0.1";
     let server = listen(host, args.port.unwrap_or(0), "--port").map_err(CliError::Reported)?;
     // Ctrl-C ends the server; nothing is half written, nothing to undo.
@@ -69,7 +68,8 @@ pub fn run(args: &Args) -> Outcome {
 }
 
 /// Serves a run's page live (`situ run … --serve [ADDR]`) from a thread of
-/// its own: the page's URL, and the log the run's [`live::PageTap`] fills.
+/// its own: the page's URL, and the log the run's
+/// [`situ_runtime::record::live::PageTap`] fills.
 /// `addr` is `PORT` or `HOST:PORT` (default host 127.0.0.1).
 pub fn serve_live(site: data::Site, addr: &str) -> Result<(String, Arc<Live>), u8> {
     let Some((host, port)) = super::host_port(addr) else {
