@@ -203,7 +203,7 @@ fn dispatch(command: Command) -> cmd::Outcome {
             cmd::bench::run(&args)
         }
         Command::Test(args) => cmd::test::run(&args),
-        Command::Gen { what } => Ok(cmd::gen::run(what)),
+        Command::Gen { what } => cmd::gen::run(what),
         Command::Export(args) => cmd::export::run(&args),
         Command::Run {
             file,
@@ -262,7 +262,7 @@ fn dispatch(command: Command) -> cmd::Outcome {
                 })
             })
         }
-        Command::Repl(args) => Ok(cmd::repl::run(&args.file)),
+        Command::Repl(args) => cmd::repl::run(&args.file),
         Command::Lsp => Ok(cmd::lsp::run()),
         Command::Replay(args) => {
             args.trust.read()?;
@@ -273,7 +273,7 @@ fn dispatch(command: Command) -> cmd::Outcome {
             Ok(cmd::distributed::up(&deploy, &file, stack, duration, &trust.trust))
         }
         Command::Graph(args) => cmd::graph::run(&args),
-        Command::Ros2(args) => Ok(cmd::ros2::run(args)),
+        Command::Ros2(args) => cmd::ros2::run(args),
         Command::View(args) => cmd::view::run(&args),
     }
 }

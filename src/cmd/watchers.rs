@@ -20,15 +20,13 @@ pub struct Watchers {
 
 impl Watchers {
     /// Starts the servers asked for; `site` makes the page's rules (only
-    /// called for `--serve`). The error is printed; the exit code returned.
+    /// called for `--serve`). The error is said (by [`super::exit_code`]);
+    /// its exit code returned, as the run's commands expect.
     pub fn start(foxglove: Option<&str>, serve: Option<&str>, site: impl FnOnce() -> Site) -> Result<Watchers, u8> {
-        let foxglove = match foxglove.map(LiveServer::start).transpose() {
-            Ok(f) => f,
-            Err(e) => {
-                eprintln!("error: --foxglove: {e}");
-                return Err(super::USAGE);
-            }
-        };
+        let foxglove = foxglove
+            .map(LiveServer::start)
+            .transpose()
+            .map_err(|e| super::exit_code(Err(super::CliError::Usage(format!("--foxglove: {e}")))))?;
         let page = serve.map(|addr| view::serve_live(site(), addr)).transpose()?;
         if let Some((url, _)) = &page {
             // The first line on standard output, as `situ view` prints it.

@@ -64,7 +64,7 @@ pub enum FileOutcome {
     /// It has errors: nothing was run (one failure).
     Errors(Checked),
     /// Its tests and properties ran.
-    Ran(Checked, FileReport),
+    Ran(Checked, Box<FileReport>),
 }
 
 /// One file given, and what became of it.
@@ -167,7 +167,7 @@ pub fn run_file(path: &Path, loader: &dyn Loader, opts: &Options) -> FileOutcome
         Ok(checked) if checked.errors() > 0 => FileOutcome::Errors(checked),
         Ok(checked) => {
             let report = run_checked(&checked, opts);
-            FileOutcome::Ran(checked, report)
+            FileOutcome::Ran(checked, Box::new(report))
         }
     }
 }

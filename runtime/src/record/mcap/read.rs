@@ -247,7 +247,7 @@ pub fn read_topics(bytes: &[u8], keep: &dyn Fn(&str) -> bool) -> Result<Reading,
     // still reach a slicing bug of the `mcap` crate (one was found by the
     // fuzz target at the top level): a panic there is damage, not a crash.
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| decode(bytes, scan, keep)))
-        .unwrap_or_else(|_| Err(ReadError::MalformedChunk { size: bytes.len() }))
+        .unwrap_or(Err(ReadError::MalformedChunk { size: bytes.len() }))
 }
 
 /// The `mcap` crate's reader over the records [`scan`] checked.
