@@ -10,16 +10,14 @@
 use super::{FAILED, OK, USAGE};
 use serde_json::json;
 use situ_compiler::bundle::Content;
-use situ_compiler::codes;
 use situ_compiler::loader::FsLoader;
 use situ_compiler::render;
-use situ_compiler::spec::{PropertySpec, TestSpec};
-use situ_grammar::diag::Diagnostic;
+use situ_compiler::spec::PropertySpec;
 use situ_verify::explore::Limits;
 use situ_verify::property::{self, Checker, Conclusion, Engines, Premise, Report, Session};
 use situ_verify::random::Search;
 use situ_verify::suite::{self, FileOutcome, SuiteReport};
-use situ_verify::{scenario, show_event, Counterexample, Verdict};
+use situ_verify::{show_event, Counterexample, Verdict};
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -261,12 +259,7 @@ fn sarif(report: SuiteReport) {
             }
             FileOutcome::Errors(checked) => checks.push(checked),
             FileOutcome::Ran(mut checked, r) => {
-                for t in r.tests.iter().filter(|t| !t.outcome.passed()) {
-                    checked.diagnostics.push(test_diagnostic(&t.spec, &t.outcome));
-                }
-                for p in &r.properties {
-                    checked.diagnostics.extend(property_diagnostics(&r.content, &p.spec, &p.report));
-                }
+                checked.diagnostics.extend(r.findings());
                 checks.push(checked);
             }
         }
@@ -426,87 +419,6 @@ fn property_json(content: &Content, path: &std::path::Path, p: &PropertySpec, r:
            "code": code, "proved_by": proved_by, "undecided_because": reasons,
            "exhaustive": verdict(&r.exhaustive), "symbolic": verdict(&r.symbolic), "random": verdict(&r.random),
            "counterexample": cex, "premise": premise})
-}
-
-/// A failed test as a finding (E0504), at its block.
-fn test_diagnostic(t: &TestSpec, outcome: &scenario::TestOutcome) -> Diagnostic {
-    let first = outcome.failures.first().map_or(String::new(), |f| format!(": {}", f.message));
-    let help: Vec<String> = outcome.failures.iter().map(|f| format!("{}: {}", f.place, f.message)).collect();
-    Diagnostic::error(
-        codes::FAILED_TEST,
-        format!("test \"{}\" failed{first}", t.name),
-        t.origin.file,
-        t.origin.span,
-        "this test",
-    )
-    .with_help(help.join("\n"))
-}
-
-/// A property's verdict as findings: violated (E0503), undecided (E0502),
-/// vacuous (W0501); none for a proved property with a reachable premise.
-fn property_diagnostics(content: &Content, p: &PropertySpec, r: &Report) -> Vec<Diagnostic> {
-    let (file, span) = (p.origin.file, p.origin.span);
-    let mut out = Vec::new();
-    match &r.conclusion {
-        Conclusion::Violated { by, counterexample: c, .. } => {
-            let mut d = Diagnostic::error(
-                codes::VIOLATED_PROPERTY,
-                format!(
-                    "property \"{}\" is broken by a run of {} events (found by {}): {}",
-                    p.name,
-                    c.steps.len(),
-                    by.name(),
-                    c.reason
-                ),
-                file,
-                span,
-                "this property",
-            )
-            .with_help(format!("the run as a test to paste into the file:\n{}", c.as_test(content, &p.name)));
-            let steps: Vec<_> = c
-                .steps
-                .iter()
-                .map(|s| json!({"event": show_event(content, s.event, &s.payload), "time_ns": s.time,
-                                 "state": content.states[s.state as usize].name}))
-                .collect();
-            d.witness = Some(json!({"events": steps, "point": c.point, "reason": c.reason}));
-            out.push(d);
-        }
-        Conclusion::Undecided { reasons } => out.push(
-            Diagnostic::error(
-                codes::UNDECIDED_PROPERTY,
-                format!("property \"{}\" is undecided: no checker proved or broke it within its budget", p.name),
-                file,
-                span,
-                "this property",
-            )
-            .with_help(reasons.join("\n")),
-        ),
-        Conclusion::Disagree { events } => out.push(Diagnostic::error(
-            codes::VIOLATED_PROPERTY,
-            format!(
-                "property \"{}\": IC3's counterexample of {events} events does not replay on the engine (an error of situ, please report it)",
-                p.name
-            ),
-            file,
-            span,
-            "this property",
-        )),
-        Conclusion::Proved { .. } => {}
-    }
-    if let Some(Premise::Vacuous { by }) = &r.premise {
-        out.push(
-            Diagnostic::warning(
-                codes::VACUOUS_PROPERTY,
-                format!("property \"{}\" is vacuous: its premise never holds ({} proved it)", p.name, by.name()),
-                file,
-                span,
-                "this property",
-            )
-            .with_help("check the premise: a state, mode or event pattern that no run reaches together"),
-        );
-    }
-    out
 }
 
 fn count(n: usize, what: &str) -> String {

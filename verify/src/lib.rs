@@ -24,6 +24,7 @@
 pub mod abstraction;
 pub mod aig;
 pub mod explore;
+pub mod findings;
 pub mod ic3;
 pub mod liveness;
 pub mod model;

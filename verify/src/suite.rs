@@ -11,12 +11,13 @@
 //! property is proved (passes), violated or in disagreement (fails), or
 //! undecided (fails unless undecided properties are allowed).
 
+use super::findings;
 use super::property::{self, Conclusion, Report, Session};
 use super::scenario::{self, TestOutcome};
 use situ_compiler::bundle::{self, Content};
 use situ_compiler::loader::Loader;
 use situ_compiler::spec::{self, PropertySpec, TestSpec};
-use situ_compiler::{Checked, RootError};
+use situ_compiler::{Checked, Diagnostic, RootError};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -55,6 +56,16 @@ pub struct FileReport {
     pub properties: Vec<PropertyResult>,
     /// What was built once for the properties (none without properties).
     pub session: Option<Session>,
+}
+
+impl FileReport {
+    /// The verdicts as findings ([`findings`]): the failed tests, then the
+    /// properties violated, undecided or vacuous.
+    pub fn findings(&self) -> Vec<Diagnostic> {
+        let tests = self.tests.iter().filter(|t| !t.outcome.passed()).map(|t| findings::of_test(&t.spec, &t.outcome));
+        let properties = self.properties.iter().flat_map(|p| findings::of_property(&self.content, &p.spec, &p.report));
+        tests.chain(properties).collect()
+    }
 }
 
 /// What became of one file.

@@ -98,3 +98,17 @@ fn undecided_properties_fail_the_suite_unless_allowed() {
     assert_eq!(s.verdict(false), Verdict::Fail);
     assert_eq!(s.verdict(true), Verdict::Pass);
 }
+
+#[test]
+fn the_verdicts_are_findings_with_their_codes() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(&dir, "button.situ", RULES);
+    let report = suite::run(&[file], &FsLoader, &options(None, false));
+    let FileOutcome::Ran(_, r) = &report.files[0].outcome else { panic!("the file has no errors") };
+    let findings = r.findings();
+    let codes: Vec<&str> = findings.iter().map(|d| d.code).collect();
+    // The failed test (E0504), then the violated property (E0503); the proved one has none.
+    assert_eq!(codes, ["E0504", "E0503"]);
+    assert!(findings[0].message.starts_with("test \"a release alone does nothing\" failed"), "{}", findings[0].message);
+    assert!(findings[1].witness.is_some());
+}
