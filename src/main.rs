@@ -1,5 +1,9 @@
 //! The `situ` command line: parses arguments and calls the crates. Every
-//! subcommand is one module of `cmd/`; each returns the process exit code.
+//! subcommand is one module of `cmd/`, with its arguments (one
+//! `#[derive(Args)]` struct, shared groups such as [`cmd::Trust`] flattened
+//! into it); each returns its exit code or a [`cmd::CliError`], and
+//! [`cmd::exit_code`] prints the error and maps it to the exit code, here
+//! and nowhere else.
 
 mod cmd;
 
@@ -21,87 +25,20 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Parse, resolve and check rule files; exit 0 clean, 1 findings that fail, 2 usage or I/O.
-    Check {
-        /// The root files to check (each with its includes).
-        #[arg(required = true)]
-        files: Vec<PathBuf>,
-        /// How to print findings.
-        #[arg(long, value_enum, default_value_t = cmd::check::Format::Human)]
-        format: cmd::check::Format,
-        /// Fail (exit 1) on warnings too.
-        #[arg(long)]
-        deny_warnings: bool,
-        /// Check again on every save of a file or of any file it includes, until Ctrl-C
-        /// (exit 0); each round ends with a line of the time and the summary.
-        #[arg(long)]
-        watch: bool,
-        /// Also check this ROS 2 map (TOML, docs/ros2.md) against the rules; one root file only.
-        #[arg(long, value_name = "MAP")]
-        ros2_map: Option<PathBuf>,
-    },
+    Check(cmd::check::Args),
     /// Format rule files in place; with --check, only report which would change.
-    Fmt {
-        #[arg(required = true)]
-        files: Vec<PathBuf>,
-        /// Change nothing; exit 1 if a file is not formatted.
-        #[arg(long)]
-        check: bool,
-    },
+    Fmt(cmd::fmt::Args),
     /// Print the long text of a diagnostic code (all codes when none is given).
-    Explain {
-        /// A code such as E0101 or situ::E0101.
-        code: Option<String>,
-    },
+    Explain(cmd::explain::Args),
     /// Compile a checked source to a bundle (versioned, hashed); exit 1 on findings, 2 on I/O.
-    Build {
-        file: PathBuf,
-        /// The bundle file to write.
-        #[arg(short, long)]
-        output: PathBuf,
-        /// Write the compact binary form instead of JSON.
-        #[arg(long)]
-        binary: bool,
-        /// Print the network's node counts and what sharing saved.
-        #[arg(long)]
-        stats: bool,
-        /// Refuse to build on warnings too.
-        #[arg(long)]
-        deny_warnings: bool,
-        /// Sign the bundle with this secret key (`situ key new NAME` writes NAME.key).
-        #[arg(long, value_name = "KEY")]
-        sign: Option<PathBuf>,
-    },
+    Build(cmd::build::Args),
     /// Signing keys: `situ key new NAME` writes NAME.key (secret) and NAME.pub (public).
     Key {
         #[command(subcommand)]
         what: cmd::key::What,
     },
     /// Throughput and latency of the Bulletinboard on a seeded random event stream, as JSON.
-    Bench {
-        /// A `.situ` source or a bundle.
-        file: PathBuf,
-        /// How many events.
-        #[arg(long, default_value_t = 1_000_000)]
-        events: u64,
-        /// The stream's seed.
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-        /// Read the events from this stream file instead (bench/README.md).
-        #[arg(long)]
-        stream_in: Option<PathBuf>,
-        /// Write the generated stream here.
-        #[arg(long)]
-        stream_out: Option<PathBuf>,
-        /// Write the `INDEX STATE` lines of the state changes here.
-        #[arg(long)]
-        states_out: Option<PathBuf>,
-        /// Do not reset to the initial state after a final state.
-        #[arg(long)]
-        no_reset: bool,
-        /// Bench only bundles signed by one of these public keys (`situ key new`); refuse others (exit 2).
-        #[arg(long, value_name = "PUBKEY")]
-        trust: Vec<PathBuf>,
-    },
+    Bench(cmd::bench::Args),
     /// Run rules: the reference stack on a mission, or any rules file on a script; exit 0 done, 1 failed, 2 usage.
     Run {
         /// A `.situ` source or a bundle (rules/outdoor.situ, rules/ugv.situ: the stack is told by the agents).
@@ -176,51 +113,15 @@ enum Command {
         /// Real-time runs (demo, none): how long, in seconds.
         #[arg(long, default_value_t = 10.0)]
         duration: f64,
-        /// Run only bundles signed by one of these public keys (`situ key new`); refuse others (exit 2).
-        #[arg(long, value_name = "PUBKEY")]
-        trust: Vec<PathBuf>,
+        #[command(flatten)]
+        trust: cmd::Trust,
     },
     /// Step through the rules by hand: post events, let time pass, ask why (commands from stdin when not a terminal).
-    Repl {
-        /// A `.situ` source or a bundle.
-        file: PathBuf,
-    },
+    Repl(cmd::repl::Args),
     /// Feed a recording's events to a bundle and say where the states differ from the recorded ones; exit 0 same, 1 differ, 2 unreadable (not a regular file, over 1 GiB, not MCAP, damaged, nothing of situ's); a recording cut short (a killed run) replays up to the cut and says so.
-    Replay {
-        /// An MCAP recording of `situ run --record`.
-        recording: PathBuf,
-        /// The rules to replay on (a bundle or a `.situ` source); default: the recording's own.
-        #[arg(long)]
-        bundle: Option<PathBuf>,
-        #[arg(long, value_enum, default_value_t = cmd::replay::Format::Human)]
-        format: cmd::replay::Format,
-        /// Replay only on bundles (the attached one or --bundle) signed by one of these public keys (`situ key new`); refuse others (exit 2).
-        #[arg(long, value_name = "PUBKEY")]
-        trust: Vec<PathBuf>,
-    },
+    Replay(cmd::replay::Args),
     /// The ROS 2 bridge: topics to events, the situation to topics, lifecycle nodes driven by the tables (docs/ros2.md; `--features ros2`).
-    Ros2 {
-        /// The rules (a `.situ` source or a bundle).
-        file: PathBuf,
-        /// The ROS 2 map (TOML): which topic each event comes from, which agents are lifecycle nodes.
-        #[arg(long)]
-        map: PathBuf,
-        /// The DDS domain (default: ROS_DOMAIN_ID, else 0).
-        #[arg(long)]
-        domain: Option<u16>,
-        /// The RMW of the robot's nodes: how their lifecycle services are carried.
-        #[arg(long, value_enum, default_value_t = cmd::ros2::Rmw::Fastrtps)]
-        rmw: cmd::ros2::Rmw,
-        /// Stop after this many seconds (default: until Ctrl-C or SIGTERM).
-        #[arg(long)]
-        duration: Option<f64>,
-        /// Record what came and went as a ROS 2 bag (a new directory; MCAP storage).
-        #[arg(long, value_name = "DIR")]
-        record: Option<PathBuf>,
-        /// Run only bundles signed by one of these public keys (`situ key new`); refuse others (exit 2).
-        #[arg(long, value_name = "PUBKEY")]
-        trust: Vec<PathBuf>,
-    },
+    Ros2(cmd::ros2::Args),
     /// Start every local process of a deployment (Zenoh) and stop them cleanly on Ctrl-C.
     Up {
         /// The deployment file.
@@ -232,107 +133,22 @@ enum Command {
         /// How long each process runs, in seconds.
         #[arg(long, default_value_t = 10.0)]
         duration: f64,
-        /// Run only bundles signed by one of these public keys (`situ key new`); refuse others (exit 2).
-        #[arg(long, value_name = "PUBKEY")]
-        trust: Vec<PathBuf>,
+        #[command(flatten)]
+        trust: cmd::Trust,
     },
     /// Pictures: the wiring of a state, the Rete network, the state transitions.
-    Graph {
-        /// A `.situ` source or a bundle (the states view needs the source).
-        file: PathBuf,
-        #[arg(long, value_enum)]
-        view: cmd::graph::View,
-        /// The state whose wiring to draw (default: all, as clusters).
-        #[arg(long)]
-        state: Option<String>,
-        #[arg(long, value_enum, default_value_t = cmd::graph::Format::Dot)]
-        format: cmd::graph::Format,
-        /// Write here instead of standard output.
-        #[arg(short, long)]
-        output: Option<PathBuf>,
-    },
+    Graph(cmd::graph::Args),
     /// Serve the Supervisor's console on 127.0.0.1 until Ctrl-C: the state graph, the wiring of a state, the rules, and for a recording a timeline; exit 2 on a damaged recording, other rules, or a port in use.
-    View {
-        /// A `.situ` source, a bundle, or an MCAP recording of `situ run --record`.
-        file: PathBuf,
-        /// The rules of a recording (a `.situ` source or a bundle); default: the bundle attached to it. Refused (exit 2) when the recording was made on other rules.
-        #[arg(long, value_name = "FILE")]
-        rules: Option<PathBuf>,
-        /// The port to listen on (default: a free one); the URL is the first line on standard output.
-        #[arg(long)]
-        port: Option<u16>,
-    },
+    View(cmd::view::Args),
     /// Run the tests and check the properties of rule files; exit 0 all hold, 1 a failure, 2 usage or I/O.
-    Test {
-        #[arg(required = true)]
-        files: Vec<PathBuf>,
-        /// Only the tests and properties whose name contains this.
-        #[arg(long)]
-        filter: Option<String>,
-        #[arg(long, value_enum, default_value_t = cmd::test::Format::Human)]
-        format: cmd::test::Format,
-        /// Which checkers look at the properties.
-        #[arg(long, value_enum, default_value_t = cmd::test::Engine::Both)]
-        engine: cmd::test::Engine,
-        /// The seed of the random search.
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-        /// Random runs per property.
-        #[arg(long, default_value_t = 256)]
-        cases: u32,
-        /// Events per random run.
-        #[arg(long, default_value_t = 120)]
-        length: usize,
-        /// The most events the exhaustive exploration goes from the start.
-        #[arg(long, default_value_t = 12)]
-        depth: usize,
-        /// The most abstract states the exhaustive exploration makes.
-        #[arg(long, default_value_t = 20_000)]
-        max_states: usize,
-        /// IC3's work budget per property, in SAT propagations: the same
-        /// budget gives the same verdict on any machine under any load.
-        #[arg(long, default_value_t = situ_verify::property::DEFAULT_EFFORT)]
-        prove_effort: u64,
-        /// A wall-clock guard on IC3, in seconds per property; a property it
-        /// stops is undecided, and the output says it was the clock.
-        #[arg(long, default_value_t = 600.0)]
-        prove_timeout: f64,
-        /// Exit 0 when no property is violated, even if some are undecided.
-        #[arg(long)]
-        allow_undecided: bool,
-        /// Print the size and time of the exploration and the random search.
-        #[arg(long)]
-        stats: bool,
-    },
+    Test(cmd::test::Args),
     /// Generate code from the rules: `situ gen agent AGENT FILE --lang python|rust`.
     Gen {
         #[command(subcommand)]
         what: cmd::gen::What,
     },
     /// Export the abstraction and the properties of a rule file to another tool.
-    Export {
-        /// A Promela model for spin (one property per `-DPROP=k`).
-        #[arg(long, required_unless_present = "aiger", conflicts_with = "aiger")]
-        promela: bool,
-        /// A binary AIGER 1.9 circuit for hardware model checkers such as ABC:
-        /// the abstraction for runs of any length, one bad-state output per
-        /// property (unbounded `eventually` has none).
-        #[arg(long)]
-        aiger: bool,
-        /// Only this property (by name), as the circuit's single bad-state output.
-        #[arg(long, requires = "aiger")]
-        property: Option<String>,
-        file: PathBuf,
-        /// Write here instead of standard output.
-        #[arg(short, long)]
-        output: Option<PathBuf>,
-        /// The most events the exploration goes from the start.
-        #[arg(long, default_value_t = 12)]
-        depth: usize,
-        /// The most abstract states.
-        #[arg(long, default_value_t = 20_000)]
-        max_states: usize,
-    },
+    Export(cmd::export::Args),
     /// Print the completion script of a shell for situ.
     #[command(long_about = "Print the completion script of a shell for situ to standard output.\n\n\
         Install it where the shell looks for completions, for example:\n\
@@ -369,68 +185,26 @@ fn main() -> ExitCode {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
     let cli = Cli::parse();
-    let code = match cli.command {
-        Command::Check { files, format, deny_warnings, watch, ros2_map } => {
-            cmd::check::run(&files, format, deny_warnings, watch, ros2_map.as_deref())
-        }
+    ExitCode::from(cmd::exit_code(dispatch(cli.command)))
+}
+
+/// Runs a subcommand: its exit code, or why it stopped short.
+fn dispatch(command: Command) -> cmd::Outcome {
+    match command {
+        Command::Check(args) => cmd::check::run(&args),
         Command::Completions { shell } => cmd::manners::completions(shell, Cli::command()),
         Command::Man { output } => cmd::manners::man(Cli::command(), output.as_deref()),
-        Command::Fmt { files, check } => cmd::fmt::run(&files, check),
-        Command::Explain { code } => cmd::explain::run(code.as_deref()),
-        Command::Build { file, output, binary, stats, deny_warnings, sign } => {
-            cmd::build::run(&file, &output, binary, stats, deny_warnings, sign.as_deref())
+        Command::Fmt(args) => Ok(cmd::fmt::run(&args)),
+        Command::Explain(args) => cmd::explain::run(&args),
+        Command::Build(args) => cmd::build::run(&args),
+        Command::Key { what } => Ok(cmd::key::run(what)),
+        Command::Bench(args) => {
+            args.trust.read()?;
+            cmd::bench::run(&args)
         }
-        Command::Key { what } => cmd::key::run(what),
-        Command::Bench { file, events, seed, stream_in, stream_out, states_out, no_reset, trust } => {
-            match cmd::program::trust(&trust) {
-                Ok(()) => cmd::bench::run(cmd::bench::Args {
-                    file,
-                    events,
-                    seed,
-                    stream_in,
-                    stream_out,
-                    states_out,
-                    no_reset,
-                }),
-                Err(code) => code,
-            }
-        }
-        Command::Test {
-            files,
-            filter,
-            format,
-            engine,
-            seed,
-            cases,
-            length,
-            depth,
-            max_states,
-            prove_effort,
-            prove_timeout,
-            allow_undecided,
-            stats,
-        } => cmd::test::run(cmd::test::Args {
-            files,
-            filter,
-            format,
-            engine,
-            seed,
-            cases,
-            length,
-            depth,
-            max_states,
-            prove_effort,
-            prove_timeout,
-            allow_undecided,
-            stats,
-        }),
+        Command::Test(args) => cmd::test::run(&args),
         Command::Gen { what } => cmd::gen::run(what),
-        Command::Export { promela: _, aiger: true, property, file, output, .. } => {
-            cmd::export::aiger(&file, output.as_ref(), property.as_deref())
-        }
-        Command::Export { file, output, depth, max_states, .. } => {
-            cmd::export::run(&file, output.as_ref(), depth, max_states)
-        }
+        Command::Export(args) => cmd::export::run(&args),
         Command::Run {
             file,
             scenario,
@@ -455,11 +229,9 @@ fn main() -> ExitCode {
             duration,
             trust,
         } => {
-            if let Err(code) = cmd::program::trust(&trust) {
-                return ExitCode::from(code);
-            }
+            trust.read()?;
             let local = stack == cmd::distributed::Stack::Sim && transport == cmd::distributed::Transport::Inproc;
-            if local && (script.is_some() || random.is_some()) {
+            Ok(if local && (script.is_some() || random.is_some()) {
                 cmd::scripted::run(cmd::scripted::Args { file, script, random, until, out, record, foxglove, serve })
             } else if local {
                 let dla = cmd::run::DlaArgs { cases, learn: !no_learning, missions, evaluate };
@@ -488,27 +260,22 @@ fn main() -> ExitCode {
                     foxglove,
                     serve,
                 })
-            }
+            })
         }
-        Command::Repl { file } => cmd::repl::run(&file),
-        Command::Lsp => cmd::lsp::run(),
-        Command::Replay { recording, bundle, format, trust } => match cmd::program::trust(&trust) {
-            Ok(()) => cmd::replay::run(&recording, bundle.as_ref(), format),
-            Err(code) => code,
-        },
-        Command::Up { deploy, file, stack, duration, trust } => match cmd::program::trust(&trust) {
-            Ok(()) => cmd::distributed::up(&deploy, &file, stack, duration, &trust),
-            Err(code) => code,
-        },
-        Command::Graph { file, view, state, format, output } => {
-            cmd::graph::run(&file, view, state.as_deref(), format, output.as_ref())
+        Command::Repl(args) => cmd::repl::run(&args.file),
+        Command::Lsp => Ok(cmd::lsp::run()),
+        Command::Replay(args) => {
+            args.trust.read()?;
+            cmd::replay::run(&args)
         }
-        Command::Ros2 { file, map, domain, rmw, duration, record, trust } => {
-            cmd::ros2::run(cmd::ros2::Args { file, map, domain, rmw, duration, record, trust })
+        Command::Up { deploy, file, stack, duration, trust } => {
+            trust.read()?;
+            Ok(cmd::distributed::up(&deploy, &file, stack, duration, &trust.trust))
         }
-        Command::View { file, rules, port } => cmd::view::run(&file, rules.as_deref(), port),
-    };
-    ExitCode::from(code)
+        Command::Graph(args) => cmd::graph::run(&args),
+        Command::Ros2(args) => cmd::ros2::run(args),
+        Command::View(args) => cmd::view::run(&args),
+    }
 }
 
 #[cfg(test)]

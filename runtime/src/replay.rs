@@ -15,12 +15,29 @@
 //! and the report says so ([`ReplayReport::cut`]); a damaged recording, or
 //! one with nothing of situ's in it, is an error.
 
-use crate::record::mcap::{read_recording, topics, Reading};
+use crate::record::mcap::{read_recording, topics, ReadError, Reading};
 use crate::rete::{format_time, Engine};
 use serde::Serialize;
 use serde_json::Value as Json;
 use situ_compiler::bundle::{Content, FieldType, Value};
 use std::sync::Arc;
+
+/// The channels of situ's own that a replay reads.
+const OURS: [&str; 3] = [topics::EVENTS, topics::TICKS, topics::STATE];
+
+/// Why a recording cannot be replayed.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ReplayError {
+    /// The recording does not read (not MCAP, damaged).
+    #[error(transparent)]
+    Read(#[from] ReadError),
+    /// Cut short before any message of situ's: why it was cut.
+    #[error("nothing to replay before the cut: {0}")]
+    NothingBeforeCut(String),
+    /// Whole, but with no message on situ's own channels.
+    #[error("no message on {}: not a recording of a situ run", OURS.join(", "))]
+    NotASituRun,
+}
 
 /// A change of the state at rest.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
@@ -108,19 +125,18 @@ fn summarize(items: &[String]) -> String {
 }
 
 /// Replays a recording's bytes on `content`.
-pub fn replay(recording: &[u8], content: Arc<Content>) -> Result<ReplayReport, String> {
+pub fn replay(recording: &[u8], content: Arc<Content>) -> Result<ReplayReport, ReplayError> {
     replay_reading(&read_recording(recording)?, content)
 }
 
 /// Replays a recording read by [`read_recording`] on `content`; an error
 /// when it holds no message of situ's own channels (nothing to replay).
-pub fn replay_reading(reading: &Reading, content: Arc<Content>) -> Result<ReplayReport, String> {
+pub fn replay_reading(reading: &Reading, content: Arc<Content>) -> Result<ReplayReport, ReplayError> {
     let messages = &reading.messages;
-    let ours = [topics::EVENTS, topics::TICKS, topics::STATE];
-    if !messages.iter().any(|(topic, _, _)| ours.contains(&topic.as_str())) {
+    if !messages.iter().any(|(topic, _, _)| OURS.contains(&topic.as_str())) {
         return Err(match &reading.cut {
-            Some(why) => format!("nothing to replay before the cut: {why}"),
-            None => format!("no message on {}: not a recording of a situ run", ours.join(", ")),
+            Some(why) => ReplayError::NothingBeforeCut(why.clone()),
+            None => ReplayError::NotASituRun,
         });
     }
     let mut engine = Engine::new(content.clone());

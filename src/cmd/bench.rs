@@ -5,30 +5,47 @@
 //! acceptance rule refuses are counted by reason in the object and said on
 //! standard error (file and line, why); the run goes on past them.
 
-use super::{OK, USAGE};
+use super::{CliError, Outcome, Trust, OK};
 use situ_runtime::bench::{self, Options, Source};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 
+// The arguments of `situ bench`.
+#[derive(clap::Args)]
+#[command(mut_arg("trust", |a| a.help(
+    "Bench only bundles signed by one of these public keys (`situ key new`); refuse others (exit 2)"
+)))]
 pub struct Args {
+    /// A `.situ` source or a bundle.
     pub file: PathBuf,
+    /// How many events.
+    #[arg(long, default_value_t = 1_000_000)]
     pub events: u64,
+    /// The stream's seed.
+    #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Read the events from this stream file instead (bench/README.md).
+    #[arg(long)]
     pub stream_in: Option<PathBuf>,
+    /// Write the generated stream here.
+    #[arg(long)]
     pub stream_out: Option<PathBuf>,
+    /// Write the `INDEX STATE` lines of the state changes here.
+    #[arg(long)]
     pub states_out: Option<PathBuf>,
+    /// Do not reset to the initial state after a final state.
+    #[arg(long)]
     pub no_reset: bool,
+    #[command(flatten)]
+    pub trust: Trust,
 }
 
 /// The largest event stream `--stream-in` reads.
 const MAX_STREAM_BYTES: u64 = 256 * 1024 * 1024;
 
-pub fn run(args: Args) -> u8 {
-    let program = match super::program::load(&args.file, false) {
-        Ok(p) => p,
-        Err(code) => return code,
-    };
+pub fn run(args: &Args) -> Outcome {
+    let program = super::program::load(&args.file, false).map_err(CliError::Reported)?;
     let content = program.content;
     let mut stream_text = None;
     let events = match &args.stream_in {
@@ -38,8 +55,7 @@ pub fn run(args: Args) -> u8 {
             let text = match read.and_then(|b| String::from_utf8(b).map_err(std::io::Error::other)) {
                 Ok(t) => t,
                 Err(e) => {
-                    eprintln!("error: cannot read `{}`: {e}", path.display());
-                    return USAGE;
+                    return Err(CliError::Usage(format!("cannot read `{}`: {e}", path.display())));
                 }
             };
             let parsed = situ_runtime::stream::parse(&content, &text);
@@ -47,25 +63,28 @@ pub fn run(args: Args) -> u8 {
             match parsed {
                 Ok(events) => Some(events),
                 Err(e) => {
-                    eprintln!("error: `{}`: {e}", path.display());
-                    return USAGE;
+                    return Err(CliError::Usage(format!("`{}`: {e}", path.display())));
                 }
             }
         }
     };
-    let create = |path: &Option<PathBuf>| -> Result<Option<BufWriter<File>>, u8> {
+    let create = |path: &Option<PathBuf>| -> Result<Option<BufWriter<File>>, CliError> {
         path.as_ref()
             .map(|p| {
-                File::create(p).map(BufWriter::new).map_err(|e| {
-                    eprintln!("error: cannot write `{}`: {e}", p.display());
-                    USAGE
-                })
+                File::create(p)
+                    .map(BufWriter::new)
+                    .map_err(|e| CliError::Usage(format!("cannot write `{}`: {e}", p.display())))
             })
             .transpose()
     };
+    // Both files are created before an error is said; both errors are said.
     let (mut stream_out, mut states_out) = match (create(&args.stream_out), create(&args.states_out)) {
         (Ok(a), Ok(b)) => (a, b),
-        (Err(code), _) | (_, Err(code)) => return code,
+        (Err(e), Ok(_)) | (Ok(_), Err(e)) => return Err(e),
+        (Err(first), Err(second)) => {
+            eprintln!("error: {first}");
+            return Err(second);
+        }
     };
     if let Some(out) = stream_out.as_mut() {
         let _ = out.write_all(situ_runtime::stream::header(&content.source, args.seed).as_bytes());
@@ -86,8 +105,7 @@ pub fn run(args: Args) -> u8 {
     for (out, path) in [(stream_out, &args.stream_out), (states_out, &args.states_out)] {
         if let (Some(mut out), Some(path)) = (out, path) {
             if let Err(e) = out.flush() {
-                eprintln!("error: cannot write `{}`: {e}", path.display());
-                return USAGE;
+                return Err(CliError::Usage(format!("cannot write `{}`: {e}", path.display())));
             }
         }
     }
@@ -101,5 +119,5 @@ pub fn run(args: Args) -> u8 {
     for line in report.refusals(place) {
         eprintln!("{line}");
     }
-    OK
+    Ok(OK)
 }

@@ -2,41 +2,53 @@
 //! a checked source to a bundle, written atomically; with `--sign`, signed
 //! with the secret key of `situ key new` (`docs/signing.md`).
 
-use super::{OK, USAGE};
+use super::{CliError, Outcome, OK};
 use situ_compiler::bundle::{self, codec, Encoding};
-use std::path::Path;
+use std::path::PathBuf;
 
-pub fn run(file: &Path, out: &Path, binary: bool, stats: bool, deny_warnings: bool, sign: Option<&Path>) -> u8 {
+// The arguments of `situ build`.
+#[derive(clap::Args)]
+pub struct Args {
+    pub file: PathBuf,
+    /// The bundle file to write.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Write the compact binary form instead of JSON.
+    #[arg(long)]
+    pub binary: bool,
+    /// Print the network's node counts and what sharing saved.
+    #[arg(long)]
+    pub stats: bool,
+    /// Refuse to build on warnings too.
+    #[arg(long)]
+    pub deny_warnings: bool,
+    /// Sign the bundle with this secret key (`situ key new NAME` writes NAME.key).
+    #[arg(long, value_name = "KEY")]
+    pub sign: Option<PathBuf>,
+}
+
+pub fn run(args: &Args) -> Outcome {
+    let (file, out, binary) = (&args.file, &args.output, args.binary);
     // The key first: a build that cannot sign writes nothing.
-    let key = match sign.map(super::key::read_secret).transpose() {
-        Ok(k) => k,
-        Err(e) => {
-            eprintln!("error: --sign: {e}");
-            return USAGE;
-        }
-    };
-    let checked = match super::program::check(file, deny_warnings) {
-        Ok(c) => c,
-        Err(code) => return code,
-    };
+    let key = args
+        .sign
+        .as_deref()
+        .map(super::key::read_secret)
+        .transpose()
+        .map_err(|e| CliError::Usage(format!("--sign: {e}")))?;
+    let checked = super::program::check(file, args.deny_warnings).map_err(CliError::Reported)?;
     let content = bundle::build(&checked);
     let encoding = if binary { Encoding::Binary } else { Encoding::Json };
     let bytes = match &key {
         Some(key) => bundle::sign::encode_signed(&content, encoding, key),
         None => bundle::encode(&content, encoding),
     };
-    if let Err(e) = super::write_atomically(out, &bytes) {
-        eprintln!("error: cannot write `{}`: {e}", out.display());
-        return USAGE;
-    }
-    let hash = match bundle::decode(&bytes) {
-        // The bundle is read back as a runtime would, before it is announced.
-        Ok(_) => codec::sha256_hex(&bytes),
-        Err(e) => {
-            eprintln!("error: the bundle written to `{}` does not read back: {e}", out.display());
-            return USAGE;
-        }
-    };
+    super::write_atomically(out, &bytes)
+        .map_err(|e| CliError::Usage(format!("cannot write `{}`: {e}", out.display())))?;
+    // The bundle is read back as a runtime would, before it is announced.
+    bundle::decode(&bytes)
+        .map_err(|e| CliError::Usage(format!("the bundle written to `{}` does not read back: {e}", out.display())))?;
+    let hash = codec::sha256_hex(&bytes);
     println!(
         "{} -> {} ({} bytes, {}, file sha256 {})",
         file.display(),
@@ -48,7 +60,7 @@ pub fn run(file: &Path, out: &Path, binary: bool, stats: bool, deny_warnings: bo
     if let Some(key) = &key {
         println!("signed by key {}", key.key_id());
     }
-    if stats {
+    if args.stats {
         let s = content.network.stats;
         let unshared = s.alpha_unshared + s.beta_unshared;
         println!(
@@ -69,5 +81,5 @@ pub fn run(file: &Path, out: &Path, binary: bool, stats: bool, deny_warnings: bo
             content.rules.len()
         );
     }
-    OK
+    Ok(OK)
 }

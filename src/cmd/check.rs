@@ -1,7 +1,7 @@
 //! `situ check FILE… [--format human|json|sarif] [--deny-warnings] [--watch]
 //! [--ros2-map MAP]`.
 
-use super::{FAILED, OK, USAGE};
+use super::{CliError, FAILED, OK, USAGE};
 use situ_compiler::loader::{FsLoader, Loader};
 use situ_compiler::render;
 use situ_compiler::source::SourceFile;
@@ -19,16 +19,38 @@ pub enum Format {
     Sarif,
 }
 
-pub fn run(files: &[PathBuf], format: Format, deny_warnings: bool, watch: bool, ros2_map: Option<&Path>) -> u8 {
+// The arguments of `situ check` (its help is the doc comment of `Command::Check` in main.rs).
+#[derive(clap::Args)]
+pub struct Args {
+    /// The root files to check (each with its includes).
+    #[arg(required = true)]
+    pub files: Vec<PathBuf>,
+    /// How to print findings.
+    #[arg(long, value_enum, default_value_t = Format::Human)]
+    pub format: Format,
+    /// Fail (exit 1) on warnings too.
+    #[arg(long)]
+    pub deny_warnings: bool,
+    /// Check again on every save of a file or of any file it includes, until Ctrl-C
+    /// (exit 0); each round ends with a line of the time and the summary.
+    #[arg(long)]
+    pub watch: bool,
+    /// Also check this ROS 2 map (TOML, docs/ros2.md) against the rules; one root file only.
+    #[arg(long, value_name = "MAP")]
+    pub ros2_map: Option<PathBuf>,
+}
+
+pub fn run(args: &Args) -> super::Outcome {
+    let (files, format, deny_warnings, ros2_map) =
+        (&args.files, args.format, args.deny_warnings, args.ros2_map.as_deref());
     if ros2_map.is_some() && files.len() > 1 {
-        eprintln!("error: --ros2-map applies to one root file; {} were given", files.len());
-        return USAGE;
+        return Err(CliError::Usage(format!("--ros2-map applies to one root file; {} were given", files.len())));
     }
-    if watch {
+    if args.watch {
         let machine = !matches!(format, Format::Human);
-        return super::watch::run(|loader| check_all(files, format, deny_warnings, ros2_map, loader).1, machine);
+        return super::recheck::run(|loader| check_all(files, format, deny_warnings, ros2_map, loader).1, machine);
     }
-    check_all(files, format, deny_warnings, ros2_map, &FsLoader).0
+    Ok(check_all(files, format, deny_warnings, ros2_map, &FsLoader).0)
 }
 
 /// Checks the ROS 2 map `map` against the checked rules: the map becomes one

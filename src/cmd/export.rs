@@ -7,7 +7,7 @@
 //! output per property, in binary AIGER 1.9 for hardware model checkers
 //! (`verify/abc-check.sh` runs ABC's `pdr` and `int` on it).
 
-use super::{FAILED, OK, USAGE};
+use super::{CliError, Outcome, FAILED, OK};
 use situ_compiler::bundle;
 use situ_compiler::bundle::Content;
 use situ_compiler::spec::{self, PropertySpec, Spec};
@@ -18,11 +18,41 @@ use situ_verify::promela;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-pub fn run(file: &Path, output: Option<&PathBuf>, depth: usize, max_states: usize) -> u8 {
-    let (content, spec) = match load(file) {
-        Ok(x) => x,
-        Err(code) => return code,
-    };
+// The arguments of `situ export`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// A Promela model for spin (one property per `-DPROP=k`).
+    #[arg(long, required_unless_present = "aiger", conflicts_with = "aiger")]
+    pub promela: bool,
+    /// A binary AIGER 1.9 circuit for hardware model checkers such as ABC:
+    /// the abstraction for runs of any length, one bad-state output per
+    /// property (unbounded `eventually` has none).
+    #[arg(long)]
+    pub aiger: bool,
+    /// Only this property (by name), as the circuit's single bad-state output.
+    #[arg(long, requires = "aiger")]
+    pub property: Option<String>,
+    pub file: PathBuf,
+    /// Write here instead of standard output.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// The most events the exploration goes from the start.
+    #[arg(long, default_value_t = 12)]
+    pub depth: usize,
+    /// The most abstract states.
+    #[arg(long, default_value_t = 20_000)]
+    pub max_states: usize,
+}
+
+pub fn run(args: &Args) -> Outcome {
+    if args.aiger {
+        return aiger(&args.file, args.output.as_ref(), args.property.as_deref());
+    }
+    promela(&args.file, args.output.as_ref(), args.depth, args.max_states)
+}
+
+fn promela(file: &Path, output: Option<&PathBuf>, depth: usize, max_states: usize) -> Outcome {
+    let (content, spec) = load(file)?;
     let props: Vec<&PropertySpec> = spec.properties.iter().collect();
     let graph = Graph::build(&content, &props, Limits { depth, max_states });
     let text = promela::export(&content, &graph, &props);
@@ -35,49 +65,37 @@ pub fn run(file: &Path, output: Option<&PathBuf>, depth: usize, max_states: usiz
                     graph.states(),
                     props.len()
                 );
-                OK
+                Ok(OK)
             }
-            Err(e) => {
-                eprintln!("error: cannot write `{}`: {e}", path.display());
-                USAGE
-            }
+            Err(e) => Err(CliError::Usage(format!("cannot write `{}`: {e}", path.display()))),
         },
         None => {
             print!("{text}");
-            if props.is_empty() {
-                FAILED
-            } else {
-                OK
-            }
+            Ok(if props.is_empty() { FAILED } else { OK })
         }
     }
 }
 
 /// The program and its properties, from a source file with no errors.
-fn load(file: &Path) -> Result<(Arc<Content>, Spec), u8> {
-    let checked = super::program::check(file, false)?;
+fn load(file: &Path) -> Result<(Arc<Content>, Spec), CliError> {
+    let checked = super::program::check(file, false).map_err(CliError::Reported)?;
     Ok((Arc::new(bundle::build(&checked)), spec::lower(&checked)))
 }
 
-pub fn aiger(file: &Path, output: Option<&PathBuf>, only: Option<&str>) -> u8 {
-    let (content, spec) = match load(file) {
-        Ok(x) => x,
-        Err(code) => return code,
-    };
+fn aiger(file: &Path, output: Option<&PathBuf>, only: Option<&str>) -> Outcome {
+    let (content, spec) = load(file)?;
     let props: Vec<&PropertySpec> = spec.properties.iter().collect();
     if let Some(name) = only {
         if !props.iter().any(|p| p.name == name) {
             let names: Vec<String> = props.iter().map(|p| format!("\"{}\"", p.name)).collect();
-            eprintln!("error: no property \"{name}\"; the properties are: {}", names.join(", "));
-            return USAGE;
+            return Err(CliError::Usage(format!("no property \"{name}\"; the properties are: {}", names.join(", "))));
         }
     }
     let alphabet = Alphabet::new(&content, &props);
     let model = match Model::build(&content, &alphabet, &props) {
         Ok(m) => m,
         Err(why) => {
-            eprintln!("error: no circuit for `{}`: {}", file.display(), why.0);
-            return FAILED;
+            return Err(CliError::Failed(format!("no circuit for `{}`: {}", file.display(), why.0)));
         }
     };
     let bad: Vec<(String, u32)> = props
@@ -87,11 +105,10 @@ pub fn aiger(file: &Path, output: Option<&PathBuf>, only: Option<&str>) -> u8 {
         .filter_map(|(p, b)| b.map(|b| (p.name.clone(), b)))
         .collect();
     if bad.is_empty() {
-        eprintln!(
-            "error: `{}` has no safety property to export (unbounded `eventually` has no bad state)",
+        return Err(CliError::Failed(format!(
+            "`{}` has no safety property to export (unbounded `eventually` has no bad state)",
             file.display()
-        );
-        return FAILED;
+        )));
     }
     let bytes = model.aig.to_aig(&bad);
     match output {
@@ -104,18 +121,15 @@ pub fn aiger(file: &Path, output: Option<&PathBuf>, only: Option<&str>) -> u8 {
                     model.aig.inputs().len(),
                     bad.len()
                 );
-                OK
+                Ok(OK)
             }
-            Err(e) => {
-                eprintln!("error: cannot write `{}`: {e}", path.display());
-                USAGE
-            }
+            Err(e) => Err(CliError::Usage(format!("cannot write `{}`: {e}", path.display()))),
         },
         None => {
             use std::io::Write;
             match std::io::stdout().write_all(&bytes) {
-                Ok(()) => OK,
-                Err(_) => USAGE,
+                Ok(()) => Ok(OK),
+                Err(_) => Err(CliError::Reported(super::USAGE)),
             }
         }
     }

@@ -8,10 +8,22 @@ use situ_compiler::render;
 use situ_compiler::source::{SourceFile, SourceMap};
 use std::path::{Path, PathBuf};
 
-pub fn run(files: &[PathBuf], check: bool) -> u8 {
+// The arguments of `situ fmt`.
+#[derive(clap::Args)]
+pub struct Args {
+    #[arg(required = true)]
+    pub files: Vec<PathBuf>,
+    /// Change nothing; exit 1 if a file is not formatted.
+    #[arg(long)]
+    pub check: bool,
+}
+
+/// Formats each file, going on past a file that cannot be: the worst exit
+/// code of them all (each file's error is said as it comes).
+pub fn run(args: &Args) -> u8 {
     let mut status = OK;
-    for path in files {
-        let code = one(path, check);
+    for path in &args.files {
+        let code = one(path, args.check);
         status = status.max(code);
     }
     status

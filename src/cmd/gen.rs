@@ -4,7 +4,7 @@
 //! `<agent>_agent.py` or `<agent>.rs` (the agent's name in snake case),
 //! atomically; `-o -` prints it instead (docs/gen.md).
 
-use super::{program, FAILED, OK, USAGE};
+use super::{program, CliError, Outcome, OK};
 use situ_compiler::codegen::{self, Lang};
 use std::io::Write;
 use std::path::PathBuf;
@@ -27,52 +27,38 @@ pub enum What {
     },
 }
 
-pub fn run(what: What) -> u8 {
+pub fn run(what: What) -> Outcome {
     match what {
         What::Agent { agent, file, lang, output } => agent_code(&agent, &file, &lang, output),
     }
 }
 
-fn agent_code(agent: &str, file: &std::path::Path, lang: &str, output: Option<PathBuf>) -> u8 {
+fn agent_code(agent: &str, file: &std::path::Path, lang: &str, output: Option<PathBuf>) -> Outcome {
     let Some(lang) = Lang::parse(lang) else {
-        eprintln!("error: unknown language `{lang}` for --lang; expected one of: {}", Lang::NAMES.join(", "));
-        return USAGE;
+        return Err(CliError::Usage(format!(
+            "unknown language `{lang}` for --lang; expected one of: {}",
+            Lang::NAMES.join(", ")
+        )));
     };
-    let program = match program::load(file, false) {
-        Ok(p) => p,
-        Err(code) => return code,
-    };
-    let generated = match codegen::agent(&program.content, agent, lang) {
-        Ok(g) => g,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return USAGE;
-        }
-    };
+    let program = program::load(file, false).map_err(CliError::Reported)?;
+    let generated = codegen::agent(&program.content, agent, lang).map_err(|e| CliError::Usage(e.to_string()))?;
     let dir = output.unwrap_or_else(|| PathBuf::from("."));
     if dir.as_os_str() == "-" {
         let mut out = std::io::stdout().lock();
         return match out.write_all(generated.text.as_bytes()).and_then(|()| out.flush()) {
-            Ok(()) => OK,
-            Err(e) => {
-                eprintln!("error: cannot write to standard output: {e}");
-                FAILED
-            }
+            Ok(()) => Ok(OK),
+            Err(e) => Err(CliError::Failed(format!("cannot write to standard output: {e}"))),
         };
     }
     if let Err(e) = std::fs::create_dir_all(&dir) {
-        eprintln!("error: cannot create `{}`: {e}", dir.display());
-        return USAGE;
+        return Err(CliError::Usage(format!("cannot create `{}`: {e}", dir.display())));
     }
     let path = dir.join(&generated.file_name);
     match super::write_atomically(&path, generated.text.as_bytes()) {
         Ok(()) => {
             eprintln!("wrote {} ({} code of agent `{agent}`)", path.display(), lang.name());
-            OK
+            Ok(OK)
         }
-        Err(e) => {
-            eprintln!("error: cannot write `{}`: {e}", path.display());
-            USAGE
-        }
+        Err(e) => Err(CliError::Usage(format!("cannot write `{}`: {e}", path.display()))),
     }
 }

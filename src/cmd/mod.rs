@@ -14,6 +14,7 @@ pub mod key;
 pub mod lsp;
 pub mod manners;
 pub mod program;
+pub mod recheck;
 pub mod repl;
 pub mod replay;
 pub mod ros2;
@@ -21,11 +22,10 @@ pub mod run;
 pub mod scripted;
 pub mod test;
 pub mod view;
-pub mod watch;
 pub mod watchers;
 
 use std::io::IsTerminal;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Exit codes of the command line contract.
 pub const OK: u8 = 0;
@@ -33,6 +33,60 @@ pub const OK: u8 = 0;
 pub const FAILED: u8 = 1;
 /// A usage or I/O error.
 pub const USAGE: u8 = 2;
+
+/// Why a command stopped short. [`exit_code`] prints it and maps it to the
+/// exit code, once, for every command.
+#[derive(Debug, thiserror::Error)]
+pub enum CliError {
+    /// A usage or I/O error: `error: MESSAGE` on standard error, exit 2.
+    #[error("{0}")]
+    Usage(String),
+    /// What was asked for fails (no circuit, nothing to export):
+    /// `error: MESSAGE` on standard error, exit 1.
+    #[error("{0}")]
+    Failed(String),
+    /// Said already where it was found (findings printed with their report,
+    /// a loader's own message): exit with this code and print nothing more.
+    #[error("exit {0}")]
+    Reported(u8),
+}
+
+/// What a command comes to: its exit code ([`OK`], or [`FAILED`] when what
+/// it checked fails), or why it stopped short.
+pub type Outcome = Result<u8, CliError>;
+
+/// The exit code of an outcome; an error's message is printed here.
+pub fn exit_code(outcome: Outcome) -> u8 {
+    match outcome {
+        Ok(code) => code,
+        Err(CliError::Usage(message)) => {
+            eprintln!("error: {message}");
+            USAGE
+        }
+        Err(CliError::Failed(message)) => {
+            eprintln!("error: {message}");
+            FAILED
+        }
+        Err(CliError::Reported(code)) => code,
+    }
+}
+
+/// `--trust PUBKEY…`, shared by every command that loads bundles. The help
+/// says "Run"; a command whose verb differs says its own (`mut_arg`).
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct Trust {
+    /// Run only bundles signed by one of these public keys (`situ key new`); refuse others (exit 2).
+    #[arg(long, value_name = "PUBKEY")]
+    pub trust: Vec<PathBuf>,
+}
+
+impl Trust {
+    /// Reads the keys: from now on every bundle this process loads must be
+    /// signed by one of them (none: every valid bundle loads).
+    pub fn read(&self) -> Result<(), CliError> {
+        program::trust(&self.trust).map_err(CliError::Reported)
+    }
+}
 
 /// The progress line of a run on standard error, redrawn at most every
 /// 200 ms of wall time and only on a terminal; wiped when the run ends.

@@ -5,7 +5,7 @@
 //! input, so that sessions can be scripted. A bad line prints an error and
 //! the session goes on; from a script, the exit code is then 1.
 
-use super::{FAILED, OK, USAGE};
+use super::{CliError, Outcome, FAILED, OK};
 use rustyline::completion::{Completer, Pair};
 use rustyline::error::ReadlineError;
 use rustyline::{Context, Editor, Helper, Highlighter, Hinter, Validator};
@@ -34,11 +34,15 @@ impl Completer for Words {
     }
 }
 
-pub fn run(file: &Path) -> u8 {
-    let program = match super::program::load(file, false) {
-        Ok(p) => p,
-        Err(code) => return code,
-    };
+// The arguments of `situ repl`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// A `.situ` source or a bundle.
+    pub file: std::path::PathBuf,
+}
+
+pub fn run(file: &Path) -> Outcome {
+    let program = super::program::load(file, false).map_err(CliError::Reported)?;
     let mut session = Session::new(program.content);
     let terminal = std::io::stdin().is_terminal();
     if terminal {
@@ -55,13 +59,12 @@ pub fn run(file: &Path) -> u8 {
     }
 }
 
-fn interactive(file: &Path, session: &mut Session) -> u8 {
+fn interactive(file: &Path, session: &mut Session) -> Outcome {
     let words = Arc::new(Mutex::new(session.words()));
     let mut editor: Editor<Words, rustyline::history::DefaultHistory> = match Editor::new() {
         Ok(e) => e,
         Err(e) => {
-            eprintln!("error: no terminal editor: {e}");
-            return USAGE;
+            return Err(CliError::Usage(format!("no terminal editor: {e}")));
         }
     };
     editor.set_helper(Some(Words(words.clone())));
@@ -71,26 +74,24 @@ fn interactive(file: &Path, session: &mut Session) -> u8 {
             Ok(line) => {
                 let _ = editor.add_history_entry(line.as_str());
                 if !handle(file, session, &line) {
-                    return OK;
+                    return Ok(OK);
                 }
                 *words.lock().unwrap_or_else(|p| p.into_inner()) = session.words();
             }
             Err(ReadlineError::Interrupted) => continue,
-            Err(ReadlineError::Eof) => return OK,
+            Err(ReadlineError::Eof) => return Ok(OK),
             Err(e) => {
-                eprintln!("error: {e}");
-                return USAGE;
+                return Err(CliError::Usage(e.to_string()));
             }
         }
     }
 }
 
-fn scripted(file: &Path, session: &mut Session) -> u8 {
+fn scripted(file: &Path, session: &mut Session) -> Outcome {
     let mut failed = false;
     for line in std::io::stdin().lock().lines() {
         let Ok(line) = line else {
-            eprintln!("error: standard input is not UTF-8 text");
-            return USAGE;
+            return Err(CliError::Usage("standard input is not UTF-8 text".into()));
         };
         if !line.trim().is_empty() && !line.trim_start().starts_with("//") {
             println!("> {}", line.trim());
@@ -107,11 +108,7 @@ fn scripted(file: &Path, session: &mut Session) -> u8 {
             }
         }
     }
-    if failed {
-        FAILED
-    } else {
-        OK
-    }
+    Ok(if failed { FAILED } else { OK })
 }
 
 /// One line on the terminal; false to quit.

@@ -15,9 +15,9 @@
 //! must be signed by one of the keys: a recording whose attached bundle was
 //! swapped or edited is refused (exit 2, naming the key).
 
-use super::{FAILED, OK, USAGE};
+use super::{CliError, Outcome, Trust, FAILED, OK};
 use situ_runtime::record::mcap::{attached_bundle, read_file, read_recording};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -26,45 +26,58 @@ pub enum Format {
     Json,
 }
 
-pub fn run(recording: &Path, bundle_path: Option<&PathBuf>, format: Format) -> u8 {
+// The arguments of `situ replay`.
+#[derive(clap::Args)]
+#[command(mut_arg("trust", |a| a.help(
+    "Replay only on bundles (the attached one or --bundle) signed by one of these public keys (`situ key new`); refuse others (exit 2)"
+)))]
+pub struct Args {
+    /// An MCAP recording of `situ run --record`.
+    pub recording: PathBuf,
+    /// The rules to replay on (a bundle or a `.situ` source); default: the recording's own.
+    #[arg(long)]
+    pub bundle: Option<PathBuf>,
+    #[arg(long, value_enum, default_value_t = Format::Human)]
+    pub format: Format,
+    #[command(flatten)]
+    pub trust: Trust,
+}
+
+pub fn run(args: &Args) -> Outcome {
+    let (recording, bundle_path, format) = (args.recording.as_path(), args.bundle.as_ref(), args.format);
     let bytes = match read_file(recording) {
         Ok(b) => b,
         Err(e) => {
-            eprintln!("error: `{}`: {e}", recording.display());
-            return USAGE;
+            return Err(CliError::Usage(format!("`{}`: {e}", recording.display())));
         }
     };
     let reading = match read_recording(&bytes) {
         Ok(r) => r,
         Err(e) => {
-            eprintln!("error: `{}` is not a readable recording: {e}", recording.display());
-            return USAGE;
+            return Err(CliError::Usage(format!("`{}` is not a readable recording: {e}", recording.display())));
         }
     };
     let content = match bundle_path {
-        Some(p) => match super::program::load(p, false) {
-            Ok(p) => p.content,
-            Err(code) => return code,
-        },
+        Some(p) => super::program::load(p, false).map_err(CliError::Reported)?.content,
         None => match attached_bundle(&bytes)
             .map(|b| super::program::decode_bundle(&b, &format!("the bundle attached to `{}`", recording.display())))
         {
             Some(Ok(c)) => Arc::new(c),
             Some(Err(e)) => {
-                eprintln!("error: the bundle attached to `{}`: {e}", recording.display());
-                return USAGE;
+                return Err(CliError::Usage(format!("the bundle attached to `{}`: {e}", recording.display())));
             }
             None => {
-                eprintln!("error: `{}` has no bundle attached: give one with --bundle", recording.display());
-                return USAGE;
+                return Err(CliError::Usage(format!(
+                    "`{}` has no bundle attached: give one with --bundle",
+                    recording.display()
+                )));
             }
         },
     };
     let report = match situ_runtime::replay::replay_reading(&reading, content) {
         Ok(r) => r,
         Err(e) => {
-            eprintln!("error: `{}`: {e}", recording.display());
-            return USAGE;
+            return Err(CliError::Usage(format!("`{}`: {e}", recording.display())));
         }
     };
     if let Some(why) = &report.cut_reason {
@@ -78,9 +91,5 @@ pub fn run(recording: &Path, bundle_path: Option<&PathBuf>, format: Format) -> u
         Format::Human => println!("{}", report.describe()),
         Format::Json => println!("{}", serde_json::to_string(&report).expect("the report serializes")),
     }
-    if report.same() {
-        OK
-    } else {
-        FAILED
-    }
+    Ok(if report.same() { OK } else { FAILED })
 }

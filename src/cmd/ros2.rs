@@ -2,7 +2,7 @@
 //! [--duration S] [--record DIR] [--trust PUBKEY…]`: the ROS 2 bridge (docs/ros2.md), built with
 //! `--features ros2`.
 
-use super::{FAILED, OK, USAGE};
+use super::{CliError, Outcome, FAILED, OK};
 use std::path::PathBuf;
 
 /// The RMW of the robot's ROS 2 nodes: how their services are carried.
@@ -14,24 +14,37 @@ pub enum Rmw {
     Fastrtps,
 }
 
+// The arguments of `situ ros2`.
+#[derive(clap::Args)]
 pub struct Args {
+    /// The rules (a `.situ` source or a bundle).
     pub file: PathBuf,
+    /// The ROS 2 map (TOML): which topic each event comes from, which agents are lifecycle nodes.
+    #[arg(long)]
     pub map: PathBuf,
+    /// The DDS domain (default: ROS_DOMAIN_ID, else 0).
+    #[arg(long)]
     pub domain: Option<u16>,
+    /// The RMW of the robot's nodes: how their lifecycle services are carried.
+    #[arg(long, value_enum, default_value_t = Rmw::Fastrtps)]
     pub rmw: Rmw,
+    /// Stop after this many seconds (default: until Ctrl-C or SIGTERM).
+    #[arg(long)]
     pub duration: Option<f64>,
+    /// Record what came and went as a ROS 2 bag (a new directory; MCAP storage).
+    #[arg(long, value_name = "DIR")]
     pub record: Option<PathBuf>,
-    pub trust: Vec<PathBuf>,
+    #[command(flatten)]
+    pub trust: super::Trust,
 }
 
 const NO_BRIDGE: &str = "this situ was built without the ROS 2 bridge: `cargo build --features ros2` \
                          (or `cargo install --path . --features ros2`)";
 
 #[cfg(not(feature = "ros2"))]
-pub fn run(args: Args) -> u8 {
-    let _ = (&args.file, &args.map, args.domain, args.rmw, args.duration, &args.record, &args.trust, OK, FAILED);
-    eprintln!("error: {NO_BRIDGE}");
-    USAGE
+pub fn run(args: Args) -> Outcome {
+    let _ = (&args.file, &args.map, args.domain, args.rmw, args.duration, &args.record, &args.trust.trust, OK, FAILED);
+    Err(CliError::Usage(NO_BRIDGE.into()))
 }
 
 /// The domain: `--domain`, else `ROS_DOMAIN_ID`, else 0.
@@ -53,7 +66,7 @@ fn domain(flag: Option<u16>) -> Result<u16, String> {
 }
 
 #[cfg(feature = "ros2")]
-pub fn run(args: Args) -> u8 {
+pub fn run(args: Args) -> Outcome {
     use situ_bridge_ros2::core::{Core, SetupError};
     use situ_bridge_ros2::dds::{self, Options};
     use situ_compiler::loader::{read_bounded, MAX_FILE_BYTES};
@@ -62,35 +75,22 @@ pub fn run(args: Args) -> u8 {
     use std::time::Duration;
 
     let _ = NO_BRIDGE;
-    let domain = match domain(args.domain) {
-        Ok(d) => d,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return USAGE;
-        }
-    };
+    let domain = domain(args.domain).map_err(CliError::Usage)?;
     let duration = match args.duration {
         None => None,
         Some(s) if s.is_finite() && s > 0.0 && s <= 1e7 => Some(Duration::from_secs_f64(s)),
         Some(s) => {
-            eprintln!("error: --duration {s}: give a number of seconds above 0");
-            return USAGE;
+            return Err(CliError::Usage(format!("--duration {s}: give a number of seconds above 0")));
         }
     };
-    if let Err(code) = super::program::trust(&args.trust) {
-        return code;
-    }
-    let program = match super::program::load(&args.file, false) {
-        Ok(p) => p,
-        Err(code) => return code,
-    };
+    args.trust.read()?;
+    let program = super::program::load(&args.file, false).map_err(CliError::Reported)?;
     let text = match read_bounded(&args.map, MAX_FILE_BYTES, "a map")
         .and_then(|b| String::from_utf8(b).map_err(|_| std::io::Error::other("the map is not UTF-8 text")))
     {
         Ok(t) => t,
         Err(e) => {
-            eprintln!("error: {}: {e}", args.map.display());
-            return USAGE;
+            return Err(CliError::Usage(format!("{}: {e}", args.map.display())));
         }
     };
     // A bundle has no source: the map is read against its agents and events.
@@ -109,12 +109,11 @@ pub fn run(args: Args) -> u8 {
         Ok(core) => core,
         Err(SetupError::Map(found)) => {
             print!("{}", render::human_list(&sources, &found, super::style()));
-            eprintln!(
-                "error: `{}` has errors; `situ check RULES --ros2-map {}` explains each",
+            return Err(CliError::Failed(format!(
+                "`{}` has errors; `situ check RULES --ros2-map {}` explains each",
                 args.map.display(),
                 args.map.display()
-            );
-            return FAILED;
+            )));
         }
     };
     let rmw = match args.rmw {
@@ -134,11 +133,10 @@ pub fn run(args: Args) -> u8 {
         Some(dir) => match situ_bridge_ros2::bag::Bag::create(dir) {
             Ok(bag) => Some(bag),
             Err(e) => {
-                eprintln!(
-                    "error: --record {}: {e} (a bag is a new directory; it is never written over)",
+                return Err(CliError::Usage(format!(
+                    "--record {}: {e} (a bag is a new directory; it is never written over)",
                     dir.display()
-                );
-                return USAGE;
+                )));
             }
         },
     };
@@ -169,15 +167,8 @@ pub fn run(args: Args) -> u8 {
                     lat.len()
                 );
             }
-            if report.record_error.is_some() {
-                FAILED
-            } else {
-                OK
-            }
+            Ok(if report.record_error.is_some() { FAILED } else { OK })
         }
-        Err(e) => {
-            eprintln!("error: DDS: {e}");
-            USAGE
-        }
+        Err(e) => Err(CliError::Usage(format!("DDS: {e}"))),
     }
 }

@@ -9,18 +9,16 @@
 
 use super::{FAILED, OK, USAGE};
 use serde_json::json;
-use situ_compiler::bundle::{self, Content};
-use situ_compiler::codes;
+use situ_compiler::bundle::Content;
 use situ_compiler::loader::FsLoader;
 use situ_compiler::render;
-use situ_compiler::spec::{self, PropertySpec, TestSpec};
-use situ_grammar::diag::Diagnostic;
+use situ_compiler::spec::PropertySpec;
 use situ_verify::explore::Limits;
-use situ_verify::property::{self, Checker, Conclusion, Engines, Premise, Report};
+use situ_verify::property::{self, Checker, Conclusion, Engines, Premise, Report, Session};
 use situ_verify::random::Search;
-use situ_verify::{scenario, show_event, Counterexample, Verdict};
+use situ_verify::suite::{self, FileOutcome, SuiteReport};
+use situ_verify::{show_event, Counterexample, Verdict};
 use std::path::PathBuf;
-use std::sync::Arc;
 use std::time::Duration;
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -43,21 +41,47 @@ pub enum Engine {
     Random,
 }
 
+// The arguments of `situ test`.
+#[derive(clap::Args)]
 pub struct Args {
+    #[arg(required = true)]
     pub files: Vec<PathBuf>,
+    /// Only the tests and properties whose name contains this.
+    #[arg(long)]
     pub filter: Option<String>,
+    #[arg(long, value_enum, default_value_t = Format::Human)]
     pub format: Format,
+    /// Which checkers look at the properties.
+    #[arg(long, value_enum, default_value_t = Engine::Both)]
     pub engine: Engine,
+    /// The seed of the random search.
+    #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Random runs per property.
+    #[arg(long, default_value_t = 256)]
     pub cases: u32,
+    /// Events per random run.
+    #[arg(long, default_value_t = 120)]
     pub length: usize,
+    /// The most events the exhaustive exploration goes from the start.
+    #[arg(long, default_value_t = 12)]
     pub depth: usize,
+    /// The most abstract states the exhaustive exploration makes.
+    #[arg(long, default_value_t = 20_000)]
     pub max_states: usize,
-    /// IC3's work budget per property (SAT propagations).
+    /// IC3's work budget per property, in SAT propagations: the same
+    /// budget gives the same verdict on any machine under any load.
+    #[arg(long, default_value_t = situ_verify::property::DEFAULT_EFFORT)]
     pub prove_effort: u64,
-    /// Wall-clock guard of IC3 per property, in seconds.
+    /// A wall-clock guard on IC3, in seconds per property; a property it
+    /// stops is undecided, and the output says it was the clock.
+    #[arg(long, default_value_t = 600.0)]
     pub prove_timeout: f64,
+    /// Exit 0 when no property is violated, even if some are undecided.
+    #[arg(long)]
     pub allow_undecided: bool,
+    /// Print the size and time of the exploration and the random search.
+    #[arg(long)]
     pub stats: bool,
 }
 
@@ -71,197 +95,216 @@ impl Engine {
     }
 }
 
-pub fn run(args: Args) -> u8 {
-    let (mut passed, mut failed, mut undecided) = (0usize, 0usize, 0usize);
-    let mut io_failed = false;
-    let human = matches!(args.format, Format::Human);
-    let sarif = matches!(args.format, Format::Sarif);
-    let json_lines = matches!(args.format, Format::Json);
-    let (mut sarif_checked, mut sarif_failures) = (Vec::new(), Vec::new());
-    for path in &args.files {
-        let mut checked = match situ_compiler::check(path, &FsLoader) {
-            Ok(c) => c,
-            Err(e) => {
+impl Args {
+    /// The suite's options (`situ_verify::suite` holds the policy).
+    fn options(&self) -> suite::Options {
+        suite::Options {
+            filter: self.filter.clone(),
+            properties: property::Options {
+                engines: self.engine.engines(),
+                search: Search { seed: self.seed, cases: self.cases, length: self.length },
+                limits: Limits { depth: self.depth, max_states: self.max_states },
+                effort: self.prove_effort,
+                timeout: Some(Duration::from_secs_f64(self.prove_timeout.clamp(0.0, 86_400.0))),
+            },
+            allow_undecided: self.allow_undecided,
+        }
+    }
+}
+
+pub fn run(args: &Args) -> super::Outcome {
+    let report = suite::run(&args.files, &FsLoader, &args.options());
+    let verdict = report.verdict();
+    match args.format {
+        Format::Human => human(args, &report),
+        Format::Json => json_lines(&report),
+        Format::Sarif => sarif(report),
+    }
+    Ok(match verdict {
+        suite::Verdict::Pass => OK,
+        suite::Verdict::Fail => FAILED,
+        suite::Verdict::Unreadable => USAGE,
+    })
+}
+
+/// A line per test and property, the failures of each file, a summary.
+fn human(args: &Args, report: &SuiteReport) {
+    for file in &report.files {
+        let path = file.path.display();
+        let r = match &file.outcome {
+            FileOutcome::Unreadable(e) => {
                 eprintln!("error: {e}");
-                io_failed = true;
-                sarif_failures.push(e);
                 continue;
             }
+            FileOutcome::Errors(checked) => {
+                print!("{}", render::human_all(checked, super::style()));
+                println!("{path}: {} error(s): no test or property was run", checked.errors());
+                continue;
+            }
+            FileOutcome::Ran(_, r) => r,
         };
-        if checked.errors() > 0 {
-            if human {
-                print!("{}", render::human_all(&checked, super::style()));
-                println!("{}: {} error(s): no test or property was run", path.display(), checked.errors());
-            } else if json_lines {
-                print!("{}", render::json_lines(&checked));
-            }
-            failed += 1;
-            sarif_checked.push(checked);
-            continue;
-        }
-        let content = Arc::new(bundle::build(&checked));
-        let spec = spec::lower(&checked);
-        let wanted = |name: &str| args.filter.as_deref().is_none_or(|f| name.contains(f));
-        let tests: Vec<&TestSpec> = spec.tests.iter().filter(|t| wanted(&t.name)).collect();
-        let props: Vec<&PropertySpec> = spec.properties.iter().filter(|p| wanted(&p.name)).collect();
-        if human {
-            println!(
-                "\nrunning {} and {} from {}",
-                count(tests.len(), "test"),
-                count(props.len(), "property"),
-                path.display()
-            );
-        }
+        println!(
+            "\nrunning {} and {} from {path}",
+            count(r.tests.len(), "test"),
+            count(r.properties.len(), "property"),
+        );
         let mut failures = Vec::new();
-        let mut verdicts = Vec::new();
-        for t in &tests {
-            let outcome = scenario::run(&content, t);
-            if human {
-                println!("test \"{}\" ... {}", t.name, if outcome.passed() { "ok" } else { "FAILED" });
-            } else if json_lines {
-                let list: Vec<_> = outcome
-                    .failures
-                    .iter()
-                    .map(|f| json!({"place": f.place.to_string(), "message": f.message}))
-                    .collect();
-                println!(
-                    "{}",
-                    json!({"kind": "test", "file": path.display().to_string(), "name": t.name,
-                           "place": t.place.to_string(), "passed": outcome.passed(), "events": outcome.events,
-                           "failures": list})
-                );
-            }
-            if outcome.passed() {
-                passed += 1;
-            } else {
-                failed += 1;
-                verdicts.push(test_diagnostic(t, &outcome));
-                let mut text = format!("---- test \"{}\" ({}) ----\n", t.name, t.place);
-                for f in &outcome.failures {
+        for t in &r.tests {
+            println!("test \"{}\" ... {}", t.spec.name, if t.outcome.passed() { "ok" } else { "FAILED" });
+            if !t.outcome.passed() {
+                let mut text = format!("---- test \"{}\" ({}) ----\n", t.spec.name, t.spec.place);
+                for f in &t.outcome.failures {
                     text.push_str(&format!("  {}: {}\n", f.place, f.message));
                 }
                 failures.push(text);
             }
         }
-        if !props.is_empty() {
-            let reports = check_properties(&args, &content, &props, human);
-            for (p, r) in props.iter().zip(&reports) {
-                if human {
-                    print_property(&content, p, r);
-                } else if json_lines {
-                    println!("{}", property_json(&content, path, p, r));
-                }
-                verdicts.extend(property_diagnostics(&content, p, r));
-                match &r.conclusion {
-                    Conclusion::Proved { .. } => passed += 1,
-                    Conclusion::Undecided { .. } => undecided += 1,
-                    Conclusion::Violated { by, how, counterexample } => {
-                        failed += 1;
-                        let mut text = format!("---- property \"{}\" ({}) ----\n", p.name, p.place);
-                        text.push_str(&format!(
-                            "counterexample ({}, {how}, {} events):\n",
-                            by.name(),
-                            counterexample.steps.len()
-                        ));
-                        text.push_str(&counterexample.describe(&content));
-                        text.push_str("replay it as a test (paste it into the file):\n");
-                        text.push_str(&counterexample.as_test(&content, &p.name));
-                        failures.push(text);
-                    }
-                    Conclusion::Disagree { .. } => {
-                        failed += 1;
-                        failures.push(format!(
-                            "---- property \"{}\" ({}) ----\nIC3's counterexample does not replay on the engine: an error of situ, please report it\n",
-                            p.name, p.place
-                        ));
-                    }
-                }
+        if args.stats {
+            if let Some(session) = &r.session {
+                print_stats(session, &r.properties);
             }
         }
-        if human && !failures.is_empty() {
+        for p in &r.properties {
+            print_property(&r.content, &p.spec, &p.report);
+            if let Some(text) = property_failure(&r.content, &p.spec, &p.report) {
+                failures.push(text);
+            }
+        }
+        if !failures.is_empty() {
             println!("\nfailures:\n");
             for f in &failures {
                 println!("{f}");
             }
         }
-        if sarif {
-            checked.diagnostics.extend(verdicts);
-            sarif_checked.push(checked);
-        }
     }
-    if sarif {
-        let checks: Vec<&situ_compiler::Checked> = sarif_checked.iter().collect();
-        let failures: Vec<_> = sarif_failures.iter().collect();
-        println!("{}", render::sarif_with_failures(&checks, &failures));
-    }
-    if human {
-        println!("\n{passed} passed, {failed} failed, {undecided} undecided");
-        if undecided > 0 && !args.allow_undecided {
-            println!(
-                "undecided properties fail the run (E0502: `situ explain E0502`); `--allow-undecided` lets them pass"
-            );
-        }
-    }
-    if json_lines {
-        println!(
-            "{}",
-            json!({"kind": "summary", "passed": passed, "failed": failed, "undecided": undecided,
-                   "allow_undecided": args.allow_undecided})
-        );
-    }
-    if io_failed {
-        USAGE
-    } else if failed > 0 || (undecided > 0 && !args.allow_undecided) {
-        FAILED
-    } else {
-        OK
+    let s = report.summary;
+    println!("\n{} passed, {} failed, {} undecided", s.passed, s.failed, s.undecided);
+    if s.undecided > 0 && !report.allow_undecided {
+        println!("undecided properties fail the run (E0502: `situ explain E0502`); `--allow-undecided` lets them pass");
     }
 }
 
-fn check_properties(args: &Args, content: &Arc<Content>, props: &[&PropertySpec], human: bool) -> Vec<Report> {
-    let opts = property::Options {
-        engines: args.engine.engines(),
-        search: Search { seed: args.seed, cases: args.cases, length: args.length },
-        limits: Limits { depth: args.depth, max_states: args.max_states },
-        effort: args.prove_effort,
-        timeout: Some(Duration::from_secs_f64(args.prove_timeout.clamp(0.0, 86_400.0))),
-    };
-    let (session, reports) = property::check_all(content, props, &opts);
-    if args.stats && human {
-        if let Some(g) = &session.graph {
+/// A failed property's text in the failures, if it failed.
+fn property_failure(content: &Content, p: &PropertySpec, r: &Report) -> Option<String> {
+    match &r.conclusion {
+        Conclusion::Violated { by, how, counterexample } => {
+            let mut text = format!("---- property \"{}\" ({}) ----\n", p.name, p.place);
+            text.push_str(&format!(
+                "counterexample ({}, {how}, {} events):\n",
+                by.name(),
+                counterexample.steps.len()
+            ));
+            text.push_str(&counterexample.describe(content));
+            text.push_str("replay it as a test (paste it into the file):\n");
+            text.push_str(&counterexample.as_test(content, &p.name));
+            Some(text)
+        }
+        Conclusion::Disagree { .. } => Some(format!(
+            "---- property \"{}\" ({}) ----\nIC3's counterexample does not replay on the engine: an error of situ, please report it\n",
+            p.name, p.place
+        )),
+        Conclusion::Proved { .. } | Conclusion::Undecided { .. } => None,
+    }
+}
+
+/// One JSON object per test or property, one per line, and the summary.
+fn json_lines(report: &SuiteReport) {
+    for file in &report.files {
+        let path = &file.path;
+        let r = match &file.outcome {
+            FileOutcome::Unreadable(e) => {
+                eprintln!("error: {e}");
+                continue;
+            }
+            FileOutcome::Errors(checked) => {
+                print!("{}", render::json_lines(checked));
+                continue;
+            }
+            FileOutcome::Ran(_, r) => r,
+        };
+        for t in &r.tests {
+            let list: Vec<_> = t
+                .outcome
+                .failures
+                .iter()
+                .map(|f| json!({"place": f.place.to_string(), "message": f.message}))
+                .collect();
             println!(
-                "exploration: {} abstract states, {} edges, {} letters, {} gaps, complete to {} events{}, {:.3} s",
-                g.states(),
-                g.edges(),
-                g.alphabet.letters.len(),
-                g.alphabet.gaps.len(),
-                g.complete_depth,
-                if g.closed { " (closed)" } else { "" },
-                session.graph_time.as_secs_f64()
+                "{}",
+                json!({"kind": "test", "file": path.display().to_string(), "name": t.spec.name,
+                       "place": t.spec.place.to_string(), "passed": t.outcome.passed(), "events": t.outcome.events,
+                       "failures": list})
             );
         }
-        match &session.model {
-            Some(Ok(m)) => println!(
-                "circuit: {} latches, {} inputs, {} and-gates, {:.3} s",
-                m.aig.latches().len(),
-                m.aig.inputs().len(),
-                m.aig.len() - 1 - m.aig.latches().len() - m.aig.inputs().len(),
-                session.model_time.as_secs_f64()
-            ),
-            Some(Err(why)) => println!("circuit: not built ({why})"),
-            None => {}
+        for p in &r.properties {
+            println!("{}", property_json(&r.content, path, &p.spec, &p.report));
         }
-        for (p, r) in props.iter().zip(&reports) {
-            if let Some(t) = r.ic3_time {
-                println!("ic3 \"{}\": {:.3} s", p.name, t.as_secs_f64());
+    }
+    let s = report.summary;
+    println!(
+        "{}",
+        json!({"kind": "summary", "passed": s.passed, "failed": s.failed, "undecided": s.undecided,
+               "allow_undecided": report.allow_undecided})
+    );
+}
+
+/// One SARIF 2.1.0 log: each file's findings with its verdicts as findings.
+fn sarif(report: SuiteReport) {
+    let (mut checks, mut unreadable) = (Vec::new(), Vec::new());
+    for file in report.files {
+        match file.outcome {
+            FileOutcome::Unreadable(e) => {
+                eprintln!("error: {e}");
+                unreadable.push(e);
             }
-            if let (Some(t), Some(Verdict::NotFound { steps, .. })) = (r.random_time, &r.random) {
-                let s = t.as_secs_f64();
-                println!("random \"{}\": {steps} steps in {s:.3} s ({:.0} steps/s)", p.name, *steps as f64 / s);
+            FileOutcome::Errors(checked) => checks.push(checked),
+            FileOutcome::Ran(mut checked, r) => {
+                checked.diagnostics.extend(r.findings());
+                checks.push(checked);
             }
         }
     }
-    reports
+    let checks: Vec<&situ_compiler::Checked> = checks.iter().collect();
+    let failures: Vec<_> = unreadable.iter().collect();
+    println!("{}", render::sarif_with_failures(&checks, &failures));
+}
+
+/// `--stats`: the size and time of the exploration, the circuit, IC3 and
+/// the random search.
+fn print_stats(session: &Session, props: &[suite::PropertyResult]) {
+    if let Some(g) = &session.graph {
+        println!(
+            "exploration: {} abstract states, {} edges, {} letters, {} gaps, complete to {} events{}, {:.3} s",
+            g.states(),
+            g.edges(),
+            g.alphabet.letters.len(),
+            g.alphabet.gaps.len(),
+            g.complete_depth,
+            if g.closed { " (closed)" } else { "" },
+            session.graph_time.as_secs_f64()
+        );
+    }
+    match &session.model {
+        Some(Ok(m)) => println!(
+            "circuit: {} latches, {} inputs, {} and-gates, {:.3} s",
+            m.aig.latches().len(),
+            m.aig.inputs().len(),
+            m.aig.len() - 1 - m.aig.latches().len() - m.aig.inputs().len(),
+            session.model_time.as_secs_f64()
+        ),
+        Some(Err(why)) => println!("circuit: not built ({why})"),
+        None => {}
+    }
+    for p in props {
+        let (name, r) = (&p.spec.name, &p.report);
+        if let Some(t) = r.ic3_time {
+            println!("ic3 \"{name}\": {:.3} s", t.as_secs_f64());
+        }
+        if let (Some(t), Some(Verdict::NotFound { steps, .. })) = (r.random_time, &r.random) {
+            let s = t.as_secs_f64();
+            println!("random \"{name}\": {steps} steps in {s:.3} s ({:.0} steps/s)", *steps as f64 / s);
+        }
+    }
 }
 
 /// A property's line, each checker's answer, its premise.
@@ -376,87 +419,6 @@ fn property_json(content: &Content, path: &std::path::Path, p: &PropertySpec, r:
            "code": code, "proved_by": proved_by, "undecided_because": reasons,
            "exhaustive": verdict(&r.exhaustive), "symbolic": verdict(&r.symbolic), "random": verdict(&r.random),
            "counterexample": cex, "premise": premise})
-}
-
-/// A failed test as a finding (E0504), at its block.
-fn test_diagnostic(t: &TestSpec, outcome: &scenario::TestOutcome) -> Diagnostic {
-    let first = outcome.failures.first().map_or(String::new(), |f| format!(": {}", f.message));
-    let help: Vec<String> = outcome.failures.iter().map(|f| format!("{}: {}", f.place, f.message)).collect();
-    Diagnostic::error(
-        codes::FAILED_TEST,
-        format!("test \"{}\" failed{first}", t.name),
-        t.origin.file,
-        t.origin.span,
-        "this test",
-    )
-    .with_help(help.join("\n"))
-}
-
-/// A property's verdict as findings: violated (E0503), undecided (E0502),
-/// vacuous (W0501); none for a proved property with a reachable premise.
-fn property_diagnostics(content: &Content, p: &PropertySpec, r: &Report) -> Vec<Diagnostic> {
-    let (file, span) = (p.origin.file, p.origin.span);
-    let mut out = Vec::new();
-    match &r.conclusion {
-        Conclusion::Violated { by, counterexample: c, .. } => {
-            let mut d = Diagnostic::error(
-                codes::VIOLATED_PROPERTY,
-                format!(
-                    "property \"{}\" is broken by a run of {} events (found by {}): {}",
-                    p.name,
-                    c.steps.len(),
-                    by.name(),
-                    c.reason
-                ),
-                file,
-                span,
-                "this property",
-            )
-            .with_help(format!("the run as a test to paste into the file:\n{}", c.as_test(content, &p.name)));
-            let steps: Vec<_> = c
-                .steps
-                .iter()
-                .map(|s| json!({"event": show_event(content, s.event, &s.payload), "time_ns": s.time,
-                                 "state": content.states[s.state as usize].name}))
-                .collect();
-            d.witness = Some(json!({"events": steps, "point": c.point, "reason": c.reason}));
-            out.push(d);
-        }
-        Conclusion::Undecided { reasons } => out.push(
-            Diagnostic::error(
-                codes::UNDECIDED_PROPERTY,
-                format!("property \"{}\" is undecided: no checker proved or broke it within its budget", p.name),
-                file,
-                span,
-                "this property",
-            )
-            .with_help(reasons.join("\n")),
-        ),
-        Conclusion::Disagree { events } => out.push(Diagnostic::error(
-            codes::VIOLATED_PROPERTY,
-            format!(
-                "property \"{}\": IC3's counterexample of {events} events does not replay on the engine (an error of situ, please report it)",
-                p.name
-            ),
-            file,
-            span,
-            "this property",
-        )),
-        Conclusion::Proved { .. } => {}
-    }
-    if let Some(Premise::Vacuous { by }) = &r.premise {
-        out.push(
-            Diagnostic::warning(
-                codes::VACUOUS_PROPERTY,
-                format!("property \"{}\" is vacuous: its premise never holds ({} proved it)", p.name, by.name()),
-                file,
-                span,
-                "this property",
-            )
-            .with_help("check the premise: a state, mode or event pattern that no run reaches together"),
-        );
-    }
-    out
 }
 
 fn count(n: usize, what: &str) -> String {

@@ -4,7 +4,8 @@
 //! [`McapRecorder`]: the channels, schemas and messages of the recording,
 //! as they are written, with or without a file.
 
-use super::view::{self, data::Site, live::Live};
+use super::view::{self, data::Site};
+use situ_runtime::record::live::{Live, PageTap};
 use situ_runtime::record::mcap::{McapRecorder, Tap};
 use std::io::Write as _;
 use std::sync::{Arc, Mutex};
@@ -19,15 +20,13 @@ pub struct Watchers {
 
 impl Watchers {
     /// Starts the servers asked for; `site` makes the page's rules (only
-    /// called for `--serve`). The error is printed; the exit code returned.
+    /// called for `--serve`). The error is said (by [`super::exit_code`]);
+    /// its exit code returned, as the run's commands expect.
     pub fn start(foxglove: Option<&str>, serve: Option<&str>, site: impl FnOnce() -> Site) -> Result<Watchers, u8> {
-        let foxglove = match foxglove.map(LiveServer::start).transpose() {
-            Ok(f) => f,
-            Err(e) => {
-                eprintln!("error: --foxglove: {e}");
-                return Err(super::USAGE);
-            }
-        };
+        let foxglove = foxglove
+            .map(LiveServer::start)
+            .transpose()
+            .map_err(|e| super::exit_code(Err(super::CliError::Usage(format!("--foxglove: {e}")))))?;
         let page = serve.map(|addr| view::serve_live(site(), addr)).transpose()?;
         if let Some((url, _)) = &page {
             // The first line on standard output, as `situ view` prints it.
@@ -48,7 +47,7 @@ impl Watchers {
             recorder.tap(Box::new(f.tap()));
         }
         if let Some((_, live)) = &self.page {
-            recorder.tap(Box::new(view::live::PageTap::new(live.clone())));
+            recorder.tap(Box::new(PageTap::new(live.clone())));
         }
     }
 

@@ -13,7 +13,9 @@
 //!   counterexample, or says up to which depth it found none.
 //!
 //! [`property`] runs them on each property and concludes: proved, violated
-//! or undecided.
+//! or undecided; [`suite`] is `situ test` as one call: the tests and the
+//! properties of each file, the summary and the verdict (the command line
+//! only renders it).
 //!
 //! Both checkers run the same [`System`]: the engine and the organisation,
 //! driven as at runtime (the FSMs see an event before the rest for it, and
@@ -22,6 +24,7 @@
 pub mod abstraction;
 pub mod aig;
 pub mod explore;
+pub mod findings;
 pub mod ic3;
 pub mod liveness;
 pub mod model;
@@ -31,6 +34,7 @@ pub mod property;
 pub mod prove;
 pub mod random;
 pub mod scenario;
+pub mod suite;
 
 use situ_compiler::bundle::{Content, Value};
 use situ_compiler::spec::{Pred, PropertySpec};

@@ -24,7 +24,7 @@ mod wiring;
 
 pub use fsm::possible as fsm_possible;
 pub use rete::rete;
-pub use states::{states, StateKind};
+pub use states::{bundle_states, states, StateKind};
 pub use wiring::{wiring, wiring_cell, wiring_legend, wiring_moment, Moment};
 
 /// A DOT string literal.
@@ -128,6 +128,25 @@ mod tests {
         assert!(wiring(&content, None).contains("subgraph \"cluster_RO\""));
         let cell = wiring_cell(&content, content.state_id("RS").unwrap());
         assert!(cell.contains("sleeping: Fusion"), "{cell}");
+    }
+
+    #[test]
+    fn the_states_of_a_bundle_are_drawn_with_the_changes_recorded() {
+        let c = check_source("t.situ", SRC);
+        let content = crate::bundle::build(&c);
+        let dot = bundle_states(&content, [("IT", "RS"), ("RS", "RO"), ("IT", "RS")]);
+        assert!(
+            dot.contains(
+                "label=\"t.situ: 6 states (the transitions need the .situ source; edges: the changes recorded)\""
+            ),
+            "{dot}"
+        );
+        assert!(dot.contains("\"IT\" [label=\"IT\", fillcolor=\"#c8e6c9\", penwidth=3];"), "{dot}");
+        assert!(dot.contains("\"GL\" [label=\"GL\", fillcolor=\"#bbdefb\", peripheries=2];"), "{dot}");
+        assert_eq!(dot.matches("\"IT\" -> \"RS\";").count(), 1, "{dot}");
+        assert!(dot.contains("\"RS\" -> \"RO\";"), "{dot}");
+        let bare = bundle_states(&content, []);
+        assert!(bare.contains("(the transitions need the .situ source)") && !bare.contains("->"), "{bare}");
     }
 
     #[test]

@@ -5,6 +5,7 @@
 //! of their own, so that every layout engine keeps the distinction.
 
 use super::{header, legend, q};
+use crate::bundle::Content;
 use crate::checks::transitions::Transitions;
 use crate::model::{Model, StateId};
 use situ_grammar::diag::{Diagnostic, Severity};
@@ -225,4 +226,39 @@ pub fn states(model: &Model, tr: &Transitions, title: &str, diagnostics: &[Diagn
 /// State names, four to a line.
 fn wrap(names: &[&str]) -> String {
     names.chunks(4).map(|c| c.join(" ")).collect::<Vec<_>>().join("\n")
+}
+
+/// The states of a bundle whose source is not at hand (the transitions
+/// need the static checks), with the changes `edges` (from, to) of a
+/// recording as edges, each pair once, in the order first seen.
+pub fn bundle_states<'a>(c: &Content, edges: impl IntoIterator<Item = (&'a str, &'a str)>) -> String {
+    let text = |s: &str| s.replace('\\', "\\\\").replace('"', "\\\"");
+    let mut edges = edges.into_iter().peekable();
+    let mut out =
+        String::from("digraph states {\n  node [shape=box, style=\"rounded,filled\", fillcolor=\"#ffffff\"];\n");
+    let caption = if edges.peek().is_none() { "" } else { "; edges: the changes recorded" };
+    let _ = writeln!(
+        out,
+        "  label=\"{}: {} states (the transitions need the .situ source{caption})\";\n  labelloc=t;",
+        text(&c.source),
+        c.states.len()
+    );
+    for (i, s) in c.states.iter().enumerate() {
+        let extra = if i == c.initial as usize {
+            ", fillcolor=\"#c8e6c9\", penwidth=3"
+        } else if s.is_final {
+            ", fillcolor=\"#bbdefb\", peripheries=2"
+        } else {
+            ""
+        };
+        let _ = writeln!(out, "  \"{}\" [label=\"{}\"{extra}];", text(&s.name), text(&s.name));
+    }
+    let mut seen = BTreeSet::new();
+    for (from, to) in edges {
+        if seen.insert((from, to)) {
+            let _ = writeln!(out, "  \"{}\" -> \"{}\";", text(from), text(to));
+        }
+    }
+    out.push_str("}\n");
+    out
 }

@@ -49,7 +49,7 @@ pub mod staged;
 #[cfg(test)]
 mod tests;
 
-pub use read::{attached_bundle, read_file, read_messages, read_recording, read_topics, Reading};
+pub use read::{attached_bundle, read_file, read_messages, read_recording, read_topics, FileError, ReadError, Reading};
 
 /// Topic names, for readers.
 pub mod topics {

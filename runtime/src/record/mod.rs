@@ -3,8 +3,14 @@
 //! every agent's mode changes. A [`Sink`] receives them as they happen;
 //! [`mcap::McapRecorder`] writes them to an MCAP file (the Recorder agent of
 //! the paper), [`Memory`] keeps them for tests.
+//!
+//! Read back: [`mcap::read`] decodes a recording, bounded; [`timeline`]
+//! turns its messages into what the Supervisor's page draws, and [`live`]
+//! keeps a live run's for its page.
 
+pub mod live;
 pub mod mcap;
+pub mod timeline;
 
 use crate::rete::StateChange;
 use situ_compiler::bundle::{Mode, Value};

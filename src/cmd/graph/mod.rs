@@ -11,7 +11,7 @@
 // The layout, as the commands that draw name it.
 pub use situ_pictures as layout;
 
-use super::{FAILED, OK, USAGE};
+use super::{CliError, Outcome, FAILED, OK};
 use situ_compiler::bundle::{self, Content};
 use situ_compiler::checks::transitions::Transitions;
 use situ_compiler::graph;
@@ -45,16 +45,13 @@ struct Input {
     content: Option<Arc<Content>>,
 }
 
-fn load(file: &Path) -> Result<Input, u8> {
+fn load(file: &Path) -> Result<Input, CliError> {
     if !super::program::is_source(file) {
-        let p = super::program::load(file, false)?;
+        let p = super::program::load(file, false).map_err(CliError::Reported)?;
         return Ok(Input { checked: p.checked, content: Some(p.content) });
     }
-    super::program::refuse_source_under_trust(file)?;
-    let checked = situ_compiler::check(file, &FsLoader).map_err(|e| {
-        eprintln!("error: {e}");
-        USAGE
-    })?;
+    super::program::refuse_source_under_trust(file).map_err(CliError::Reported)?;
+    let checked = situ_compiler::check(file, &FsLoader).map_err(|e| CliError::Usage(e.to_string()))?;
     // The findings on standard error: standard output is the picture.
     let style = render::Style { colour: false, ..super::style() };
     eprint!("{}", render::human_all(&checked, style));
@@ -62,22 +59,37 @@ fn load(file: &Path) -> Result<Input, u8> {
     Ok(Input { checked: Some(checked), content })
 }
 
-pub fn run(file: &Path, view: View, state: Option<&str>, format: Format, out: Option<&PathBuf>) -> u8 {
-    let input = match load(file) {
-        Ok(i) => i,
-        Err(code) => return code,
-    };
+// The arguments of `situ graph`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// A `.situ` source or a bundle (the states view needs the source).
+    pub file: PathBuf,
+    #[arg(long, value_enum)]
+    pub view: View,
+    /// The state whose wiring to draw (default: all, as clusters).
+    #[arg(long)]
+    pub state: Option<String>,
+    #[arg(long, value_enum, default_value_t = Format::Dot)]
+    pub format: Format,
+    /// Write here instead of standard output.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+}
+
+pub fn run(args: &Args) -> Outcome {
+    let (file, view, state, format, out) =
+        (&args.file, args.view, args.state.as_deref(), args.format, args.output.as_ref());
+    let input = load(file)?;
     let name = file.display().to_string();
     let errors = input.checked.as_ref().map_or(0, |c| c.errors());
     let content = match (&input.content, view) {
         (_, View::States) => None,
         (Some(c), _) => Some(c.clone()),
         (None, _) => {
-            eprintln!(
-                "error: `{name}` has {errors} error(s): the wiring and Rete views are drawn from a program without errors \
+            return Err(CliError::Failed(format!(
+                "`{name}` has {errors} error(s): the wiring and Rete views are drawn from a program without errors \
                  (the states view draws what resolved; `situ check` explains each)"
-            );
-            return FAILED;
+            )));
         }
     };
     let state = match (state, &content) {
@@ -85,8 +97,7 @@ pub fn run(file: &Path, view: View, state: Option<&str>, format: Format, out: Op
             Some(id) => Some(id),
             None => {
                 let names: Vec<&str> = c.states.iter().map(|s| s.name.as_str()).collect();
-                eprintln!("error: no state `{s}`; the states are: {}", names.join(", "));
-                return USAGE;
+                return Err(CliError::Usage(format!("no state `{s}`; the states are: {}", names.join(", "))));
             }
         },
         _ => None,
@@ -95,8 +106,9 @@ pub fn run(file: &Path, view: View, state: Option<&str>, format: Format, out: Op
         (View::States, _) => match &input.checked {
             Some(ch) => graph::states(&ch.model, &Transitions::build(&ch.model), &name, &ch.diagnostics),
             None => {
-                eprintln!("error: the states view comes from the static checks: give the `.situ` source, not a bundle");
-                return USAGE;
+                return Err(CliError::Usage(
+                    "the states view comes from the static checks: give the `.situ` source, not a bundle".into(),
+                ));
             }
         },
         (View::Wiring, Some(c)) => graph::wiring(c, state),
@@ -117,8 +129,7 @@ pub fn run(file: &Path, view: View, state: Option<&str>, format: Format, out: Op
             match laid {
                 Ok(svg) => svg,
                 Err(e) => {
-                    eprintln!("error: cannot lay out the graph: {e}");
-                    return USAGE;
+                    return Err(CliError::Usage(format!("cannot lay out the graph: {e}")));
                 }
             }
         }
@@ -127,14 +138,11 @@ pub fn run(file: &Path, view: View, state: Option<&str>, format: Format, out: Op
     match out {
         None => {
             print!("{text}");
-            code
+            Ok(code)
         }
         Some(path) => match super::write_atomically(path, text.as_bytes()) {
-            Ok(()) => code,
-            Err(e) => {
-                eprintln!("error: cannot write `{}`: {e}", path.display());
-                USAGE
-            }
+            Ok(()) => Ok(code),
+            Err(e) => Err(CliError::Usage(format!("cannot write `{}`: {e}", path.display()))),
         },
     }
 }

@@ -1,119 +1,18 @@
 //! What the page draws, computed once when `situ view` starts: the program
-//! as JSON, the state graph as SVG, and a recording's timeline.
+//! as JSON, the state graph as SVG, and a recording's timeline (read by
+//! the runtime: `situ_runtime::record::timeline`).
 
-use crate::cmd::{graph::layout, program, USAGE};
+use crate::cmd::{graph::layout, program, CliError};
 use serde_json::{json, Value as Json};
 use situ_compiler::bundle::{self, Action, Behaviour, Content, Mode};
 use situ_compiler::checks::transitions::Transitions;
 use situ_compiler::loader::FsLoader;
 use situ_compiler::Checked;
-use situ_runtime::record::mcap::{attached_bundle, read_file, read_topics, topics};
+use situ_runtime::record::mcap::{attached_bundle, read_file, read_topics};
+use situ_runtime::record::timeline::{Change, Timeline, TimelineError, TOPICS};
 use std::fmt::Write as _;
 use std::path::Path;
 use std::sync::Arc;
-
-/// A state change of a run.
-pub struct Change {
-    pub t: u64,
-    pub from: String,
-    pub to: String,
-    pub rules: Vec<String>,
-    pub explain: String,
-}
-
-/// An agent's mode as recorded.
-pub struct ModeAt {
-    pub t: u64,
-    pub agent: String,
-    pub function: String,
-    pub mode: String,
-}
-
-/// An event the Bulletinboard refused, and why.
-pub struct Refusal {
-    pub t: u64,
-    pub agent: String,
-    pub event: String,
-    pub reason: String,
-}
-
-/// What the page draws of one message of a run (a recording's, or a live
-/// run's as its recorder writes it).
-pub enum Entry {
-    Change(Change),
-    Mode(ModeAt),
-    Refused(Refusal),
-    /// A message of the run that moves only its clock: an accepted event,
-    /// a tick, a state message that did not change the state.
-    Time(u64),
-}
-
-impl Entry {
-    /// The entry of a message on `topic` at `time` (ns); `None` when the
-    /// topic is not one of a situ run's (a simulation's pose, say).
-    pub fn of(topic: &str, time: u64, msg: &Json) -> Option<Entry> {
-        let text = |k: &str| msg[k].as_str().unwrap_or("").to_string();
-        let t = msg["time_ns"].as_u64().unwrap_or(time);
-        Some(match topic {
-            topics::STATE if msg["from"] != msg["state"] => {
-                let rules = msg["rules"]
-                    .as_array()
-                    .map(|r| r.iter().filter_map(|x| x.as_str().map(String::from)).collect())
-                    .unwrap_or_default();
-                Entry::Change(Change { t, from: text("from"), to: text("state"), rules, explain: text("explain") })
-            }
-            topics::MODES => {
-                Entry::Mode(ModeAt { t, agent: text("agent"), function: text("function"), mode: text("mode") })
-            }
-            topics::EVENTS if msg["accepted"] == Json::Bool(false) => {
-                Entry::Refused(Refusal { t, agent: text("agent"), event: text("event"), reason: text("reason") })
-            }
-            topics::STATE | topics::EVENTS | topics::TICKS => Entry::Time(t),
-            _ => return None,
-        })
-    }
-
-    /// What in the entry is not of `content` (a state, an agent), if anything.
-    pub fn foreign(&self, content: &Content) -> Option<String> {
-        match self {
-            Entry::Change(c) => [&c.from, &c.to]
-                .into_iter()
-                .find(|s| content.state_id(s).is_none())
-                .map(|s| format!("its state `{s}` is not a state")),
-            Entry::Mode(m) => {
-                content.agent_id(&m.agent).is_none().then(|| format!("its agent `{}` is not an agent", m.agent))
-            }
-            Entry::Refused(_) | Entry::Time(_) => None,
-        }
-    }
-
-    pub fn time(&self) -> u64 {
-        match self {
-            Entry::Change(c) => c.t,
-            Entry::Mode(m) => m.t,
-            Entry::Refused(r) => r.t,
-            Entry::Time(t) => *t,
-        }
-    }
-}
-
-impl Change {
-    pub fn json(&self) -> Json {
-        json!({ "t": self.t, "from": self.from, "to": self.to, "rules": self.rules, "explain": self.explain })
-    }
-}
-
-impl ModeAt {
-    pub fn json(&self) -> Json {
-        json!({ "t": self.t, "agent": self.agent, "function": self.function, "mode": self.mode })
-    }
-}
-
-impl Refusal {
-    pub fn json(&self) -> Json {
-        json!({ "t": self.t, "agent": self.agent, "event": self.event, "reason": self.reason })
-    }
-}
 
 pub struct Site {
     name: String,
@@ -122,37 +21,33 @@ pub struct Site {
     pub program: String,
     pub graph: String,
     pub timeline: String,
-    changes: Vec<Change>,
-    modes: Vec<ModeAt>,
+    /// A recording's run; empty for rules.
+    run: Timeline,
 }
 
 impl Site {
-    /// Loads a source, a bundle or a recording; on failure prints why and
-    /// returns the exit code (2 for a damaged recording or other rules).
-    pub fn load(file: &Path, rules: Option<&Path>) -> Result<Site, u8> {
+    /// Loads a source, a bundle or a recording; the error says why (exit 2
+    /// for a damaged recording or other rules).
+    pub fn load(file: &Path, rules: Option<&Path>) -> Result<Site, CliError> {
         let name = file.display().to_string();
         let is_recording = file.extension().is_some_and(|e| e == "mcap");
         if !is_recording {
             if rules.is_some() {
-                eprintln!("error: --rules goes with a recording (`.mcap`); `{name}` is the rules already");
-                return Err(USAGE);
+                return Err(CliError::Usage(format!(
+                    "--rules goes with a recording (`.mcap`); `{name}` is the rules already"
+                )));
             }
-            let p = program::load(file, false)?;
+            let p = program::load(file, false).map_err(CliError::Reported)?;
             let kind = if p.checked.is_some() { "rules" } else { "bundle" };
             let checked = p.checked.or_else(|| source_of(&p.content));
-            return Ok(Site::new(name, kind, p.content, checked.as_ref(), Vec::new(), Vec::new(), Vec::new(), None));
+            return Ok(Site::new(name, kind, p.content, checked.as_ref(), None));
         }
-        let bytes = read_file(file).map_err(|e| {
-            eprintln!("error: `{name}`: {e}");
-            USAGE
-        })?;
+        let bytes = read_file(file).map_err(|e| CliError::Usage(format!("`{name}`: {e}")))?;
         // The page draws the rules' topics only (not a simulation's pose,
         // not the /events log that repeats /situ/events).
-        let wanted = |t: &str| [topics::STATE, topics::MODES, topics::EVENTS, topics::TICKS].contains(&t);
-        let reading = read_topics(&bytes, &wanted).map_err(|e| {
-            eprintln!("error: `{name}` is not a readable recording: {e}");
-            USAGE
-        })?;
+        let wanted = |t: &str| TOPICS.contains(&t);
+        let reading = read_topics(&bytes, &wanted)
+            .map_err(|e| CliError::Usage(format!("`{name}` is not a readable recording: {e}")))?;
         if let Some(why) = &reading.cut {
             eprintln!("warning: `{name}` is cut short: {why}; the page shows the part before the cut");
         }
@@ -160,15 +55,14 @@ impl Site {
             attached_bundle(&bytes).map(|b| program::decode_bundle(&b, &format!("the bundle attached to `{name}`")));
         let (content, checked) = match (rules, attached) {
             (Some(r), attached) => {
-                let p = program::load(r, false)?;
+                let p = program::load(r, false).map_err(CliError::Reported)?;
                 if let Some(Ok(a)) = attached {
                     if !same_rules(&a, &p.content) {
-                        eprintln!(
-                            "error: `{name}` was recorded on other rules than `{}` (its attached bundle differs); \
+                        return Err(CliError::Usage(format!(
+                            "`{name}` was recorded on other rules than `{}` (its attached bundle differs); \
                              leave --rules out to view it on its own rules",
                             r.display()
-                        );
-                        return Err(USAGE);
+                        )));
                     }
                 }
                 let checked = p.checked.or_else(|| source_of(&p.content));
@@ -179,67 +73,39 @@ impl Site {
                 let checked = source_of(&c);
                 (c, checked)
             }
-            (None, Some(Err(e))) => {
-                eprintln!("error: the bundle attached to `{name}`: {e}");
-                return Err(USAGE);
-            }
+            (None, Some(Err(e))) => return Err(CliError::Usage(format!("the bundle attached to `{name}`: {e}"))),
             (None, None) => {
-                eprintln!("error: `{name}` has no bundle attached: give its rules with --rules");
-                return Err(USAGE);
+                return Err(CliError::Usage(format!("`{name}` has no bundle attached: give its rules with --rules")))
             }
         };
-        let mut changes = Vec::new();
-        let mut modes = Vec::new();
-        let mut refused = Vec::new();
-        let mut ours = 0usize;
-        for (topic, time, msg) in &reading.messages {
-            let Some(entry) = Entry::of(topic, *time, msg) else { continue };
-            ours += 1;
-            if let Some(why) = entry.foreign(&content) {
-                eprintln!("error: `{name}` was recorded on other rules: {why} of `{}`", content.source);
-                return Err(USAGE);
-            }
-            match entry {
-                Entry::Change(c) => changes.push(c),
-                Entry::Mode(m) => modes.push(m),
-                Entry::Refused(r) => refused.push(r.json()),
-                Entry::Time(_) => {}
-            }
-        }
-        if ours == 0 {
-            eprintln!("error: `{name}` holds no message of a situ run (/state, /situ/events, /situ/modes)");
-            return Err(USAGE);
-        }
-        let end = reading.end;
-        Ok(Site::new(name, "recording", content, checked.as_ref(), changes, modes, refused, Some((end, reading.cut))))
+        let run = Timeline::read(&reading, &content).map_err(|e| {
+            CliError::Usage(match e {
+                TimelineError::OtherRules { what } => {
+                    format!("`{name}` was recorded on other rules: {what} of `{}`", content.source)
+                }
+                TimelineError::NothingOfSitu => format!("`{name}` {e}"),
+            })
+        })?;
+        Ok(Site::new(name, "recording", content, checked.as_ref(), Some(run)))
     }
 
-    #[allow(clippy::too_many_arguments)]
+    /// The site of rules (`run`: none) or of a recording's run.
     fn new(
         name: String,
         kind: &'static str,
         content: Arc<Content>,
         checked: Option<&Checked>,
-        changes: Vec<Change>,
-        modes: Vec<ModeAt>,
-        refused: Vec<Json>,
-        recording: Option<(u64, Option<String>)>,
+        run: Option<Timeline>,
     ) -> Site {
         let program = program_json(&name, kind, &content).to_string();
-        let graph = state_graph(&content, checked, &changes);
-        let timeline = match &recording {
-            None => json!({ "recording": false }),
-            Some((end, cut)) => json!({
-                "recording": true,
-                "end_ns": end,
-                "cut": cut,
-                "changes": changes.iter().map(Change::json).collect::<Vec<_>>(),
-                "modes": modes.iter().map(ModeAt::json).collect::<Vec<_>>(),
-                "refused": refused,
-            }),
+        let run = run.unwrap_or_default();
+        let graph = state_graph(&content, checked, &run.changes);
+        let timeline = match kind {
+            "recording" => run.json(),
+            _ => json!({ "recording": false }),
         }
         .to_string();
-        Site { name, kind, content, program, graph, timeline, changes, modes }
+        Site { name, kind, content, program, graph, timeline, run }
     }
 
     /// The page of a run as it goes (`situ run --serve`): the rules, and a
@@ -247,7 +113,7 @@ impl Site {
     pub fn live(name: String, content: Arc<Content>, checked: Option<&Checked>) -> Site {
         let found = checked.is_none().then(|| source_of(&content)).flatten();
         let checked = checked.or(found.as_ref());
-        let mut site = Site::new(name, "live run", content, checked, Vec::new(), Vec::new(), Vec::new(), None);
+        let mut site = Site::new(name, "live run", content, checked, None);
         site.timeline = json!({
             "recording": true, "live": true, "end_ns": 0, "cut": null, "changes": [], "modes": [], "refused": [],
         })
@@ -267,7 +133,7 @@ impl Site {
             c.rules.len()
         );
         if self.kind == "recording" {
-            let _ = write!(s, ", {} state changes", self.changes.len());
+            let _ = write!(s, ", {} state changes", self.run.changes.len());
         }
         s
     }
@@ -276,23 +142,7 @@ impl Site {
     /// `at` (nanoseconds; none: the end of a recording, the initial state
     /// of rules).
     pub fn state_at(&self, at: Option<u64>) -> String {
-        let c = &self.content;
-        let t = at.unwrap_or(u64::MAX);
-        let mut state = c.states[c.initial as usize].name.clone();
-        let mut visited = vec![state.clone()];
-        let mut fired = Json::Null;
-        for ch in self.changes.iter().take_while(|ch| ch.t <= t) {
-            state = ch.to.clone();
-            if !visited.contains(&state) {
-                visited.push(state.clone());
-            }
-            fired = json!({ "t": ch.t, "rules": ch.rules, "explain": ch.explain });
-        }
-        let mut modes = serde_json::Map::new();
-        for m in self.modes.iter().take_while(|m| m.t <= t) {
-            modes.insert(m.agent.clone(), json!({ "mode": m.mode, "function": m.function }));
-        }
-        json!({ "at_ns": at, "state": state, "visited": visited, "fired": fired, "modes": modes }).to_string()
+        self.run.state_at(&self.content, at).to_string()
     }
 }
 
@@ -391,7 +241,7 @@ fn program_json(name: &str, kind: &str, c: &Content) -> Json {
 fn state_graph(c: &Content, checked: Option<&Checked>, changes: &[Change]) -> String {
     let dot = match checked {
         Some(ch) => situ_compiler::graph::states(&ch.model, &Transitions::build(&ch.model), &c.source, &ch.diagnostics),
-        None => bare_states(c, changes),
+        None => situ_compiler::graph::bundle_states(c, changes.iter().map(|ch| (ch.from.as_str(), ch.to.as_str()))),
     };
     match layout::svg(&dot) {
         Ok(svg) => mark_states(&svg, c),
@@ -400,42 +250,6 @@ fn state_graph(c: &Content, checked: Option<&Checked>, changes: &[Change]) -> St
             format!("<svg xmlns=\"http://www.w3.org/2000/svg\"><text x=\"10\" y=\"20\">cannot lay out the state graph: {}</text></svg>", xml(&e.to_string()))
         }
     }
-}
-
-/// The states of a bundle whose source is not at hand, with the changes of
-/// its recording as edges.
-fn bare_states(c: &Content, changes: &[Change]) -> String {
-    let mut out =
-        String::from("digraph states {\n  node [shape=box, style=\"rounded,filled\", fillcolor=\"#ffffff\"];\n");
-    let edges = if changes.is_empty() { "" } else { "; edges: the changes recorded" };
-    let _ = writeln!(
-        out,
-        "  label=\"{}: {} states (the transitions need the .situ source{edges})\";\n  labelloc=t;",
-        dot_text(&c.source),
-        c.states.len()
-    );
-    for (i, s) in c.states.iter().enumerate() {
-        let extra = if i == c.initial as usize {
-            ", fillcolor=\"#c8e6c9\", penwidth=3"
-        } else if s.is_final {
-            ", fillcolor=\"#bbdefb\", peripheries=2"
-        } else {
-            ""
-        };
-        let _ = writeln!(out, "  \"{}\" [label=\"{}\"{extra}];", dot_text(&s.name), dot_text(&s.name));
-    }
-    let mut seen = std::collections::BTreeSet::new();
-    for ch in changes {
-        if seen.insert((ch.from.as_str(), ch.to.as_str())) {
-            let _ = writeln!(out, "  \"{}\" -> \"{}\";", dot_text(&ch.from), dot_text(&ch.to));
-        }
-    }
-    out.push_str("}\n");
-    out
-}
-
-fn dot_text(s: &str) -> String {
-    s.replace('\\', "\\\\").replace('"', "\\\"")
 }
 
 fn xml(s: &str) -> String {

@@ -24,14 +24,13 @@
 
 pub mod data;
 pub mod guard;
-pub mod live;
 
-use super::USAGE;
+use super::{CliError, Outcome};
 use guard::Guard;
-use live::Live;
+use situ_runtime::record::live::Live;
 use std::io::Write as _;
 use std::net::TcpListener;
-use std::path::Path;
+use std::path::PathBuf;
 use std::sync::Arc;
 
 const INDEX: &str = include_str!("index.html");
@@ -42,32 +41,47 @@ const STYLE: &str = include_str!("style.css");
 /// of its own); one more is told to come back.
 const MAX_WAITING: usize = 64;
 
-pub fn run(file: &Path, rules: Option<&Path>, port: Option<u16>) -> u8 {
-    let site = match data::Site::load(file, rules) {
-        Ok(s) => s,
-        Err(code) => return code,
-    };
+// The arguments of `situ view`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// A `.situ` source, a bundle, or an MCAP recording of `situ run --record`.
+    pub file: PathBuf,
+    /// The rules of a recording (a `.situ` source or a bundle); default: the bundle attached to it. Refused (exit 2) when the recording was made on other rules.
+    #[arg(long, value_name = "FILE")]
+    pub rules: Option<PathBuf>,
+    /// The port to listen on (default: a free one); the URL is the first line on standard output.
+    #[arg(long)]
+    pub port: Option<u16>,
+}
+
+pub fn run(args: &Args) -> Outcome {
+    let site = data::Site::load(&args.file, args.rules.as_deref())?;
     let host = "127.0.0.1";
-    let server = match listen(host, port.unwrap_or(0), "--port") {
-        Ok(s) => s,
-        Err(code) => return code,
-    };
+    let server = listen(host, args.port.unwrap_or(0), "--port")?;
     // Ctrl-C ends the server; nothing is half written, nothing to undo.
     let _ = ctrlc::set_handler(|| std::process::exit(0));
     println!("serving http://{}/", server.1);
     let _ = std::io::stdout().flush();
     eprintln!("{}; Ctrl-C stops", site.summary());
     serve(Arc::new(site), server.0, Guard::new(server.1, host), None);
-    super::OK
+    Ok(super::OK)
 }
 
 /// Serves a run's page live (`situ run … --serve [ADDR]`) from a thread of
-/// its own: the page's URL, and the log the run's [`live::PageTap`] fills.
-/// `addr` is `PORT` or `HOST:PORT` (default host 127.0.0.1).
+/// its own: the page's URL, and the log the run's
+/// [`situ_runtime::record::live::PageTap`] fills.
+/// `addr` is `PORT` or `HOST:PORT` (default host 127.0.0.1). The error
+/// is said (by [`super::exit_code`]) and its exit code returned, as the
+/// run's commands expect.
 pub fn serve_live(site: data::Site, addr: &str) -> Result<(String, Arc<Live>), u8> {
+    start_live(site, addr).map_err(|e| super::exit_code(Err(e)))
+}
+
+fn start_live(site: data::Site, addr: &str) -> Result<(String, Arc<Live>), CliError> {
     let Some((host, port)) = super::host_port(addr) else {
-        eprintln!("error: --serve `{addr}` is not a port or an address (PORT or HOST:PORT, say 127.0.0.1:8080)");
-        return Err(USAGE);
+        return Err(CliError::Usage(format!(
+            "--serve `{addr}` is not a port or an address (PORT or HOST:PORT, say 127.0.0.1:8080)"
+        )));
     };
     let (server, bound) = listen(host, port, "--serve")?;
     let live = Arc::new(Live::default());
@@ -75,37 +89,27 @@ pub fn serve_live(site: data::Site, addr: &str) -> Result<(String, Arc<Live>), u
     let l = live.clone();
     let guard = Guard::new(bound, host);
     let thread = std::thread::Builder::new().name("situ-view".into());
-    thread.spawn(move || serve(site, server, guard, Some(l))).map_err(|e| {
-        eprintln!("error: cannot start the page's server: {e}");
-        USAGE
-    })?;
+    thread
+        .spawn(move || serve(site, server, guard, Some(l)))
+        .map_err(|e| CliError::Usage(format!("cannot start the page's server: {e}")))?;
     Ok((format!("http://{bound}/"), live))
 }
 
 /// A server listening on `host:port`; the error names the port and the
 /// option that chose it.
-fn listen(host: &str, port: u16, option: &str) -> Result<(tiny_http::Server, std::net::SocketAddr), u8> {
-    let listener = match TcpListener::bind((host, port)) {
-        Ok(l) => l,
-        Err(e) if e.kind() == std::io::ErrorKind::AddrInUse => {
-            eprintln!(
-                "error: port {port} on {host} is in use: choose another with {option}, or leave the port out for a free one"
-            );
-            return Err(USAGE);
-        }
-        Err(e) => {
-            eprintln!("error: cannot listen on {host}:{port}: {e}");
-            return Err(USAGE);
-        }
-    };
-    let addr = listener.local_addr().map_err(|e| {
-        eprintln!("error: cannot tell the port listened on: {e}");
-        USAGE
+fn listen(host: &str, port: u16, option: &str) -> Result<(tiny_http::Server, std::net::SocketAddr), CliError> {
+    let listener = TcpListener::bind((host, port)).map_err(|e| {
+        CliError::Usage(if e.kind() == std::io::ErrorKind::AddrInUse {
+            format!(
+                "port {port} on {host} is in use: choose another with {option}, or leave the port out for a free one"
+            )
+        } else {
+            format!("cannot listen on {host}:{port}: {e}")
+        })
     })?;
-    let server = tiny_http::Server::from_listener(listener, None).map_err(|e| {
-        eprintln!("error: cannot serve on {addr}: {e}");
-        USAGE
-    })?;
+    let addr = listener.local_addr().map_err(|e| CliError::Usage(format!("cannot tell the port listened on: {e}")))?;
+    let server = tiny_http::Server::from_listener(listener, None)
+        .map_err(|e| CliError::Usage(format!("cannot serve on {addr}: {e}")))?;
     Ok((server, addr))
 }
 

@@ -37,6 +37,38 @@ const MAGIC: &[u8] = ::mcap::MAGIC;
 /// Opcode and length.
 const RECORD_HEAD: usize = 9;
 
+/// Why a recording's bytes do not read: each says where and why.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ReadError {
+    /// The bytes do not start with the MCAP magic.
+    #[error("not an MCAP file (it does not start with the MCAP magic)")]
+    NotMcap,
+    /// A top-level record that does not hold together, at byte `at` of a
+    /// file of `size` bytes.
+    #[error("damaged at byte {at} of {size}: {why}")]
+    Damaged { at: usize, size: usize, why: String },
+    /// The MCAP reader failed before byte `near` (a chunk's CRC, its
+    /// compression, a record inside it), after `messages` messages.
+    #[error("damaged before byte {near} of {size}: {why} ({messages} messages read before it)")]
+    DamagedBefore { near: usize, size: usize, why: String, messages: usize },
+    /// A record inside a chunk is malformed (the MCAP reader failed on it).
+    #[error("damaged: a record inside a chunk is malformed (the MCAP reader failed on it); {size} bytes")]
+    MalformedChunk { size: usize },
+}
+
+/// Why a recording file is not read ([`read_file`]).
+#[derive(Debug, thiserror::Error)]
+pub enum FileError {
+    #[error("cannot read it: {0}")]
+    Io(#[from] std::io::Error),
+    /// A device, a FIFO, a directory.
+    #[error("not a regular file: a recording is a file")]
+    NotAFile,
+    /// Larger than [`MAX_FILE`] (`size`: as the file system says, when it said so).
+    #[error("{}larger than the {MAX_FILE} bytes a recording may have", size.map_or(String::new(), |s| format!("{s} bytes: ")))]
+    TooLarge { size: Option<u64> },
+}
+
 /// A recording read back.
 #[derive(Debug, Clone)]
 pub struct Reading {
@@ -125,9 +157,9 @@ fn check_attachment(body: &[u8]) -> Result<(), String> {
 }
 
 /// Walks the top-level records (see the module).
-fn scan(bytes: &[u8]) -> Result<Scan, String> {
+fn scan(bytes: &[u8]) -> Result<Scan, ReadError> {
     if !bytes.starts_with(MAGIC) {
-        return Err("not an MCAP file (it does not start with the MCAP magic)".into());
+        return Err(ReadError::NotMcap);
     }
     let size = bytes.len();
     let mut at = MAGIC.len();
@@ -148,7 +180,7 @@ fn scan(bytes: &[u8]) -> Result<Scan, String> {
         }
         let opcode = bytes[at];
         let len = u64_at(bytes, at + 1).unwrap_or(u64::MAX);
-        let damaged = |why: String| Err(format!("damaged at byte {at} of {size}: {why}"));
+        let damaged = |why: String| Err(ReadError::Damaged { at, size, why });
         if at == MAGIC.len() && opcode != op::HEADER {
             return damaged(format!("the first record has opcode {opcode:#04x}, not a header"));
         }
@@ -202,28 +234,24 @@ fn scan(bytes: &[u8]) -> Result<Scan, String> {
 
 /// Reads every message of a recording, whole or cut short (see the module);
 /// an error says what is wrong with the file and where.
-pub fn read_recording(bytes: &[u8]) -> Result<Reading, String> {
+pub fn read_recording(bytes: &[u8]) -> Result<Reading, ReadError> {
     read_topics(bytes, &|_| true)
 }
 
 /// [`read_recording`] keeping only the messages of the topics `keep`
 /// accepts (the others are checked as the file is, not decoded).
-pub fn read_topics(bytes: &[u8], keep: &dyn Fn(&str) -> bool) -> Result<Reading, String> {
+pub fn read_topics(bytes: &[u8], keep: &dyn Fn(&str) -> bool) -> Result<Reading, ReadError> {
     let scan = scan(bytes)?;
     // The scan checks the top-level records; inside a chunk whose CRC is 0
     // ("not checked", by the MCAP specification) a malformed record could
     // still reach a slicing bug of the `mcap` crate (one was found by the
     // fuzz target at the top level): a panic there is damage, not a crash.
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| decode(bytes, scan, keep))).unwrap_or_else(|_| {
-        Err(format!(
-            "damaged: a record inside a chunk is malformed (the MCAP reader failed on it); {} bytes",
-            bytes.len()
-        ))
-    })
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| decode(bytes, scan, keep)))
+        .unwrap_or(Err(ReadError::MalformedChunk { size: bytes.len() }))
 }
 
 /// The `mcap` crate's reader over the records [`scan`] checked.
-fn decode(bytes: &[u8], scan: Scan, keep: &dyn Fn(&str) -> bool) -> Result<Reading, String> {
+fn decode(bytes: &[u8], scan: Scan, keep: &dyn Fn(&str) -> bool) -> Result<Reading, ReadError> {
     let options = LinearReaderOptions::default()
         .with_skip_end_magic(true)
         .with_validate_chunk_crcs(true)
@@ -262,11 +290,12 @@ fn decode(bytes: &[u8], scan: Scan, keep: &dyn Fn(&str) -> bool) -> Result<Readi
             }
             Err(e) => {
                 let near = scan.end - rest.len();
-                return Err(format!(
-                    "damaged before byte {near} of {}: {e} ({} messages read before it)",
-                    bytes.len(),
-                    messages.len()
-                ));
+                return Err(ReadError::DamagedBefore {
+                    near,
+                    size: bytes.len(),
+                    why: e.to_string(),
+                    messages: messages.len(),
+                });
             }
         }
     }
@@ -275,7 +304,7 @@ fn decode(bytes: &[u8], scan: Scan, keep: &dyn Fn(&str) -> bool) -> Result<Readi
 
 /// Reads every message of a recording, whole or cut short, in file order,
 /// and whether the file was cut short; a damaged file is an error.
-pub fn read_messages(bytes: &[u8]) -> Result<(Vec<Recorded>, bool), String> {
+pub fn read_messages(bytes: &[u8]) -> Result<(Vec<Recorded>, bool), ReadError> {
     let r = read_recording(bytes)?;
     Ok((r.messages, r.cut.is_some()))
 }
@@ -299,20 +328,20 @@ pub fn attached_bundle(bytes: &[u8]) -> Option<Vec<u8>> {
 
 /// Reads a recording file, refusing at once what is not a regular file
 /// (a device, a FIFO, a directory) or is larger than [`MAX_FILE`].
-pub fn read_file(path: &Path) -> Result<Vec<u8>, String> {
-    let meta = std::fs::metadata(path).map_err(|e| format!("cannot read it: {e}"))?;
+pub fn read_file(path: &Path) -> Result<Vec<u8>, FileError> {
+    let meta = std::fs::metadata(path)?;
     if !meta.is_file() {
-        return Err("not a regular file: a recording is a file".into());
+        return Err(FileError::NotAFile);
     }
     if meta.len() > MAX_FILE {
-        return Err(format!("{} bytes: larger than the {MAX_FILE} bytes a recording may have", meta.len()));
+        return Err(FileError::TooLarge { size: Some(meta.len()) });
     }
-    let file = std::fs::File::open(path).map_err(|e| format!("cannot read it: {e}"))?;
+    let file = std::fs::File::open(path)?;
     // The file may have changed since: read at most one byte more than allowed.
     let mut bytes = Vec::new();
-    file.take(MAX_FILE + 1).read_to_end(&mut bytes).map_err(|e| format!("cannot read it: {e}"))?;
+    file.take(MAX_FILE + 1).read_to_end(&mut bytes)?;
     if bytes.len() as u64 > MAX_FILE {
-        return Err(format!("larger than the {MAX_FILE} bytes a recording may have"));
+        return Err(FileError::TooLarge { size: None });
     }
     Ok(bytes)
 }

@@ -1,7 +1,7 @@
 //! The recording's boundaries: every flush leaves a valid file, a damaged
 //! file is an error and never an abort or a panic, whatever bit is flipped.
 
-use super::read::{attached_bundle, read_recording, MAX_RECORD};
+use super::read::{attached_bundle, read_recording, ReadError, MAX_RECORD};
 use super::staged::PROVISIONAL_END;
 use super::{topics, McapRecorder};
 use crate::record::{EventRecord, Sink, Verdict};
@@ -121,13 +121,18 @@ fn an_absurd_chunk_length_is_an_error_not_an_allocation() {
     // The top bit of the chunk's length: 2^63 more bytes than the file has.
     let mut damaged = bytes.clone();
     damaged[at + 8] ^= 0x80;
-    let e = read_recording(&damaged).unwrap_err();
-    assert!(e.contains(&format!("damaged at byte {at}")) && e.contains("claims"), "{e}");
+    match read_recording(&damaged).unwrap_err() {
+        ReadError::Damaged { at: where_, size, why } => {
+            assert_eq!((where_, size), (at, bytes.len()));
+            assert!(why.contains("claims"), "{why}");
+        }
+        e => panic!("{e}"),
+    }
     // Its uncompressed size (offset 16 of the chunk's body): too large to decompress.
     let mut damaged = bytes.clone();
     damaged[at + 9 + 16 + 7] ^= 0x40;
     let e = read_recording(&damaged).unwrap_err();
-    assert!(e.contains("uncompressed"), "{e}");
+    assert!(matches!(&e, ReadError::Damaged { why, .. } if why.contains("uncompressed")), "{e}");
     // Bytes of its compressed data: the chunk's CRC or zstd says so. The
     // 10th, bit 7, is the flip of issue 14: the `mcap` crate's own reader
     // decompressed it to a record length of 8.2e18 bytes and aborted.
@@ -136,7 +141,7 @@ fn an_absurd_chunk_length_is_an_error_not_an_allocation() {
         let mut damaged = bytes.clone();
         damaged[data + i] ^= bit;
         let e = read_recording(&damaged).unwrap_err();
-        assert!(e.contains("damaged"), "{e}");
+        assert!(e.to_string().starts_with("damaged"), "{e}");
     }
 }
 
@@ -144,7 +149,7 @@ fn an_absurd_chunk_length_is_an_error_not_an_allocation() {
 fn garbage_and_foreign_files_are_errors() {
     for junk in [&b""[..], b"not a recording", b"\x89MCAP0\r\n", &[0u8; 64]] {
         match read_recording(junk) {
-            Err(e) => assert!(e.contains("not an MCAP file") || e.contains("damaged"), "{e}"),
+            Err(e) => assert!(matches!(e, ReadError::NotMcap | ReadError::Damaged { .. }), "{e}"),
             // Only the magic: a recording cut right after it.
             Ok(r) => assert!(r.messages.is_empty() && r.cut.is_some()),
         }
@@ -206,7 +211,7 @@ fn a_flipped_bit_anywhere_never_panics_or_aborts() {
                     }
                 }
                 Err(e) => {
-                    assert!(!e.is_empty());
+                    assert!(!e.to_string().is_empty());
                     errors += 1;
                 }
             }
@@ -214,4 +219,23 @@ fn a_flipped_bit_anywhere_never_panics_or_aborts() {
         }
     }
     assert!(errors > 0);
+}
+
+/// What cannot be replayed says why as a value: not MCAP, cut before
+/// anything of situ's; what is not a recording file says so too.
+#[test]
+fn replay_and_file_errors_are_typed() {
+    use crate::replay::{replay, ReplayError};
+    let c = content();
+    assert_eq!(replay(b"not a recording", c.clone()).unwrap_err(), ReplayError::Read(ReadError::NotMcap));
+    match replay(::mcap::MAGIC, c.clone()).unwrap_err() {
+        ReplayError::NothingBeforeCut(why) => assert!(why.contains("no footer"), "{why}"),
+        e => panic!("{e}"),
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let e = super::read_file(dir.path()).unwrap_err();
+    assert!(matches!(e, super::FileError::NotAFile), "{e}");
+    assert_eq!(e.to_string(), "not a regular file: a recording is a file");
+    let e = super::read_file(&dir.path().join("missing.mcap")).unwrap_err();
+    assert!(matches!(e, super::FileError::Io(_)) && e.to_string().starts_with("cannot read it: "), "{e}");
 }

@@ -1,4 +1,4 @@
-//! The page of a run as it goes (`situ run … --serve`): the run's recorder
+//! The live log of a run for its page (`situ run … --serve`): the run's recorder
 //! tells a [`PageTap`] each message it writes; the tap keeps what the page
 //! draws in a [`Live`] log; the page asks `/api/live?since=N` and the
 //! answer comes as soon as there is something after `N` (a long poll: one
@@ -10,9 +10,9 @@
 //! state, the states visited and the agents' modes at the first entry
 //! kept), so that a long run's log stays bounded.
 
-use super::data::Entry;
+use super::mcap::Tap;
+use super::timeline::{Entry, TOPICS};
 use serde_json::{json, Value as Json};
-use situ_runtime::record::mcap::{topics, Tap};
 use std::collections::{BTreeMap, HashMap, VecDeque};
 use std::sync::{Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
@@ -244,8 +244,7 @@ impl PageTap {
 
 impl Tap for PageTap {
     fn channel(&mut self, id: u16, topic: &str, _schema_name: &str, _schema: &str) {
-        if let Some(t) = [topics::STATE, topics::MODES, topics::EVENTS, topics::TICKS].into_iter().find(|t| *t == topic)
-        {
+        if let Some(t) = TOPICS.into_iter().find(|t| *t == topic) {
             self.topics.insert(id, t);
         }
     }
@@ -264,7 +263,7 @@ impl Tap for PageTap {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cmd::view::data::{Change, ModeAt};
+    use crate::record::timeline::{Change, ModeAt};
 
     fn change(t: u64, from: &str, to: &str) -> Entry {
         Entry::Change(Change { t, from: from.into(), to: to.into(), rules: vec!["r".into()], explain: String::new() })

@@ -9,7 +9,7 @@
 //! seen; so is a file that comes back), and a burst of events is one round
 //! once it has been quiet for [`DEBOUNCE`].
 
-use super::{OK, USAGE};
+use super::{CliError, Outcome, OK};
 use notify::event::{AccessKind, AccessMode, EventKind};
 use notify::{RecursiveMode, Watcher};
 use situ_compiler::loader::{normalize, FsLoader, Loader};
@@ -28,23 +28,19 @@ pub const DEBOUNCE: Duration = Duration::from_millis(100);
 /// files it read. `machine` output (JSON, SARIF) keeps standard output for
 /// the documents: the separator and the notes go to standard error.
 /// Ends with [`OK`] on Ctrl-C (or SIGTERM).
-pub fn run(mut round: impl FnMut(&dyn Loader) -> String, machine: bool) -> u8 {
+pub fn run(mut round: impl FnMut(&dyn Loader) -> String, machine: bool) -> Outcome {
     let (tx, rx) = mpsc::channel::<Message>();
     let stop = tx.clone();
     if let Err(e) = ctrlc::set_handler(move || {
         let _ = stop.send(Message::Stop);
     }) {
-        eprintln!("error: cannot catch Ctrl-C: {e}");
-        return USAGE;
+        return Err(CliError::Usage(format!("cannot catch Ctrl-C: {e}")));
     }
     let mut watcher = match notify::recommended_watcher(move |event| {
         let _ = tx.send(Message::Fs(event));
     }) {
         Ok(watcher) => watcher,
-        Err(e) => {
-            eprintln!("error: cannot watch files: {e}");
-            return USAGE;
-        }
+        Err(e) => return Err(CliError::Usage(format!("cannot watch files: {e}"))),
     };
     let say = |line: &str| {
         if machine {
@@ -104,12 +100,12 @@ pub fn run(mut round: impl FnMut(&dyn Loader) -> String, machine: bool) -> u8 {
                 Ok(Message::Fs(Ok(event))) if concerns(&event, &files) => break,
                 Ok(Message::Fs(Ok(_))) => {}
                 Ok(Message::Fs(Err(e))) => eprintln!("warning: watching: {e}"),
-                Ok(Message::Stop) | Err(_) => return OK,
+                Ok(Message::Stop) | Err(_) => return Ok(OK),
             }
         }
         loop {
             match rx.recv_timeout(DEBOUNCE) {
-                Ok(Message::Stop) | Err(mpsc::RecvTimeoutError::Disconnected) => return OK,
+                Ok(Message::Stop) | Err(mpsc::RecvTimeoutError::Disconnected) => return Ok(OK),
                 Ok(Message::Fs(_)) => {}
                 Err(mpsc::RecvTimeoutError::Timeout) => break,
             }
