@@ -20,8 +20,10 @@
 
 mod error;
 mod program;
+mod suite;
 
 pub use error::Error;
 pub use program::{build, check, format, load, load_path, BuildOptions, Built, Input, Loaded, Program, Trust};
 pub use situ_compiler::bundle::{Content, Encoding};
 pub use situ_compiler::{Checked, Diagnostic, Severity};
+pub use suite::{test, SuiteReport, TestOptions, Verdict};

@@ -90,3 +90,19 @@ fn load_path_reads_sources_and_bundles_and_refuses_sources_under_trust() {
     let missing = dir.path().join("gone.bundle");
     assert!(matches!(load_path(&missing, &Trust::Any, false), Err(Error::Read { .. })));
 }
+
+#[test]
+fn test_gives_each_verdict_and_the_suites() {
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let file = dir.path().join("door.situ");
+    let text = format!(
+        "{DOOR}\ntest \"it opens\" {{\n    on OPENED at 0ms\n    expect state Open\n}}\n\
+         property \"a state of the door\" {{ always state in {{Closed, Open}} }}\n\
+         property \"never open\" {{ never state == Open }}\n"
+    );
+    std::fs::write(&file, text).expect("written");
+    let report = situ_api::test(&[file], &situ_api::TestOptions::default());
+    // The test passes and the first property is proved; the second is violated.
+    assert_eq!((report.summary.passed, report.summary.failed, report.summary.undecided), (2, 1, 0));
+    assert_eq!(report.verdict(), situ_api::Verdict::Fail);
+}

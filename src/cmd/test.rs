@@ -14,7 +14,9 @@ use situ_compiler::loader::FsLoader;
 use situ_compiler::render;
 use situ_compiler::spec::PropertySpec;
 use situ_verify::explore::Limits;
-use situ_verify::property::{self, Checker, Conclusion, Engines, Premise, Report, Session};
+use situ_verify::property::{
+    self, Checker, Conclusion, Engines, Premise, Report, Session, DEFAULT_OPTIONS as DEFAULTS,
+};
 use situ_verify::random::Search;
 use situ_verify::suite::{self, FileOutcome, SuiteReport};
 use situ_verify::{show_event, Counterexample, Verdict};
@@ -55,19 +57,19 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = Engine::Both)]
     pub engine: Engine,
     /// The seed of the random search.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = DEFAULTS.search.seed)]
     pub seed: u64,
     /// Random runs per property.
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, default_value_t = DEFAULTS.search.cases)]
     pub cases: u32,
     /// Events per random run.
-    #[arg(long, default_value_t = 120)]
+    #[arg(long, default_value_t = DEFAULTS.search.length)]
     pub length: usize,
     /// The most events the exhaustive exploration goes from the start.
-    #[arg(long, default_value_t = 12)]
+    #[arg(long, default_value_t = DEFAULTS.limits.depth)]
     pub depth: usize,
     /// The most abstract states the exhaustive exploration makes.
-    #[arg(long, default_value_t = 20_000)]
+    #[arg(long, default_value_t = DEFAULTS.limits.max_states)]
     pub max_states: usize,
     /// IC3's work budget per property, in SAT propagations: the same
     /// budget gives the same verdict on any machine under any load.

@@ -63,6 +63,24 @@ pub struct Options {
     pub timeout: Option<Duration>,
 }
 
+/// The budgets `situ test` uses when it is not told otherwise (its flags'
+/// defaults are these): both checkers, 256 random runs of 120 events from
+/// seed 1, exploration to 12 events or 20,000 states, IC3 on
+/// [`DEFAULT_EFFORT`] propagations under a 600 s guard.
+pub const DEFAULT_OPTIONS: Options = Options {
+    engines: Engines::Both,
+    search: Search { seed: 1, cases: 256, length: 120 },
+    limits: Limits { depth: 12, max_states: 20_000 },
+    effort: DEFAULT_EFFORT,
+    timeout: Some(Duration::from_secs(600)),
+};
+
+impl Default for Options {
+    fn default() -> Self {
+        DEFAULT_OPTIONS
+    }
+}
+
 /// The checker that decided.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Checker {

@@ -21,8 +21,8 @@ use situ_compiler::{Checked, Diagnostic, RootError};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-/// What to run, and on what budget.
-#[derive(Debug, Clone)]
+/// What to run, and on what budget; the default is `situ test`'s.
+#[derive(Debug, Clone, Default)]
 pub struct Options {
     /// Only the tests and properties whose name contains this.
     pub filter: Option<String>,
