@@ -341,6 +341,36 @@ pub fn builtin(name: &str) -> Option<Scenario> {
     parse(text).ok()
 }
 
+/// A scenario given by name that cannot be had.
+#[derive(Debug, thiserror::Error)]
+pub enum NamedError {
+    /// Neither a built-in scenario nor a file.
+    #[error("no built-in scenario `{0}` (outdoor-default, dafflon-4, dla-offices, dla-field) and no such file")]
+    Unknown(String),
+    /// The file is not a valid scenario.
+    #[error("scenario `{name}`: {error}")]
+    Bad {
+        /// The name given.
+        name: String,
+        /// What is wrong.
+        #[source]
+        error: ScenarioError,
+    },
+}
+
+/// A built-in scenario by name ([`builtin`]), or a TOML file ([`load`]); the
+/// error names the field or the place.
+pub fn named(name: &str) -> Result<Scenario, NamedError> {
+    if let Some(s) = builtin(name) {
+        return Ok(s);
+    }
+    let path = Path::new(name);
+    if !path.exists() && !name.ends_with(".toml") {
+        return Err(NamedError::Unknown(name.to_string()));
+    }
+    load(path).map_err(|error| NamedError::Bad { name: name.to_string(), error })
+}
+
 /// The built-in outdoor mission.
 pub fn outdoor_default() -> Scenario {
     // The embedded file is checked by this crate's tests; an error here is a bug.

@@ -9,7 +9,7 @@
 //! | LADAR | [`Ladar::observe`] | `LAOBS{distance, height}`, `LAOBN` |
 //! | Localization | [`Localization::observe`] | `LOFIX{error}`, `LOLOST` |
 //!
-//! [`Event::name`] and [`Event::fields`] give a wrapper the event's name and
+//! [`Event::name`](crate::agent::Event::name) and [`Event::fields`](crate::agent::Event::fields) give a wrapper the event's name and
 //! payload as the rules file spells them.
 //!
 //! The obstacle sensors are mounted at the front bumper, centred; their
@@ -25,25 +25,7 @@ use crate::vehicle::VehicleState;
 use crate::world::{Corridor, CorridorHit, ObstacleView, RoadAhead, RoadLookahead, World};
 use serde::Serialize;
 
-/// A payload value, as the rules file types it.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-#[serde(untagged)]
-pub enum Value {
-    /// An `f64` field.
-    F64(f64),
-    /// An `i64` field.
-    I64(i64),
-    /// A symbol field (`side: {left, right}`, `reason: {…}`).
-    Symbol(&'static str),
-}
-
-/// An event of `rules/outdoor.situ`: its name and payload.
-pub trait Event {
-    /// The event's name in the rules file (e.g. `LAOBS`).
-    fn name(&self) -> &'static str;
-    /// The payload, field by field, in the rules file's order.
-    fn fields(&self) -> Vec<(&'static str, Value)>;
-}
+use crate::agent::{Event, Value};
 
 /// RFCCD's events.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

@@ -6,7 +6,7 @@ use situ_compiler::bundle::{Content, Mode};
 use situ_compiler::loader::FsLoader;
 use situ_runtime::record::{Fate, Memory, SharedMemory};
 use situ_sim::scenario;
-use situ_sim::stack::{self, Outcome, Recording, RunReport, StackConfig, StackKind, StackRun};
+use situ_sim::stack::{self, Outcome, Recording, Registry, RunReport, StackConfig, StackRun};
 use situ_sim::ugv::Strategy;
 use std::path::Path;
 use std::sync::{Arc, OnceLock};
@@ -20,7 +20,7 @@ fn rules(name: &str) -> Arc<Content> {
 
 fn run(rules_file: &str, seed: u64, memory: Option<SharedMemory>) -> RunReport {
     let content = rules(rules_file);
-    let kind = StackKind::of(&content).expect("a reference stack");
+    let kind = Registry::sim().of(&content).expect("a reference stack");
     let world = scenario::builtin(kind.default_scenario()).expect("built in").world;
     let cfg = StackConfig { seed, until: kind.default_until(), ..StackConfig::default() };
     let recording = Recording { mcap: None, sinks: memory.into_iter().map(|m| Box::new(m) as _).collect() };
@@ -43,11 +43,12 @@ fn outdoor() -> &'static (RunReport, Memory, Arc<Content>) {
 fn every_event_the_agents_report_is_one_of_the_rules_file() {
     let c = rules("outdoor.situ");
     for e in stack::outdoor::sample_events() {
-        assert!(stack::events::payload(&c, e.as_ref()).is_some(), "{} maps onto outdoor.situ", e.name());
+        assert!(situ_sim::agent::payload(&c, e.as_ref()).is_some(), "{} maps onto outdoor.situ", e.name());
     }
-    assert_eq!(StackKind::of(&c), Ok(StackKind::Outdoor));
-    assert_eq!(StackKind::of(&rules("ugv.situ")), Ok(StackKind::Ugv));
-    assert_eq!(StackKind::of(&rules("ugv-merge.situ")), Ok(StackKind::UgvMerge));
+    let name = |c: &situ_compiler::bundle::Content| Registry::sim().of(c).map(|s| s.name());
+    assert_eq!(name(&c), Ok("outdoor"));
+    assert_eq!(name(&rules("ugv.situ")), Ok("ugv"));
+    assert_eq!(name(&rules("ugv-merge.situ")), Ok("ugv_merge"));
 }
 
 #[test]
@@ -115,11 +116,12 @@ fn ugv_programs() -> stack::UgvPrograms {
 }
 
 /// Both strategies through the stack (and the sim loop for reference), once.
-fn dafflon() -> &'static (situ_sim::ugv::Comparison, Vec<RunReport>) {
-    static RUN: OnceLock<(situ_sim::ugv::Comparison, Vec<RunReport>)> = OnceLock::new();
+fn dafflon() -> &'static (situ_sim::baseline::ugv::Comparison, Vec<RunReport>) {
+    static RUN: OnceLock<(situ_sim::baseline::ugv::Comparison, Vec<RunReport>)> = OnceLock::new();
     RUN.get_or_init(|| {
         let world = scenario::dafflon_4().world;
-        stack::compare(&ugv_programs(), &world, &[Strategy::HardSwitch, Strategy::Merge], 1).expect("compared")
+        stack::compare(&ugv_programs(), &Registry::sim(), &world, &[Strategy::HardSwitch, Strategy::Merge], 1)
+            .expect("compared")
     })
 }
 
@@ -165,7 +167,7 @@ fn dafflon_the_merge_of_the_rules_is_smoother_and_faster_than_the_hard_switch_of
     let merge = stack_row("merge");
     assert!(hard.strategy.contains("ugv.situ") && merge.strategy.contains("ugv-merge.situ"));
     let report = &reports[1];
-    assert_eq!(report.stack, StackKind::UgvMerge);
+    assert_eq!(report.stack, "ugv_merge");
     assert!(matches!(report.outcome, Outcome::GoalReached { .. }), "{:?}", report.outcome);
     // The Merger blended both limit cycles, then handed the last metres over.
     for st in ["Reaching", "AvoidCW", "AvoidCCW", "Docking", "Reached"] {
@@ -222,7 +224,7 @@ fn a_lost_position_is_an_emergency_that_ends_in_a_stop_once_the_vehicle_stands()
     let memory = SharedMemory::default();
     let cfg = StackConfig { seed: 1, until: 120.0, ..StackConfig::default() };
     let recording = Recording { mcap: None, sinks: vec![Box::new(memory.clone())] };
-    let mut run = StackRun::new(content.clone(), StackKind::Outdoor, &world, cfg, recording).unwrap();
+    let mut run = StackRun::new(content.clone(), Arc::new(stack::outdoor::Outdoor), &world, cfg, recording).unwrap();
     run.run(&mut |_| {});
     let report = run.finish().unwrap();
     assert!(matches!(&report.outcome, Outcome::Stopped { state, .. } if state == "SP"), "{:?}", report.outcome);

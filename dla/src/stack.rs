@@ -1,7 +1,7 @@
 //! The agents of `rules/dla.situ` (Pérez 2006, DLA) on the runtime: the
 //! deliberative layer of Poncela et al. (2002) and the case-based reactive
-//! layer of Urdiales et al. (2006), on the building blocks of
-//! [`crate::dla`].
+//! layer of Urdiales et al. (2006), on the building blocks of this crate;
+//! [`Dla`] is the [`Stack`] that runs them.
 //!
 //! | agent | reads (data) | does | sends |
 //! |---|---|---|---|
@@ -17,21 +17,21 @@
 //! route (a stand-in for the computing time the paper's claim is about:
 //! the robot must not stop meanwhile), so re-planning is visible in a run.
 
-use super::events::{report, Named};
-use super::ugv::{fresh, names, take};
-use super::{lock, SharedPhysics};
-use crate::dla::cases::{self, Case, CaseBase, Command as CaseCommand, DriverParams, Situation};
-use crate::dla::detour::Detour;
-use crate::dla::grid::{Beam, CellClass, GridParams, OccupancyGrid};
-use crate::dla::pyramid::{Pyramid, PyramidParams, RegionClass};
-use crate::dla::route::{plan_path, plan_route, PathParams, RouteParams};
-use crate::geom::{edges, unit, v2, wrap_angle, Pose, Vec2};
-use crate::noise::Noise;
-use crate::sensors::Value as SimValue;
-use crate::vehicle::{Command, VehicleParams};
-use crate::world::{ObstacleView, World};
+use crate::cases::{self, Case, CaseBase, Command as CaseCommand, DriverParams, Situation};
+use crate::detour::Detour;
+use crate::grid::{Beam, CellClass, GridParams, OccupancyGrid};
+use crate::pyramid::{Pyramid, PyramidParams, RegionClass};
+use crate::route::{plan_path, plan_route, PathParams, RouteParams};
 use situ_compiler::bundle::{Content, Mode};
 use situ_runtime::agent::{Agent, Body, Context};
+use situ_sim::agent::{fresh, names, report, take, Named, Value as SimValue};
+use situ_sim::geom::{edges, unit, v2, wrap_angle, Pose, Vec2};
+use situ_sim::noise::Noise;
+use situ_sim::scenario::Scenario;
+use situ_sim::stack::{lock, RunReport, SharedPhysics, Stack};
+use situ_sim::vehicle::{Command, VehicleParams};
+use situ_sim::world::{ObstacleView, World};
+use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
 mod reflexes;
@@ -239,9 +239,9 @@ pub fn train(seed: u64, seconds: f64, novelty: f64) -> Cases {
         views.push(ObstacleView { index, polygon, height: 1.0, center, radius });
     }
     let free = |p: Vec2, views: &[ObstacleView]| {
-        views
-            .iter()
-            .all(|v| !crate::geom::contains(&v.polygon, p) && crate::geom::dist_point_polygon(&v.polygon, p) > 0.4)
+        views.iter().all(|v| {
+            !situ_sim::geom::contains(&v.polygon, p) && situ_sim::geom::dist_point_polygon(&v.polygon, p) > 0.4
+        })
     };
     let pick = |noise: &mut Noise| loop {
         let p = v2(1.0 + 18.0 * noise.uniform(), 1.0 + 18.0 * noise.uniform());
@@ -393,7 +393,8 @@ impl Agent for Mapper {
     }
 }
 
-fn lock_plans(p: &SharedPlans) -> std::sync::MutexGuard<'_, Plans> {
+/// Locks the plans (a poisoned lock is still the truth).
+pub fn lock_plans(p: &SharedPlans) -> std::sync::MutexGuard<'_, Plans> {
     p.lock().unwrap_or_else(|e| e.into_inner())
 }
 
@@ -738,19 +739,117 @@ pub fn region_counts(p: &Pyramid) -> (usize, usize, usize) {
     (count(RegionClass::Free), count(RegionClass::Occupied), count(RegionClass::Unexplored))
 }
 
-/// The case base handed to a run, compared by identity (a [`StackConfig`](super::StackConfig) is).
-#[derive(Clone)]
-pub struct CasesHandle(pub SharedCases);
+/// Pérez's DLA (`rules/dla.situ`): deliberative and case-based reactive
+/// layers. It holds what a run of it shares beyond the physics: the case
+/// base (`None`: one trained before each run by the scripted driver,
+/// [`train`]), whether the reactive layer learns on line, and the plans
+/// the run leaves ([`Dla::plans`], drawn by [`Stack::pictures`]).
+pub struct Dla {
+    cases: Option<SharedCases>,
+    learn: bool,
+    plans: SharedPlans,
+}
 
-impl PartialEq for CasesHandle {
-    fn eq(&self, other: &Self) -> bool {
-        Arc::ptr_eq(&self.0, &other.0)
+impl Default for Dla {
+    fn default() -> Self {
+        Dla::new(None, true)
     }
 }
 
-impl std::fmt::Debug for CasesHandle {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let n = self.0.lock().map_or(0, |c| c.len());
-        write!(f, "CasesHandle({n} cases)")
+impl Dla {
+    /// The stack with the case base `cases` (`None`: trained at the start
+    /// of each run), learning into it when `learn`.
+    pub fn new(cases: Option<SharedCases>, learn: bool) -> Dla {
+        Dla { cases, learn, plans: SharedPlans::default() }
     }
+
+    /// The map, route and path of the last run, and its counts.
+    pub fn plans(&self) -> &SharedPlans {
+        &self.plans
+    }
+}
+
+/// The name of DLA's stack ([`Stack::name`]).
+pub const NAME: &str = "dla";
+
+impl Stack for Dla {
+    fn name(&self) -> &'static str {
+        NAME
+    }
+    fn title(&self) -> &'static str {
+        "Dla"
+    }
+    fn agents(&self) -> &'static [&'static str] {
+        AGENTS
+    }
+    fn known_as(&self) -> String {
+        format!("of rules/dla.situ ({})", AGENTS.join(", "))
+    }
+    fn default_scenario(&self) -> &'static str {
+        "dla-offices"
+    }
+    fn goal_state(&self) -> &'static str {
+        "Arrived"
+    }
+    fn rates(&self) -> BTreeMap<String, f64> {
+        BTreeMap::new()
+    }
+    /// The reactive layer's 10 Hz.
+    fn sample_every(&self) -> u64 {
+        10
+    }
+    fn default_until(&self) -> f64 {
+        300.0
+    }
+    /// A run starts with no plans.
+    fn agents_for(
+        &self,
+        content: &Arc<Content>,
+        physics: &SharedPhysics,
+        world: &World,
+        seed: u64,
+    ) -> Vec<Box<dyn Agent>> {
+        let cases = match &self.cases {
+            Some(c) => c.clone(),
+            None => Arc::new(Mutex::new(train(seed, TRAINING_SECONDS, NOVELTY))),
+        };
+        *lock_plans(&self.plans) = Plans::default();
+        agents(content, physics, world, seed, cases, self.learn, self.plans.clone())
+    }
+    fn pictures(&self, scenario: &Scenario, report: &RunReport) -> Vec<(&'static str, String)> {
+        pictures(&self.plans, scenario, report)
+    }
+}
+
+/// DLA's pictures: `dla.svg`, the last occupancy grid and the regions of
+/// its pyramid, with the last path and the trajectory; `dla-route.svg`, the
+/// map the last route was planned on, its regions numbered along the route.
+pub fn pictures(plans: &SharedPlans, scenario: &Scenario, report: &RunReport) -> Vec<(&'static str, String)> {
+    let p = lock_plans(plans);
+    let world = &scenario.world;
+    let trajectory: Vec<(f64, f64)> = report.metrics.samples.iter().map(|s| (s.x, s.y)).collect();
+    let start = (world.start.x, world.start.y);
+    let goal = (world.goal.position.x, world.goal.position.y);
+    let mut out = Vec::new();
+    if let Some(map) = &p.map {
+        let title = format!("{} — {}: the last map, its regions, the last path", scenario.name, report.rules);
+        let svg = crate::draw::draw(&map.grid, Some(map.pyramid()), &[], &p.path, &trajectory, start, goal, &title);
+        out.push(("dla.svg", svg));
+    }
+    if let Some(route) = &p.route {
+        let title =
+            format!("{} — {}: route {} on the map it was planned on", scenario.name, report.rules, route.number);
+        let svg = crate::draw::draw(
+            &route.map.grid,
+            Some(route.map.pyramid()),
+            &route.regions,
+            &p.path,
+            &trajectory,
+            start,
+            goal,
+            &title,
+        );
+        out.push(("dla-route.svg", svg));
+    }
+    out
 }

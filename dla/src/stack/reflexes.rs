@@ -16,10 +16,10 @@
 //!   cannot; otherwise the command becomes a turn on the spot, or a stop.
 
 use super::driver;
-use crate::dla::cases::Command as CaseCommand;
-use crate::dla::grid::Beam;
-use crate::geom::{v2, Pose, Vec2};
-use crate::vehicle::{integrate, VehicleParams};
+use crate::cases::Command as CaseCommand;
+use crate::grid::Beam;
+use situ_sim::geom::{v2, Pose, Vec2};
+use situ_sim::vehicle::{integrate, VehicleParams};
 
 /// How far to the side of the laser (the robot's centre) a turn on the
 /// spot turns about (m): the indoor robot on full lock, 0.2 m / tan 1.2.
@@ -167,7 +167,7 @@ fn ahead_clear(points: &[Vec2], reach: f64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::vehicle::VehicleParams;
+    use situ_sim::vehicle::VehicleParams;
 
     /// A flat wall `x` metres ahead, readings every 2 cm across 1.2 m.
     fn wall(x: f64) -> Vec<Vec2> {
