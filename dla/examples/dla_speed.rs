@@ -20,8 +20,8 @@
 //! [`CaseBase::learn`] over obstacle-field situations, one learn and one
 //! retrieval per step, as the running stack does.
 //!
-//! `cargo run --release -p situ-sim --example dla_speed`
-//! `cargo run --release -p situ-sim --example dla_speed -- --retrieval`
+//! `cargo run --release -p situ-dla --example dla_speed`
+//! `cargo run --release -p situ-dla --example dla_speed -- --retrieval`
 //! (only the 8-sector retrieval and the on-line learning: no pyramid, no
 //! 4- and 6-sector runs; ~1/3 of the time); `--kiddo` also measures
 //! kiddo 5's incremental and immutable k-d trees on the same cases.

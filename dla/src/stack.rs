@@ -27,14 +27,15 @@ use situ_runtime::agent::{Agent, Body, Context};
 use situ_sim::agent::{fresh, names, report, take, Named, Value as SimValue};
 use situ_sim::geom::{edges, unit, v2, wrap_angle, Pose, Vec2};
 use situ_sim::noise::Noise;
-use situ_sim::scenario::Scenario;
-use situ_sim::stack::{lock, RunReport, SharedPhysics, Stack};
+use situ_sim::stack::{lock, SharedPhysics};
 use situ_sim::vehicle::{Command, VehicleParams};
 use situ_sim::world::{ObstacleView, World};
-use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
+mod dla;
 mod reflexes;
+
+pub use dla::{pictures, Dla, NAME};
 
 use reflexes::{reflexes, scan_points, standstill};
 pub use reflexes::{CRAWL, CREEP, STILL_TURN, SWEEP_MARGIN, SWEEP_TIME, TURN_RADIUS, TURN_SWEEP, TURN_TIGHT};
@@ -737,119 +738,4 @@ pub fn agents(
 pub fn region_counts(p: &Pyramid) -> (usize, usize, usize) {
     let count = |c: RegionClass| p.regions().iter().filter(|r| r.class == c).count();
     (count(RegionClass::Free), count(RegionClass::Occupied), count(RegionClass::Unexplored))
-}
-
-/// Pérez's DLA (`rules/dla.situ`): deliberative and case-based reactive
-/// layers. It holds what a run of it shares beyond the physics: the case
-/// base (`None`: one trained before each run by the scripted driver,
-/// [`train`]), whether the reactive layer learns on line, and the plans
-/// the run leaves ([`Dla::plans`], drawn by [`Stack::pictures`]).
-pub struct Dla {
-    cases: Option<SharedCases>,
-    learn: bool,
-    plans: SharedPlans,
-}
-
-impl Default for Dla {
-    fn default() -> Self {
-        Dla::new(None, true)
-    }
-}
-
-impl Dla {
-    /// The stack with the case base `cases` (`None`: trained at the start
-    /// of each run), learning into it when `learn`.
-    pub fn new(cases: Option<SharedCases>, learn: bool) -> Dla {
-        Dla { cases, learn, plans: SharedPlans::default() }
-    }
-
-    /// The map, route and path of the last run, and its counts.
-    pub fn plans(&self) -> &SharedPlans {
-        &self.plans
-    }
-}
-
-/// The name of DLA's stack ([`Stack::name`]).
-pub const NAME: &str = "dla";
-
-impl Stack for Dla {
-    fn name(&self) -> &'static str {
-        NAME
-    }
-    fn title(&self) -> &'static str {
-        "Dla"
-    }
-    fn agents(&self) -> &'static [&'static str] {
-        AGENTS
-    }
-    fn known_as(&self) -> String {
-        format!("of rules/dla.situ ({})", AGENTS.join(", "))
-    }
-    fn default_scenario(&self) -> &'static str {
-        "dla-offices"
-    }
-    fn goal_state(&self) -> &'static str {
-        "Arrived"
-    }
-    fn rates(&self) -> BTreeMap<String, f64> {
-        BTreeMap::new()
-    }
-    /// The reactive layer's 10 Hz.
-    fn sample_every(&self) -> u64 {
-        10
-    }
-    fn default_until(&self) -> f64 {
-        300.0
-    }
-    /// A run starts with no plans.
-    fn agents_for(
-        &self,
-        content: &Arc<Content>,
-        physics: &SharedPhysics,
-        world: &World,
-        seed: u64,
-    ) -> Vec<Box<dyn Agent>> {
-        let cases = match &self.cases {
-            Some(c) => c.clone(),
-            None => Arc::new(Mutex::new(train(seed, TRAINING_SECONDS, NOVELTY))),
-        };
-        *lock_plans(&self.plans) = Plans::default();
-        agents(content, physics, world, seed, cases, self.learn, self.plans.clone())
-    }
-    fn pictures(&self, scenario: &Scenario, report: &RunReport) -> Vec<(&'static str, String)> {
-        pictures(&self.plans, scenario, report)
-    }
-}
-
-/// DLA's pictures: `dla.svg`, the last occupancy grid and the regions of
-/// its pyramid, with the last path and the trajectory; `dla-route.svg`, the
-/// map the last route was planned on, its regions numbered along the route.
-pub fn pictures(plans: &SharedPlans, scenario: &Scenario, report: &RunReport) -> Vec<(&'static str, String)> {
-    let p = lock_plans(plans);
-    let world = &scenario.world;
-    let trajectory: Vec<(f64, f64)> = report.metrics.samples.iter().map(|s| (s.x, s.y)).collect();
-    let start = (world.start.x, world.start.y);
-    let goal = (world.goal.position.x, world.goal.position.y);
-    let mut out = Vec::new();
-    if let Some(map) = &p.map {
-        let title = format!("{} — {}: the last map, its regions, the last path", scenario.name, report.rules);
-        let svg = crate::draw::draw(&map.grid, Some(map.pyramid()), &[], &p.path, &trajectory, start, goal, &title);
-        out.push(("dla.svg", svg));
-    }
-    if let Some(route) = &p.route {
-        let title =
-            format!("{} — {}: route {} on the map it was planned on", scenario.name, report.rules, route.number);
-        let svg = crate::draw::draw(
-            &route.map.grid,
-            Some(route.map.pyramid()),
-            &route.regions,
-            &p.path,
-            &trajectory,
-            start,
-            goal,
-            &title,
-        );
-        out.push(("dla-route.svg", svg));
-    }
-    out
 }

@@ -237,3 +237,81 @@ fn a_lost_position_is_an_emergency_that_ends_in_a_stop_once_the_vehicle_stands()
     assert!((2.3..3.0).contains(&braking), "EM for {braking:.2} s");
     assert!(report.metrics.summary.collisions.is_empty());
 }
+
+fn source(name: &str, text: &str) -> Arc<Content> {
+    let checked = situ_compiler::check_source(name, text);
+    assert_eq!(checked.errors(), 0, "{name}: {:?}", checked.diagnostics);
+    Arc::new(situ_compiler::bundle::build(&checked))
+}
+
+#[test]
+fn a_program_of_no_stack_is_told_which_agents_each_stack_has() {
+    let minimal = source(
+        "minimal.situ",
+        "states { IT initial RD final }\nagent Supervisor interface { event SVRDY }\nrule ready { when state == IT and SVRDY then RD }\n",
+    );
+    let e = Registry::sim().of(&minimal).err().expect("no stack");
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "no simulated stack for these agents (Supervisor): `situ run` knows the agents of rules/outdoor.situ ({}), \
+             of rules/ugv.situ ({}) and of rules/ugv-merge.situ (those and Merger)",
+            stack::outdoor::AGENTS.join(", "),
+            stack::ugv::AGENTS.join(", ")
+        )
+    );
+}
+
+#[test]
+fn the_merge_is_told_from_the_hard_switch_in_any_order_of_the_registry() {
+    use stack::{merge::UgvMerge, ugv::Ugv};
+    let (hard, merge) = (rules("ugv.situ"), rules("ugv-merge.situ"));
+    for registry in
+        [Registry::new(vec![Arc::new(Ugv), Arc::new(UgvMerge)]), Registry::new(vec![Arc::new(UgvMerge), Arc::new(Ugv)])]
+    {
+        assert_eq!(registry.of(&merge).map(|s| s.name()), Ok("ugv_merge"));
+        assert_eq!(registry.of(&hard).map(|s| s.name()), Ok("ugv"));
+    }
+}
+
+#[test]
+fn the_comparison_reads_its_other_program_beside_the_rules_or_says_where_it_looked() {
+    use stack::merge::{strategies, CompareError};
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../rules");
+    let all = strategies(&["hard-switch".into(), " merge".into()]).expect("both strategies");
+    let registry = Registry::sim();
+    let hard = rules("ugv.situ");
+    let stack = registry.of(&hard).unwrap();
+    let (programs, sibling) =
+        stack::UgvPrograms::plan(&dir.join("ugv.situ"), hard.clone(), stack.as_ref(), &all).unwrap();
+    assert!(programs.hard_switch.is_some() && programs.merge.is_none());
+    let sibling = sibling.expect("the merge is wanted");
+    assert_eq!((sibling.strategy, sibling.path), (Strategy::Merge, dir.join("ugv-merge.situ")));
+    // Only the hard switch: no other program.
+    let (_, none) =
+        stack::UgvPrograms::plan(&dir.join("ugv.situ"), hard.clone(), stack.as_ref(), &[Strategy::HardSwitch]).unwrap();
+    assert_eq!(none, None);
+    // Alone in its directory.
+    let lonely = tempfile::tempdir().unwrap();
+    let file = lonely.path().join("ugv.situ");
+    std::fs::write(&file, "").unwrap();
+    let e = stack::UgvPrograms::plan(&file, hard, stack.as_ref(), &all).err().expect("no sibling");
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "--compare: the merge strategy runs `ugv-merge.situ` through the stack, and there is no `{}` beside `{}`",
+            lonely.path().join("ugv-merge.situ").display(),
+            file.display()
+        )
+    );
+    let outdoor = rules("outdoor.situ");
+    let not = stack::UgvPrograms::plan(
+        &dir.join("outdoor.situ"),
+        outdoor.clone(),
+        registry.of(&outdoor).unwrap().as_ref(),
+        &all,
+    );
+    assert!(matches!(not, Err(CompareError::NotUgv)));
+    let bad = strategies(&["merge".into(), "blend".into()]).expect_err("unknown");
+    assert_eq!(bad.to_string(), "--compare: unknown strategy `blend` (hard-switch, merge)");
+}

@@ -5,6 +5,10 @@
 //! the runtime's simulated-time scheduler with the compiled rules deciding
 //! the state. This is what `situ run` drives.
 //!
+//! - [`Stack`]: what a reference stack is to the loop (its agents, rates,
+//!   goal state, defaults, pictures); [`outdoor::Outdoor`], [`ugv::Ugv`]
+//!   and [`merge::UgvMerge`] here, DLA's in `situ-dla`. A [`Registry`]
+//!   tells a program's stack by its agents.
 //! - [`Physics`]: the ground truth the agents share (world, vehicle, time,
 //!   the last command). Sensors read it; the actuator (Drive, Vehicle)
 //!   writes its command into it; nothing else touches it. Every other input

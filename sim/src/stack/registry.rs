@@ -36,6 +36,11 @@ fn list(items: &[String]) -> String {
 }
 
 impl Registry {
+    /// A registry of `stacks`, in the order an error lists them.
+    pub fn new(stacks: Vec<Arc<dyn Stack>>) -> Registry {
+        Registry { stacks }
+    }
+
     /// The sim's stacks: outdoor, the UGV's hard switch and its merge.
     pub fn sim() -> Registry {
         Registry { stacks: vec![Arc::new(Outdoor), Arc::new(Ugv), Arc::new(UgvMerge)] }
