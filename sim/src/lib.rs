@@ -5,7 +5,7 @@
 //! - [`world`]: roads (a petgraph graph with geometry), cross-country areas,
 //!   static and moving obstacles, and the queries sensors need;
 //! - [`scenario`]: TOML scenarios, validated into a [`world::World`]
-//!   (built in: `outdoor-default`, `dafflon-4`);
+//!   (built in: `outdoor-default`, `dafflon-4`, `dla-offices`, `dla-field`);
 //! - [`geom`]: points, poses, polygons, road pieces; [`noise`]: seeded noise;
 //! - [`vehicle`]: the tricycle model of eq. (1) of Dafflon et al.;
 //! - [`sensors`]: RFCCD, STCCD, LADAR and Localization of Zhang & Zhu, each

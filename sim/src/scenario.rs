@@ -329,7 +329,7 @@ pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
     parse(&text)
 }
 
-/// A built-in scenario by name: `outdoor-default` or `dafflon-4`.
+/// A built-in scenario by name: `outdoor-default`, `dafflon-4`, `dla-offices` or `dla-field`.
 pub fn builtin(name: &str) -> Option<Scenario> {
     let text = match name {
         "outdoor-default" => OUTDOOR_DEFAULT,
