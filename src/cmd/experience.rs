@@ -13,20 +13,43 @@
 //! held-out mission of the last evaluation are done, 1 otherwise, 2 on
 //! usage or I/O.
 
-use super::run::Args;
 use super::{FAILED, OK, USAGE};
 use situ_compiler::bundle::Content;
 use situ_dla::missions::{self, load_or_train, Series, Step, HELD_OUT};
 use situ_dla::stack::SharedCases;
 use situ_sim::scenario::Scenario;
 use situ_sim::stack::{Stack, StackRun};
+use std::path::Path;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
+/// What `situ run --missions` was given besides the rules and the scenario.
+pub struct Args<'a> {
+    /// The rules file, for messages.
+    pub file: &'a Path,
+    /// The first learning mission's seed.
+    pub seed: u64,
+    /// `--cases`: the case base read before and written after.
+    pub cases: Option<&'a Path>,
+    /// Whether the missions learn on line.
+    pub learn: bool,
+    /// `--evaluate`: held-out missions per evaluation.
+    pub evaluate: u64,
+    /// `--out`: where the curve and its data go.
+    pub out: Option<&'a Path>,
+}
+
 /// `missions` learning missions (`--missions`), the evaluations of
-/// `args.dla.evaluate` held-out missions each ([`missions::experience`]).
-pub fn run(args: &Args, content: Arc<Content>, kind: &dyn Stack, scenario: &Scenario, missions: u64, until: f64) -> u8 {
-    let held_out = args.dla.evaluate;
+/// `args.evaluate` held-out missions each ([`missions::experience`]).
+pub fn run(
+    args: &Args<'_>,
+    content: Arc<Content>,
+    kind: &dyn Stack,
+    scenario: &Scenario,
+    missions: u64,
+    until: f64,
+) -> u8 {
+    let held_out = args.evaluate;
     if kind.name() != situ_dla::stack::NAME {
         eprintln!(
             "error: --missions runs successive missions of a DLA stack (agents of rules/dla.situ, whose reactive \
@@ -36,12 +59,12 @@ pub fn run(args: &Args, content: Arc<Content>, kind: &dyn Stack, scenario: &Scen
         );
         return USAGE;
     }
-    let series = Series { missions, held_out, seed: args.seed, until, learn: args.dla.learn };
+    let series = Series { missions, held_out, seed: args.seed, until, learn: args.learn };
     if let Err(e) = missions::check(&series) {
         eprintln!("error: {e}");
         return USAGE;
     }
-    let (cases, read) = match load_or_train(args.dla.cases.as_deref(), args.seed) {
+    let (cases, read) = match load_or_train(args.cases, args.seed) {
         Ok(c) => c,
         Err(e) => {
             eprintln!("error: --cases {e}");
@@ -75,7 +98,7 @@ pub fn run(args: &Args, content: Arc<Content>, kind: &dyn Stack, scenario: &Scen
         args.seed,
         args.seed.wrapping_add(missions - 1),
         if read { "read" } else { "trained" },
-        if args.dla.learn { "learning on line" } else { "no learning" }
+        if args.learn { "learning on line" } else { "no learning" }
     );
     print!("{}", experience.table());
     if held_out > 0 {
@@ -91,7 +114,7 @@ pub fn run(args: &Args, content: Arc<Content>, kind: &dyn Stack, scenario: &Scen
         simulated / 3600.0,
         simulated / wall.max(1e-9)
     );
-    if let Some(path) = &args.dla.cases {
+    if let Some(path) = args.cases {
         let cases = handle.lock().unwrap_or_else(|e| e.into_inner());
         if let Err(e) = cases.write(path) {
             eprintln!("error: cannot write the case base `{}`: {e}", path.display());
@@ -99,7 +122,7 @@ pub fn run(args: &Args, content: Arc<Content>, kind: &dyn Stack, scenario: &Scen
         }
         println!("  case base         {} cases written to {}", cases.len(), path.display());
     }
-    if let Some(out) = &args.out {
+    if let Some(out) = args.out {
         let title = format!("{} on {}: experience over {missions} missions", content.source, scenario.name);
         let svg = match experience.svg(&title) {
             Ok(s) => s,

@@ -129,7 +129,15 @@ pub fn run(args: Args) -> u8 {
         return compare(&args, content, kind.as_ref(), &scenario, list);
     }
     if let Some(n) = args.dla.missions {
-        return super::experience::run(&args, content, kind.as_ref(), &scenario, n, until);
+        let experience = super::experience::Args {
+            file: &args.file,
+            seed: args.seed,
+            cases: args.dla.cases.as_deref(),
+            learn: args.dla.learn,
+            evaluate: args.dla.evaluate,
+            out: args.out.as_deref(),
+        };
+        return super::experience::run(&experience, content, kind.as_ref(), &scenario, n, until);
     }
 
     // The recording: at --record, else in --out.
