@@ -315,3 +315,28 @@ fn the_comparison_reads_its_other_program_beside_the_rules_or_says_where_it_look
     let bad = strategies(&["merge".into(), "blend".into()]).expect_err("unknown");
     assert_eq!(bad.to_string(), "--compare: unknown strategy `blend` (hard-switch, merge)");
 }
+
+#[test]
+fn a_run_in_real_time_is_the_same_run_and_reports_each_simulated_second() {
+    let content = rules("outdoor.situ");
+    let world = scenario::outdoor_default().world;
+    let report = |paced: bool| {
+        let cfg = StackConfig { seed: 1, until: 2.0, ..StackConfig::default() };
+        let mut run =
+            StackRun::new(content.clone(), Arc::new(stack::outdoor::Outdoor), &world, cfg, Recording::default())
+                .unwrap();
+        let mut seconds = Vec::new();
+        let mut each = |r: &StackRun| seconds.push(r.t());
+        if paced {
+            run.run_in_real_time(&mut each);
+        } else {
+            run.run(&mut each);
+        }
+        (run.finish().unwrap().to_json(), seconds)
+    };
+    let (paced, at) = report(true);
+    let (free, free_at) = report(false);
+    assert!(paced.as_bytes() == free.as_bytes(), "metrics.json differs when paced");
+    assert_eq!(at, [1.0, 2.0]);
+    assert_eq!(at, free_at);
+}

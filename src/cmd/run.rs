@@ -181,7 +181,6 @@ pub fn run(args: Args) -> u8 {
     } else {
         kind.clone()
     };
-    let physics_step = cfg.physics_step;
     let mut run = match StackRun::new(
         content.clone(),
         stack.clone(),
@@ -196,26 +195,11 @@ pub fn run(args: Args) -> u8 {
         }
     };
     let mut line = super::LiveLine::new();
-    match watchers.any() {
-        true => {
-            watchers.wait();
-            // Real time: a simulated second a wall second.
-            let start = std::time::Instant::now();
-            let per_second = (1_000_000_000 / physics_step).max(1);
-            let mut k = 0u64;
-            while run.step() {
-                k += 1;
-                let t = run.physics.lock().unwrap_or_else(|e| e.into_inner()).t;
-                let ahead = std::time::Duration::from_secs_f64(t.max(0.0)).saturating_sub(start.elapsed());
-                if !ahead.is_zero() {
-                    std::thread::sleep(ahead);
-                }
-                if k.is_multiple_of(per_second) {
-                    line.draw(|| run.progress().line());
-                }
-            }
-        }
-        false => run.run(&mut |r| line.draw(|| r.progress().line())),
+    if watchers.any() {
+        watchers.wait();
+        run.run_in_real_time(&mut |r| line.draw(|| r.progress().line()));
+    } else {
+        run.run(&mut |r| line.draw(|| r.progress().line()));
     }
     line.clear();
     let finished = run.finish();

@@ -647,6 +647,24 @@ impl StackRun {
         }
     }
 
+    /// Runs to the end in real time, a simulated second a wall second (for
+    /// people watching it live); `progress` is called every simulated
+    /// second. The run itself is the same as [`StackRun::run`]'s.
+    pub fn run_in_real_time(&mut self, progress: &mut dyn FnMut(&StackRun)) {
+        let start = std::time::Instant::now();
+        let per_second = (NS / self.cfg.physics_step).max(1);
+        while self.step() {
+            let t = lock(&self.physics).t;
+            let ahead = std::time::Duration::from_secs_f64(t.max(0.0)).saturating_sub(start.elapsed());
+            if !ahead.is_zero() {
+                std::thread::sleep(ahead);
+            }
+            if self.k.is_multiple_of(per_second) {
+                progress(self);
+            }
+        }
+    }
+
     /// Ends the run (and the recording) and gathers the report.
     pub fn finish(mut self) -> Result<RunReport, StackError> {
         while self.outcome.is_none() {
