@@ -22,7 +22,7 @@
 //!   stacks and this one, which `situ run` chooses among;
 //! - [`missions`]: DLA's experience (`situ run --missions`): missions with
 //!   one case base, evaluations on held-out missions, the whole series;
-//! - [`cases::load_or_train`]: the case base a run starts from.
+//! - [`missions::load_or_train`]: the case base a run starts from.
 #![deny(missing_docs)]
 
 pub mod cases;

@@ -1,7 +1,7 @@
 //! The agents of `rules/dla.situ` (Pérez 2006, DLA) on the runtime: the
 //! deliberative layer of Poncela et al. (2002) and the case-based reactive
 //! layer of Urdiales et al. (2006), on the building blocks of this crate;
-//! [`Dla`] is the [`Stack`] that runs them.
+//! [`Dla`] is the [`Stack`](situ_sim::stack::Stack) that runs them.
 //!
 //! | agent | reads (data) | does | sends |
 //! |---|---|---|---|

@@ -9,7 +9,7 @@
 //! | LADAR | [`Ladar::observe`] | `LAOBS{distance, height}`, `LAOBN` |
 //! | Localization | [`Localization::observe`] | `LOFIX{error}`, `LOLOST` |
 //!
-//! [`Event::name`](crate::agent::Event::name) and [`Event::fields`](crate::agent::Event::fields) give a wrapper the event's name and
+//! [`Event::name`] and [`Event::fields`] give a wrapper the event's name and
 //! payload as the rules file spells them.
 //!
 //! The obstacle sensors are mounted at the front bumper, centred; their

@@ -122,9 +122,9 @@ fn turn_side(points: &[Vec2], side: f64, sweep: f64) -> Option<f64> {
     [side, -side].into_iter().find(|&s| turn_clear_within(points, &here, s, sweep))
 }
 
-/// How far ahead (s) [`sweep_clear`] follows a command.
+/// How far ahead (s) `sweep_clear` follows a command.
 pub const SWEEP_TIME: f64 = 0.5;
-/// What the body keeps from every reading in [`sweep_clear`] (m).
+/// What the body keeps from every reading in `sweep_clear` (m).
 pub const SWEEP_MARGIN: f64 = 0.04;
 
 /// Whether the Base driving `c` (as [`Base`] turns it into a speed and a

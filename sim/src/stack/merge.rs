@@ -9,7 +9,7 @@
 //! | Merger | Reacher, Avoider, Lidar, Gps | `blend()`: [`Merge::command`]; BLEND{steer, speed}; `follow()` (Docking): target reaching alone | the vehicle's [`Command`] |
 //! | Vehicle | Merger | `apply()` the Merger's command, or `brake()` | the command (to the vehicle) |
 //!
-//! The Merger computes what the sim's closed loop ([`crate::ugv::run`])
+//! The Merger computes what the sim's closed loop ([`crate::baseline::ugv::run`])
 //! computes in its merge branch, from the latest inputs it holds: follow =
 //! the control law on target reaching; avoid = the control law on the limit
 //! cycle, or follow when nothing hinders; d = the distance to the nearest
@@ -327,7 +327,7 @@ impl UgvPrograms {
 /// Dafflon et al.'s comparison of two situ programs: for each strategy, the
 /// run of its program through the stack (`hard-switch`: `rules/ugv.situ`,
 /// `merge`: `rules/ugv-merge.situ`) and, for reference, the sim's own closed
-/// loop ([`crate::ugv::run`]). A strategy whose program is not given runs in
+/// loop ([`crate::baseline::ugv::run`]). A strategy whose program is not given runs in
 /// the sim loop only. `stacks` tells each program's stack. Returns the
 /// table and the stack runs' reports, in the order of the strategies.
 pub fn compare(

@@ -1,7 +1,7 @@
 //! The reference stacks on the **real** rules: every agent of
 //! `rules/outdoor.situ` (Zhang & Zhu) and of `rules/ugv.situ` and
 //! `rules/ugv-merge.situ` (Dafflon et al.: hard switch, merge) as a runtime
-//! [`Agent`](situ_runtime::agent::Agent) wrapping the sim's parts, run by
+//! [`Agent`] wrapping the sim's parts, run by
 //! the runtime's simulated-time scheduler with the compiled rules deciding
 //! the state. This is what `situ run` drives.
 //!

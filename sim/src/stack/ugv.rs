@@ -310,7 +310,7 @@ pub(super) mod common {
     /// The state that means "mission done".
     pub const GOAL: &str = "Reached";
     /// 20 Hz, the control period of Dafflon et al.'s closed loop
-    /// ([`crate::ugv::run`]), so that the stacks' figures compare with it.
+    /// ([`crate::baseline::ugv::run`]), so that the stacks' figures compare with it.
     pub const SAMPLE_EVERY: u64 = 5;
     /// The longest run by default (s).
     pub const UNTIL: f64 = 120.0;
