@@ -4,7 +4,8 @@
 //! cargo run -p situ-sim --example mission -- outdoor-default out/outdoor
 //! cargo run -p situ-sim --example mission -- dafflon-4 out/dafflon   # both strategies
 //! ```
-use situ_sim::{outdoor, plot, scenario, ugv};
+use situ_sim::baseline::{outdoor, ugv as sim_loop};
+use situ_sim::{plot, scenario, ugv};
 use std::path::PathBuf;
 
 fn main() {
@@ -22,8 +23,12 @@ fn main() {
         },
     };
     if sc.world.vehicle == situ_sim::vehicle::VehicleParams::urban() {
-        let table =
-            ugv::compare(&sc.world, &[ugv::Strategy::HardSwitch, ugv::Strategy::Merge], 1, &ugv::UgvConfig::default());
+        let table = sim_loop::compare(
+            &sc.world,
+            &[ugv::Strategy::HardSwitch, ugv::Strategy::Merge],
+            1,
+            &ugv::UgvConfig::default(),
+        );
         println!("{table}");
         for m in &table.runs {
             if let Err(e) = plot::write_run(&out.join(&m.controller), &sc.world, m) {

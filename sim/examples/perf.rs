@@ -7,7 +7,7 @@
 //! ```sh
 //! cargo run --release -p situ-sim --example perf [-- --samples]
 //! ```
-use situ_sim::outdoor::OutdoorSim;
+use situ_sim::baseline::outdoor::OutdoorSim;
 use situ_sim::scenario;
 use std::time::Instant;
 

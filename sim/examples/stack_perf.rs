@@ -10,7 +10,7 @@
 //! ```
 use situ_compiler::loader::FsLoader;
 use situ_sim::scenario;
-use situ_sim::stack::{Recording, StackConfig, StackKind, StackRun};
+use situ_sim::stack::{outdoor::Outdoor, Recording, StackConfig, StackRun};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -25,7 +25,7 @@ fn main() {
     let (mut simulated, mut missions, mut steps, mut events) = (0.0, 0u64, 0u64, 0u64);
     while simulated < hour {
         let cfg = StackConfig { seed: missions + 1, until: hour - simulated, samples, ..StackConfig::default() };
-        let mut run = StackRun::new(content.clone(), StackKind::Outdoor, &world, cfg, Recording::default())
+        let mut run = StackRun::new(content.clone(), std::sync::Arc::new(Outdoor), &world, cfg, Recording::default())
             .expect("every agent bound");
         run.run(&mut |_| {});
         let report = run.finish().expect("finished");

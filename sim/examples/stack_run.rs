@@ -10,7 +10,7 @@
 //! largest steering-rate steps, and `WINDOW=T` the samples around T seconds.
 use situ_compiler::loader::FsLoader;
 use situ_sim::scenario;
-use situ_sim::stack::{Recording, StackConfig, StackKind, StackRun};
+use situ_sim::stack::{Recording, Registry, StackConfig, StackRun};
 use std::sync::Arc;
 
 fn main() {
@@ -18,7 +18,7 @@ fn main() {
     let rules = args.get(1).map_or("rules/outdoor.situ", String::as_str);
     let checked = situ_compiler::check(std::path::Path::new(rules), &FsLoader).expect("rules read");
     let content = Arc::new(situ_compiler::bundle::build(&checked));
-    let kind = StackKind::of(&content).expect("a known stack");
+    let kind = Registry::sim().of(&content).expect("a known stack");
     let name = args.get(2).map_or(kind.default_scenario(), String::as_str);
     let sc = scenario::builtin(name).expect("a built-in scenario");
     let seed = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(1);

@@ -7,8 +7,9 @@
 //! perfect); the fused polygon is the convex hull of theirs, the height the
 //! LADAR's (else the stereo estimate), the corridor distance the smaller.
 
+use crate::agent::{Event, Value};
 use crate::geom::{convex_hull, Vec2};
-use crate::sensors::{Detection, Event, RfccdEvent, Value};
+use crate::sensors::{Detection, RfccdEvent};
 use serde::Serialize;
 use std::collections::BTreeMap;
 

@@ -8,8 +8,8 @@
 //! the goal edge's end node at 10 m/s (admissible). The start leaves its edge in the direction of the
 //! vehicle's heading (no U-turn), unless that way is blocked.
 
+use crate::agent::{Event, Value};
 use crate::geom::{wrap_angle, Piece, Pose, Vec2};
-use crate::sensors::{Event, Value};
 use crate::world::{EdgeKind, World};
 use petgraph::algo::astar;
 use petgraph::graph::{EdgeIndex, NodeIndex};

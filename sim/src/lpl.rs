@@ -21,11 +21,11 @@
 //! plain plan of the road ahead (PLRS, PLRT, PLRB, PLCN): the "avoidance
 //! manoeuvre is over" witness of the rules `obstacle_passed_*`.
 
+use crate::agent::{Event, Value};
 use crate::control::Target;
 use crate::fusion::FusedObstacle;
 use crate::geom::{contains, unit, wrap_angle, Pose};
 use crate::gpl::GlobalPath;
-use crate::sensors::{Event, Value};
 use crate::world::{EdgeKind, World};
 use petgraph::graph::EdgeIndex;
 use serde::Serialize;

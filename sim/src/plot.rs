@@ -25,7 +25,8 @@ impl std::fmt::Display for PlotError {
 
 impl std::error::Error for PlotError {}
 
-pub(crate) fn err<E: std::fmt::Debug>(e: E) -> PlotError {
+/// A plotting backend's error as a [`PlotError`].
+pub fn err<E: std::fmt::Debug>(e: E) -> PlotError {
     PlotError(format!("{e:?}"))
 }
 

@@ -329,7 +329,7 @@ pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
     parse(&text)
 }
 
-/// A built-in scenario by name: `outdoor-default` or `dafflon-4`.
+/// A built-in scenario by name: `outdoor-default`, `dafflon-4`, `dla-offices` or `dla-field`.
 pub fn builtin(name: &str) -> Option<Scenario> {
     let text = match name {
         "outdoor-default" => OUTDOOR_DEFAULT,
@@ -339,6 +339,36 @@ pub fn builtin(name: &str) -> Option<Scenario> {
         _ => return None,
     };
     parse(text).ok()
+}
+
+/// A scenario given by name that cannot be had.
+#[derive(Debug, thiserror::Error)]
+pub enum NamedError {
+    /// Neither a built-in scenario nor a file.
+    #[error("no built-in scenario `{0}` (outdoor-default, dafflon-4, dla-offices, dla-field) and no such file")]
+    Unknown(String),
+    /// The file is not a valid scenario.
+    #[error("scenario `{name}`: {error}")]
+    Bad {
+        /// The name given.
+        name: String,
+        /// What is wrong.
+        #[source]
+        error: ScenarioError,
+    },
+}
+
+/// A built-in scenario by name ([`builtin`]), or a TOML file ([`load`]); the
+/// error names the field or the place.
+pub fn named(name: &str) -> Result<Scenario, NamedError> {
+    if let Some(s) = builtin(name) {
+        return Ok(s);
+    }
+    let path = Path::new(name);
+    if !path.exists() && !name.ends_with(".toml") {
+        return Err(NamedError::Unknown(name.to_string()));
+    }
+    load(path).map_err(|error| NamedError::Bad { name: name.to_string(), error })
 }
 
 /// The built-in outdoor mission.

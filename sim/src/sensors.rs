@@ -25,25 +25,7 @@ use crate::vehicle::VehicleState;
 use crate::world::{Corridor, CorridorHit, ObstacleView, RoadAhead, RoadLookahead, World};
 use serde::Serialize;
 
-/// A payload value, as the rules file types it.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-#[serde(untagged)]
-pub enum Value {
-    /// An `f64` field.
-    F64(f64),
-    /// An `i64` field.
-    I64(i64),
-    /// A symbol field (`side: {left, right}`, `reason: {…}`).
-    Symbol(&'static str),
-}
-
-/// An event of `rules/outdoor.situ`: its name and payload.
-pub trait Event {
-    /// The event's name in the rules file (e.g. `LAOBS`).
-    fn name(&self) -> &'static str;
-    /// The payload, field by field, in the rules file's order.
-    fn fields(&self) -> Vec<(&'static str, Value)>;
-}
+use crate::agent::{Event, Value};
 
 /// RFCCD's events.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

@@ -2,8 +2,9 @@
 //! LIDAR + selection + controllers + control law): the multi-agent merge
 //! against the hard switch.
 
+use situ_sim::baseline::ugv::compare;
 use situ_sim::scenario;
-use situ_sim::ugv::{compare, Strategy, UgvConfig};
+use situ_sim::ugv::{Strategy, UgvConfig};
 
 #[test]
 fn merge_is_smoother_and_faster_than_the_hard_switch_and_safe() {

@@ -4,9 +4,9 @@
 //! states than near obstacles or cross-country. And determinism: the same
 //! scenario and seed give the same metrics to the byte.
 
-use situ_sim::outdoor::run_mission;
+use situ_sim::baseline::outdoor::run_mission;
 use situ_sim::scenario;
-use situ_sim::ugv::{self, Strategy, UgvConfig};
+use situ_sim::ugv::{Strategy, UgvConfig};
 
 fn mean_speed_in(m: &situ_sim::metrics::Metrics, states: &[&str]) -> f64 {
     let v: Vec<f64> = m.samples.iter().filter(|s| states.contains(&s.label.as_str())).map(|s| s.v).collect();
@@ -54,7 +54,7 @@ fn same_scenario_and_seed_give_the_same_metrics_to_the_byte() {
     let c = run_mission(scenario::outdoor_default().world, 8, 40.0).to_json();
     assert_ne!(a, c, "the seed matters");
     let world = scenario::dafflon_4().world;
-    let x = ugv::run(&world, Strategy::Merge, 3, &UgvConfig::default()).to_json();
-    let y = ugv::run(&world, Strategy::Merge, 3, &UgvConfig::default()).to_json();
+    let x = situ_sim::baseline::ugv::run(&world, Strategy::Merge, 3, &UgvConfig::default()).to_json();
+    let y = situ_sim::baseline::ugv::run(&world, Strategy::Merge, 3, &UgvConfig::default()).to_json();
     assert_eq!(x.as_bytes(), y.as_bytes());
 }

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 #[test]
 fn a_run_writes_metrics_and_pictures() {
     let world = scenario::dafflon_4().world;
-    let m = ugv::run(&world, ugv::Strategy::HardSwitch, 1, &ugv::UgvConfig::default());
+    let m = situ_sim::baseline::ugv::run(&world, ugv::Strategy::HardSwitch, 1, &ugv::UgvConfig::default());
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("pictures-hard-switch");
     plot::write_run(&dir, &world, &m).expect("written");
     let traj = std::fs::read_to_string(dir.join("trajectory.svg")).expect("trajectory.svg");

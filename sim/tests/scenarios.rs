@@ -39,3 +39,18 @@ fn shipped_scenarios_load() {
     let missing = scenario::load(&dir.join("nope.toml")).expect_err("no such file");
     assert!(missing.to_string().contains("cannot read scenario"));
 }
+
+#[test]
+fn a_scenario_by_name_is_built_in_or_a_file_and_else_says_which_exist() {
+    assert_eq!(scenario::named("dafflon-4").expect("built in").name, scenario::dafflon_4().name);
+    let e = scenario::named("nowhere").expect_err("unknown");
+    assert_eq!(
+        e.to_string(),
+        "no built-in scenario `nowhere` (outdoor-default, dafflon-4, dla-offices, dla-field) and no such file"
+    );
+    let bad = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenarios-bad/unknown-node.toml");
+    let name = bad.display().to_string();
+    let e = scenario::named(&name).expect_err("a bad file");
+    let whole = scenario::load(&bad).expect_err("a bad file");
+    assert_eq!(e.to_string(), format!("scenario `{name}`: {whole}"));
+}

@@ -6,7 +6,7 @@ use situ_compiler::bundle::{Content, Mode};
 use situ_compiler::loader::FsLoader;
 use situ_runtime::record::{Fate, Memory, SharedMemory};
 use situ_sim::scenario;
-use situ_sim::stack::{self, Outcome, Recording, RunReport, StackConfig, StackKind, StackRun};
+use situ_sim::stack::{self, Outcome, Recording, Registry, RunReport, StackConfig, StackRun};
 use situ_sim::ugv::Strategy;
 use std::path::Path;
 use std::sync::{Arc, OnceLock};
@@ -20,7 +20,7 @@ fn rules(name: &str) -> Arc<Content> {
 
 fn run(rules_file: &str, seed: u64, memory: Option<SharedMemory>) -> RunReport {
     let content = rules(rules_file);
-    let kind = StackKind::of(&content).expect("a reference stack");
+    let kind = Registry::sim().of(&content).expect("a reference stack");
     let world = scenario::builtin(kind.default_scenario()).expect("built in").world;
     let cfg = StackConfig { seed, until: kind.default_until(), ..StackConfig::default() };
     let recording = Recording { mcap: None, sinks: memory.into_iter().map(|m| Box::new(m) as _).collect() };
@@ -43,11 +43,12 @@ fn outdoor() -> &'static (RunReport, Memory, Arc<Content>) {
 fn every_event_the_agents_report_is_one_of_the_rules_file() {
     let c = rules("outdoor.situ");
     for e in stack::outdoor::sample_events() {
-        assert!(stack::events::payload(&c, e.as_ref()).is_some(), "{} maps onto outdoor.situ", e.name());
+        assert!(situ_sim::agent::payload(&c, e.as_ref()).is_some(), "{} maps onto outdoor.situ", e.name());
     }
-    assert_eq!(StackKind::of(&c), Ok(StackKind::Outdoor));
-    assert_eq!(StackKind::of(&rules("ugv.situ")), Ok(StackKind::Ugv));
-    assert_eq!(StackKind::of(&rules("ugv-merge.situ")), Ok(StackKind::UgvMerge));
+    let name = |c: &situ_compiler::bundle::Content| Registry::sim().of(c).map(|s| s.name());
+    assert_eq!(name(&c), Ok("outdoor"));
+    assert_eq!(name(&rules("ugv.situ")), Ok("ugv"));
+    assert_eq!(name(&rules("ugv-merge.situ")), Ok("ugv_merge"));
 }
 
 #[test]
@@ -115,11 +116,12 @@ fn ugv_programs() -> stack::UgvPrograms {
 }
 
 /// Both strategies through the stack (and the sim loop for reference), once.
-fn dafflon() -> &'static (situ_sim::ugv::Comparison, Vec<RunReport>) {
-    static RUN: OnceLock<(situ_sim::ugv::Comparison, Vec<RunReport>)> = OnceLock::new();
+fn dafflon() -> &'static (situ_sim::baseline::ugv::Comparison, Vec<RunReport>) {
+    static RUN: OnceLock<(situ_sim::baseline::ugv::Comparison, Vec<RunReport>)> = OnceLock::new();
     RUN.get_or_init(|| {
         let world = scenario::dafflon_4().world;
-        stack::compare(&ugv_programs(), &world, &[Strategy::HardSwitch, Strategy::Merge], 1).expect("compared")
+        stack::compare(&ugv_programs(), &Registry::sim(), &world, &[Strategy::HardSwitch, Strategy::Merge], 1)
+            .expect("compared")
     })
 }
 
@@ -165,7 +167,7 @@ fn dafflon_the_merge_of_the_rules_is_smoother_and_faster_than_the_hard_switch_of
     let merge = stack_row("merge");
     assert!(hard.strategy.contains("ugv.situ") && merge.strategy.contains("ugv-merge.situ"));
     let report = &reports[1];
-    assert_eq!(report.stack, StackKind::UgvMerge);
+    assert_eq!(report.stack, "ugv_merge");
     assert!(matches!(report.outcome, Outcome::GoalReached { .. }), "{:?}", report.outcome);
     // The Merger blended both limit cycles, then handed the last metres over.
     for st in ["Reaching", "AvoidCW", "AvoidCCW", "Docking", "Reached"] {
@@ -222,7 +224,7 @@ fn a_lost_position_is_an_emergency_that_ends_in_a_stop_once_the_vehicle_stands()
     let memory = SharedMemory::default();
     let cfg = StackConfig { seed: 1, until: 120.0, ..StackConfig::default() };
     let recording = Recording { mcap: None, sinks: vec![Box::new(memory.clone())] };
-    let mut run = StackRun::new(content.clone(), StackKind::Outdoor, &world, cfg, recording).unwrap();
+    let mut run = StackRun::new(content.clone(), Arc::new(stack::outdoor::Outdoor), &world, cfg, recording).unwrap();
     run.run(&mut |_| {});
     let report = run.finish().unwrap();
     assert!(matches!(&report.outcome, Outcome::Stopped { state, .. } if state == "SP"), "{:?}", report.outcome);
@@ -234,4 +236,107 @@ fn a_lost_position_is_an_emergency_that_ends_in_a_stop_once_the_vehicle_stands()
     let braking = (at("SP") - at("EM")) as f64 * 1e-9;
     assert!((2.3..3.0).contains(&braking), "EM for {braking:.2} s");
     assert!(report.metrics.summary.collisions.is_empty());
+}
+
+fn source(name: &str, text: &str) -> Arc<Content> {
+    let checked = situ_compiler::check_source(name, text);
+    assert_eq!(checked.errors(), 0, "{name}: {:?}", checked.diagnostics);
+    Arc::new(situ_compiler::bundle::build(&checked))
+}
+
+#[test]
+fn a_program_of_no_stack_is_told_which_agents_each_stack_has() {
+    let minimal = source(
+        "minimal.situ",
+        "states { IT initial RD final }\nagent Supervisor interface { event SVRDY }\nrule ready { when state == IT and SVRDY then RD }\n",
+    );
+    let e = Registry::sim().of(&minimal).err().expect("no stack");
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "no simulated stack for these agents (Supervisor): `situ run` knows the agents of rules/outdoor.situ ({}), \
+             of rules/ugv.situ ({}) and of rules/ugv-merge.situ (those and Merger)",
+            stack::outdoor::AGENTS.join(", "),
+            stack::ugv::AGENTS.join(", ")
+        )
+    );
+}
+
+#[test]
+fn the_merge_is_told_from_the_hard_switch_in_any_order_of_the_registry() {
+    use stack::{merge::UgvMerge, ugv::Ugv};
+    let (hard, merge) = (rules("ugv.situ"), rules("ugv-merge.situ"));
+    for registry in
+        [Registry::new(vec![Arc::new(Ugv), Arc::new(UgvMerge)]), Registry::new(vec![Arc::new(UgvMerge), Arc::new(Ugv)])]
+    {
+        assert_eq!(registry.of(&merge).map(|s| s.name()), Ok("ugv_merge"));
+        assert_eq!(registry.of(&hard).map(|s| s.name()), Ok("ugv"));
+    }
+}
+
+#[test]
+fn the_comparison_reads_its_other_program_beside_the_rules_or_says_where_it_looked() {
+    use stack::merge::{strategies, CompareError};
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../rules");
+    let all = strategies(&["hard-switch".into(), " merge".into()]).expect("both strategies");
+    let registry = Registry::sim();
+    let hard = rules("ugv.situ");
+    let stack = registry.of(&hard).unwrap();
+    let (programs, sibling) =
+        stack::UgvPrograms::plan(&dir.join("ugv.situ"), hard.clone(), stack.as_ref(), &all).unwrap();
+    assert!(programs.hard_switch.is_some() && programs.merge.is_none());
+    let sibling = sibling.expect("the merge is wanted");
+    assert_eq!((sibling.strategy, sibling.path), (Strategy::Merge, dir.join("ugv-merge.situ")));
+    // Only the hard switch: no other program.
+    let (_, none) =
+        stack::UgvPrograms::plan(&dir.join("ugv.situ"), hard.clone(), stack.as_ref(), &[Strategy::HardSwitch]).unwrap();
+    assert_eq!(none, None);
+    // Alone in its directory.
+    let lonely = tempfile::tempdir().unwrap();
+    let file = lonely.path().join("ugv.situ");
+    std::fs::write(&file, "").unwrap();
+    let e = stack::UgvPrograms::plan(&file, hard, stack.as_ref(), &all).err().expect("no sibling");
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "--compare: the merge strategy runs `ugv-merge.situ` through the stack, and there is no `{}` beside `{}`",
+            lonely.path().join("ugv-merge.situ").display(),
+            file.display()
+        )
+    );
+    let outdoor = rules("outdoor.situ");
+    let not = stack::UgvPrograms::plan(
+        &dir.join("outdoor.situ"),
+        outdoor.clone(),
+        registry.of(&outdoor).unwrap().as_ref(),
+        &all,
+    );
+    assert!(matches!(not, Err(CompareError::NotUgv)));
+    let bad = strategies(&["merge".into(), "blend".into()]).expect_err("unknown");
+    assert_eq!(bad.to_string(), "--compare: unknown strategy `blend` (hard-switch, merge)");
+}
+
+#[test]
+fn a_run_in_real_time_is_the_same_run_and_reports_each_simulated_second() {
+    let content = rules("outdoor.situ");
+    let world = scenario::outdoor_default().world;
+    let report = |paced: bool| {
+        let cfg = StackConfig { seed: 1, until: 2.0, ..StackConfig::default() };
+        let mut run =
+            StackRun::new(content.clone(), Arc::new(stack::outdoor::Outdoor), &world, cfg, Recording::default())
+                .unwrap();
+        let mut seconds = Vec::new();
+        let mut each = |r: &StackRun| seconds.push(r.t());
+        if paced {
+            run.run_in_real_time(&mut each);
+        } else {
+            run.run(&mut each);
+        }
+        (run.finish().unwrap().to_json(), seconds)
+    };
+    let (paced, at) = report(true);
+    let (free, free_at) = report(false);
+    assert!(paced.as_bytes() == free.as_bytes(), "metrics.json differs when paced");
+    assert_eq!(at, [1.0, 2.0]);
+    assert_eq!(at, free_at);
 }

@@ -13,82 +13,83 @@
 //! held-out mission of the last evaluation are done, 1 otherwise, 2 on
 //! usage or I/O.
 
-use super::run::{dla_cases, Args};
 use super::{FAILED, OK, USAGE};
 use situ_compiler::bundle::Content;
-use situ_sim::dla::experience::{evaluation_points, Experience};
+use situ_dla::missions::{self, load_or_train, Series, Step, HELD_OUT};
+use situ_dla::stack::SharedCases;
 use situ_sim::scenario::Scenario;
-use situ_sim::stack::experience::{evaluate, mission, HELD_OUT};
-use situ_sim::stack::{self, StackKind, StackRun};
+use situ_sim::stack::{Stack, StackRun};
+use std::path::Path;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-/// At most this many missions in one call.
-pub const MAX_MISSIONS: u64 = 10_000;
+/// What `situ run --missions` was given besides the rules and the scenario.
+pub struct Args<'a> {
+    /// The rules file, for messages.
+    pub file: &'a Path,
+    /// The first learning mission's seed.
+    pub seed: u64,
+    /// `--cases`: the case base read before and written after.
+    pub cases: Option<&'a Path>,
+    /// Whether the missions learn on line.
+    pub learn: bool,
+    /// `--evaluate`: held-out missions per evaluation.
+    pub evaluate: u64,
+    /// `--out`: where the curve and its data go.
+    pub out: Option<&'a Path>,
+}
 
 /// `missions` learning missions (`--missions`), the evaluations of
-/// `args.dla.evaluate` held-out missions each.
-pub fn run(args: &Args, content: Arc<Content>, kind: StackKind, scenario: &Scenario, missions: u64, until: f64) -> u8 {
-    let held_out = args.dla.evaluate;
-    if kind != StackKind::Dla {
+/// `args.evaluate` held-out missions each ([`missions::experience`]).
+pub fn run(
+    args: &Args<'_>,
+    content: Arc<Content>,
+    kind: &dyn Stack,
+    scenario: &Scenario,
+    missions: u64,
+    until: f64,
+) -> u8 {
+    let held_out = args.evaluate;
+    if kind.name() != situ_dla::stack::NAME {
         eprintln!(
             "error: --missions runs successive missions of a DLA stack (agents of rules/dla.situ, whose reactive \
-             layer learns); `{}` runs on the {kind:?} stack",
-            args.file.display()
+             layer learns); `{}` runs on the {} stack",
+            args.file.display(),
+            kind.title()
         );
         return USAGE;
     }
-    if !(1..=MAX_MISSIONS).contains(&missions) || held_out > MAX_MISSIONS {
-        eprintln!("error: --missions must be between 1 and {MAX_MISSIONS}, --evaluate at most {MAX_MISSIONS}");
+    let series = Series { missions, held_out, seed: args.seed, until, learn: args.learn };
+    if let Err(e) = missions::check(&series) {
+        eprintln!("error: {e}");
         return USAGE;
     }
-    let (cases, read) = match dla_cases(&args.dla, args.seed) {
+    let (cases, read) = match load_or_train(args.cases, args.seed) {
         Ok(c) => c,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: --cases {e}");
             return USAGE;
         }
     };
     let before = cases.len();
-    let handle = stack::dla::CasesHandle(Arc::new(Mutex::new(cases)));
-    let mut experience = Experience::default();
+    let handle: SharedCases = Arc::new(Mutex::new(cases));
     let mut line = super::LiveLine::new();
     let start = Instant::now();
-    let points = if held_out > 0 { evaluation_points(missions as usize) } else { Vec::new() };
-    let mut ran = || -> Result<(), String> {
-        for k in 0..=missions as usize {
-            if points.contains(&k) {
-                let mut progress = |j: u64, r: &StackRun| {
-                    line.draw(|| format!("after {k}: held-out {}/{held_out}: {}", j + 1, r.progress().line()))
-                };
-                let e = evaluate(&content, &scenario.world, k, held_out, until, &handle, &mut progress)?;
-                experience.evaluations.push(e);
-            }
-            if k == missions as usize {
-                break;
-            }
-            let seed = args.seed.wrapping_add(k as u64);
-            let mut progress =
-                |r: &StackRun| line.draw(|| format!("mission {}/{missions}: {}", k + 1, r.progress().line()));
-            experience.missions.push(mission(
-                &content,
-                &scenario.world,
-                k + 1,
-                seed,
-                until,
-                args.dla.learn,
-                &handle,
-                &mut progress,
-            )?);
+    let mut progress = |step: Step, r: &StackRun| match step {
+        Step::HeldOut { after, j } => {
+            line.draw(|| format!("after {after}: held-out {j}/{held_out}: {}", r.progress().line()))
         }
-        Ok(())
+        Step::Learning(k) => line.draw(|| format!("mission {k}/{missions}: {}", r.progress().line())),
     };
-    let result = ran();
+    let result = missions::experience(&content, &scenario.world, &series, &handle, &mut progress);
     line.clear();
-    if let Err(e) = result {
-        eprintln!("error: `{}`: {e}", args.file.display());
-        return USAGE;
-    }
+    let experience = match result {
+        Ok(e) => e,
+        Err(e) => {
+            eprintln!("error: `{}`: {e}", args.file.display());
+            return USAGE;
+        }
+    };
     let wall = start.elapsed().as_secs_f64();
     println!(
         "{} on {}: {missions} learning mission(s), seeds {}–{}; {before} case(s) {}, {}\n",
@@ -97,7 +98,7 @@ pub fn run(args: &Args, content: Arc<Content>, kind: StackKind, scenario: &Scena
         args.seed,
         args.seed.wrapping_add(missions - 1),
         if read { "read" } else { "trained" },
-        if args.dla.learn { "learning on line" } else { "no learning" }
+        if args.learn { "learning on line" } else { "no learning" }
     );
     print!("{}", experience.table());
     if held_out > 0 {
@@ -113,15 +114,15 @@ pub fn run(args: &Args, content: Arc<Content>, kind: StackKind, scenario: &Scena
         simulated / 3600.0,
         simulated / wall.max(1e-9)
     );
-    if let Some(path) = &args.dla.cases {
-        let cases = handle.0.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(path) = args.cases {
+        let cases = handle.lock().unwrap_or_else(|e| e.into_inner());
         if let Err(e) = cases.write(path) {
             eprintln!("error: cannot write the case base `{}`: {e}", path.display());
             return USAGE;
         }
         println!("  case base         {} cases written to {}", cases.len(), path.display());
     }
-    if let Some(out) = &args.out {
+    if let Some(out) = args.out {
         let title = format!("{} on {}: experience over {missions} missions", content.source, scenario.name);
         let svg = match experience.svg(&title) {
             Ok(s) => s,

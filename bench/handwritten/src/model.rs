@@ -3,6 +3,13 @@
 //! in declaration order.
 
 /// The system states of `outdoor.situ`, in declaration order.
+///
+/// A copy of `situ_sim::baseline::outdoor::State` (both copy the rules),
+/// kept here on purpose: this crate is the benchmark's hand-written
+/// practical limit and has no dependency at all; taking the enum from
+/// `situ-sim` would build the sim, the runtime and the compiler into the
+/// benchmark, and the sim's enum (ordered, serialized, with LPL's plans per
+/// state) is not the `repr(u8)` one the matcher indexes by.
 #[allow(clippy::upper_case_acronyms)]
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 #[repr(u8)]

@@ -1,10 +1,14 @@
 //! The reference stacks on the **real** rules: every agent of
 //! `rules/outdoor.situ` (Zhang & Zhu) and of `rules/ugv.situ` and
 //! `rules/ugv-merge.situ` (Dafflon et al.: hard switch, merge) as a runtime
-//! [`Agent`](situ_runtime::agent::Agent) wrapping the sim's parts, run by
+//! [`Agent`] wrapping the sim's parts, run by
 //! the runtime's simulated-time scheduler with the compiled rules deciding
 //! the state. This is what `situ run` drives.
 //!
+//! - [`Stack`]: what a reference stack is to the loop (its agents, rates,
+//!   goal state, defaults, pictures); [`outdoor::Outdoor`], [`ugv::Ugv`]
+//!   and [`merge::UgvMerge`] here, DLA's in `situ-dla`. A [`Registry`]
+//!   tells a program's stack by its agents.
 //! - [`Physics`]: the ground truth the agents share (world, vehicle, time,
 //!   the last command). Sensors read it; the actuator (Drive, Vehicle)
 //!   writes its command into it; nothing else touches it. Every other input
@@ -21,22 +25,24 @@
 //!   Nothing in it reads a clock: the same scenario and seed give the same
 //!   bytes.
 
-pub mod dla;
-pub mod events;
-pub mod experience;
 pub mod merge;
-
-pub use merge::{compare, UgvPrograms};
 pub mod outdoor;
+mod registry;
+mod scene;
 pub mod ugv;
 
+pub use merge::{compare, CompareError, UgvPrograms};
+pub use registry::{NoStack, Registry};
+pub use scene::{pose_in_frame_schema, scene_update_schema, topics};
+
 use crate::metrics::{Metrics, Recorder, Sample};
+use crate::scenario::Scenario;
 use crate::vehicle::{Command, Vehicle};
 use crate::world::{ObstacleView, World};
+use scene::Scene;
 use serde::Serialize;
-use serde_json::{json, Value as Json};
 use situ_compiler::bundle::{Content, Mode};
-use situ_runtime::agent;
+use situ_runtime::agent::{self, Agent};
 use situ_runtime::record::mcap::McapRecorder;
 use situ_runtime::record::{DataRecord, EventRecord, Fate, Level, ModeRecord, Sink, Tee};
 use situ_runtime::rete::StateChange;
@@ -72,101 +78,71 @@ pub fn lock(p: &SharedPhysics) -> MutexGuard<'_, Physics> {
     p.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// Which reference stack a program is, told by its agents.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum StackKind {
-    /// Zhang & Zhu's outdoor vehicle (`rules/outdoor.situ`).
-    Outdoor,
-    /// Dafflon et al.'s urban UGV with the hard switch (`rules/ugv.situ`).
-    Ugv,
-    /// Dafflon et al.'s urban UGV with the multi-agent merge
-    /// (`rules/ugv-merge.situ`): the agents of `rules/ugv.situ` and a Merger.
-    UgvMerge,
-    /// Pérez's DLA (`rules/dla.situ`): deliberative and case-based reactive layers.
-    Dla,
-}
+/// A reference stack: the agents of one rules file on the sim's parts, and
+/// what a run of it needs besides (its goal, its rates, how long, how
+/// often to sample, its pictures). [`StackRun`] runs any of them; a
+/// [`Registry`] tells which one a program is, by its agents.
+///
+/// The sim's own are [`outdoor::Outdoor`], [`ugv::Ugv`] and
+/// [`merge::UgvMerge`]; DLA's is in the `situ-dla` crate.
+pub trait Stack: Send + Sync {
+    /// Its name in `metrics.json` (`outdoor`, `ugv`, `ugv_merge`, `dla`).
+    fn name(&self) -> &'static str;
 
-impl StackKind {
+    /// Its name in messages (`Outdoor`, `Ugv`, `UgvMerge`, `Dla`).
+    fn title(&self) -> &'static str;
+
     /// The agents a program must declare to run on this stack.
-    pub fn agents(self) -> &'static [&'static str] {
-        match self {
-            StackKind::Outdoor => outdoor::AGENTS,
-            StackKind::Ugv => ugv::AGENTS,
-            StackKind::UgvMerge => merge::AGENTS,
-            StackKind::Dla => dla::AGENTS,
-        }
-    }
+    fn agents(&self) -> &'static [&'static str];
 
-    /// The stack whose agents the program declares.
-    pub fn of(content: &Content) -> Result<StackKind, String> {
-        let names: BTreeSet<&str> = content.agents.iter().map(|a| a.name.as_str()).collect();
-        // The merge's agents include the hard switch's: it is tried first.
-        for kind in [StackKind::Outdoor, StackKind::UgvMerge, StackKind::Ugv, StackKind::Dla] {
-            if kind.agents().iter().all(|a| names.contains(a)) {
-                return Ok(kind);
-            }
-        }
-        Err(format!(
-            "no simulated stack for these agents ({}): `situ run` knows the agents of rules/outdoor.situ ({}), of rules/ugv.situ ({}), of rules/ugv-merge.situ (those and Merger) and of rules/dla.situ ({})",
-            names.into_iter().collect::<Vec<_>>().join(", "),
-            outdoor::AGENTS.join(", "),
-            ugv::AGENTS.join(", "),
-            dla::AGENTS.join(", ")
-        ))
-    }
+    /// How an error listing the stacks names this one's agents
+    /// (`of rules/outdoor.situ (RFCCD, …)`).
+    fn known_as(&self) -> String;
 
     /// The built-in scenario run by default.
-    pub fn default_scenario(self) -> &'static str {
-        match self {
-            StackKind::Outdoor => "outdoor-default",
-            StackKind::Ugv | StackKind::UgvMerge => "dafflon-4",
-            StackKind::Dla => "dla-offices",
-        }
-    }
+    fn default_scenario(&self) -> &'static str;
 
     /// The state that means "mission done".
-    pub fn goal_state(self) -> &'static str {
-        match self {
-            StackKind::Outdoor => "GL",
-            StackKind::Ugv | StackKind::UgvMerge => "Reached",
-            StackKind::Dla => "Arrived",
-        }
+    fn goal_state(&self) -> &'static str;
+
+    /// Rates the stack sets over the rules file (none by default).
+    fn rates(&self) -> BTreeMap<String, f64> {
+        BTreeMap::new()
     }
 
-    /// Rates the stack sets over the rules file, and why.
-    pub fn rates(self) -> BTreeMap<String, f64> {
-        match self {
-            // TeleControl has no `rate` in the rules (it runs in every state
-            // with no function): its heartbeat TCHB comes at 10 Hz, the
-            // rate the rules' `stale after 1s` ("10 heartbeats") assumes.
-            StackKind::Outdoor => [("TeleControl".to_string(), 10.0)].into(),
-            StackKind::Ugv | StackKind::UgvMerge | StackKind::Dla => BTreeMap::new(),
-        }
-    }
-
-    /// Physics steps (of 10 ms) per metrics sample: the outdoor Drive's
-    /// period (50 Hz), so that the steering rate is the rate of its
-    /// commands; for the UGV 20 Hz, the control period of Dafflon et al.'s
-    /// closed loop ([`crate::ugv::run`]), so that its figures compare with
-    /// the merge's.
-    pub fn sample_every(self) -> u64 {
-        match self {
-            StackKind::Outdoor => 2,
-            StackKind::Ugv | StackKind::UgvMerge => 5,
-            // The reactive layer's 10 Hz.
-            StackKind::Dla => 10,
-        }
-    }
+    /// Physics steps (of 10 ms) per metrics sample.
+    fn sample_every(&self) -> u64;
 
     /// The longest run by default (s of simulated time).
-    pub fn default_until(self) -> f64 {
-        match self {
-            StackKind::Outdoor => 600.0,
-            StackKind::Ugv | StackKind::UgvMerge => 120.0,
-            StackKind::Dla => 300.0,
-        }
+    fn default_until(&self) -> f64;
+
+    /// The agents of a run of `content` on `world`, sharing `physics`,
+    /// their noise seeded with `seed`.
+    fn agents_for(
+        &self,
+        content: &Arc<Content>,
+        physics: &SharedPhysics,
+        world: &World,
+        seed: u64,
+    ) -> Vec<Box<dyn Agent>>;
+
+    /// The stack's own pictures of a finished run (file name, SVG), beside
+    /// the trajectory and the time line every run draws; none by default.
+    fn pictures(&self, scenario: &Scenario, report: &RunReport) -> Vec<(&'static str, String)> {
+        let _ = (scenario, report);
+        Vec::new()
     }
+}
+
+/// Why a run could not be set up or finished.
+#[derive(Debug, thiserror::Error)]
+pub enum StackError {
+    /// The program's agents do not bind to the stack's.
+    #[error("{0}")]
+    Bind(#[from] agent::BindError),
+    /// The recording could not be written.
+    #[error("recording: {0}")]
+    Recording(#[from] std::io::Error),
 }
 
 /// How a run is set up.
@@ -179,17 +155,12 @@ pub struct StackConfig {
     /// The physics step (ns).
     pub physics_step: u64,
     /// A metrics sample every this many physics steps (0: the stack's own,
-    /// [`StackKind::sample_every`]).
+    /// [`Stack::sample_every`]).
     pub sample_every: u64,
     /// Keep every sample in the metrics (off: the summary only).
     pub samples: bool,
-    /// Rates (Hz) over the rules file and the stack's own ([`StackKind::rates`]).
+    /// Rates (Hz) over the rules file and the stack's own ([`Stack::rates`]).
     pub rates: BTreeMap<String, f64>,
-    /// DLA: the reactive layer's case base (`None`: one trained before the
-    /// run by the scripted driver, [`dla::train`]).
-    pub cases: Option<dla::CasesHandle>,
-    /// DLA: whether the reactive layer learns novel situations on line.
-    pub learn: bool,
 }
 
 impl Default for StackConfig {
@@ -201,8 +172,6 @@ impl Default for StackConfig {
             sample_every: 0,
             samples: true,
             rates: BTreeMap::new(),
-            cases: None,
-            learn: true,
         }
     }
 }
@@ -300,8 +269,8 @@ pub struct StateFigures {
 pub struct RunReport {
     /// The rules (the bundle's source name).
     pub rules: String,
-    /// Which stack.
-    pub stack: StackKind,
+    /// Which stack ([`Stack::name`]).
+    pub stack: &'static str,
     /// The scenario's name.
     pub scenario: String,
     /// The noise seed.
@@ -319,6 +288,17 @@ pub struct RunReport {
 }
 
 impl RunReport {
+    /// `trajectory.svg` and `timeline.svg`: the run's path on the world and
+    /// its time line (file name, SVG).
+    pub fn pictures(&self, scenario: &Scenario) -> Result<Vec<(&'static str, String)>, crate::plot::PlotError> {
+        let title = format!("{} — {}", scenario.name, self.rules);
+        let samples = &self.metrics.samples;
+        Ok(vec![
+            ("trajectory.svg", crate::plot::trajectory_svg(&scenario.world, samples, &title)?),
+            ("timeline.svg", crate::plot::timeline_svg(samples, &title)?),
+        ])
+    }
+
     /// `metrics.json` (pretty, deterministic).
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
@@ -416,91 +396,6 @@ impl Sink for StreamCounts {
     }
 }
 
-/// Topics `situ run` adds to a recording.
-pub mod topics {
-    /// The vehicle's pose, `foxglove.PoseInFrame`.
-    pub const POSE: &str = "/pose";
-    /// The obstacles, `foxglove.SceneUpdate`.
-    pub const OBSTACLES: &str = "/obstacles";
-}
-
-fn time_json(t: u64) -> Json {
-    json!({ "sec": t / NS, "nsec": t % NS })
-}
-
-/// The JSON schema of `foxglove.PoseInFrame`: Foxglove's own, as published
-/// (schemas/jsonschema/PoseInFrame.json of github.com/foxglove/foxglove-sdk,
-/// MIT), so that Foxglove's panels read the messages and a recording
-/// validates against it.
-pub fn pose_in_frame_schema() -> String {
-    include_str!("schemas/PoseInFrame.json").trim_end().to_string()
-}
-
-/// The JSON schema of `foxglove.SceneUpdate`: Foxglove's own, as published
-/// (schemas/jsonschema/SceneUpdate.json of github.com/foxglove/foxglove-sdk,
-/// MIT), every sub-schema in full (SceneEntity, SceneEntityDeletion, the
-/// primitives, Pose, Vector3, Quaternion, Color, time, duration).
-pub fn scene_update_schema() -> String {
-    include_str!("schemas/SceneUpdate.json").trim_end().to_string()
-}
-
-/// The pose and obstacle channels of a recording.
-struct Scene {
-    mcap: Arc<Mutex<McapRecorder>>,
-    pose: u16,
-    obstacles: u16,
-}
-
-impl Scene {
-    fn new(mcap: Arc<Mutex<McapRecorder>>) -> std::io::Result<Scene> {
-        let (pose, obstacles) = {
-            let mut m = mcap.lock().unwrap_or_else(|e| e.into_inner());
-            let pose = m.add_channel(topics::POSE, "foxglove.PoseInFrame", &pose_in_frame_schema())?;
-            let obstacles = m.add_channel(topics::OBSTACLES, "foxglove.SceneUpdate", &scene_update_schema())?;
-            (pose, obstacles)
-        };
-        Ok(Scene { mcap, pose, obstacles })
-    }
-
-    fn pose(&self, t: u64, ph: &Physics) {
-        let p = ph.vehicle.state.pose;
-        let (s, c) = (p.theta / 2.0).sin_cos();
-        let msg = json!({
-            "timestamp": time_json(t), "frame_id": "map",
-            "pose": { "position": {"x": p.x, "y": p.y, "z": 0.0}, "orientation": {"x": 0.0, "y": 0.0, "z": s, "w": c} },
-        });
-        self.mcap.lock().unwrap_or_else(|e| e.into_inner()).write_message(self.pose, t, &msg);
-    }
-
-    fn obstacles(&self, t: u64, ph: &Physics) {
-        let entities: Vec<Json> = ph
-            .views
-            .iter()
-            .map(|o| {
-                let points: Vec<Json> = o.polygon.iter().map(|q| json!({"x": q.x, "y": q.y, "z": 0.0})).collect();
-                let tall = o.height > ph.world.vehicle.clearance;
-                let color = if tall { json!({"r": 0.85, "g": 0.15, "b": 0.15, "a": 1.0}) } else { json!({"r": 0.6, "g": 0.6, "b": 0.6, "a": 1.0}) };
-                json!({
-                    "timestamp": time_json(t), "frame_id": "map",
-                    "id": format!("obstacle/{}", o.index), "lifetime": {"sec": 0, "nsec": 0}, "frame_locked": false,
-                    "metadata": [ {"key": "name", "value": ph.world.obstacles[o.index].id},
-                                  {"key": "height", "value": format!("{:.2}", o.height)} ],
-                    "arrows": [], "cubes": [], "spheres": [], "cylinders": [],
-                    "lines": [{
-                        "type": 1,
-                        "pose": { "position": {"x": 0.0, "y": 0.0, "z": 0.0}, "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0} },
-                        "thickness": 0.15, "scale_invariant": false, "points": points,
-                        "color": color, "colors": [], "indices": [],
-                    }],
-                    "triangles": [], "texts": [], "models": [],
-                })
-            })
-            .collect();
-        let msg = json!({ "deletions": [], "entities": entities });
-        self.mcap.lock().unwrap_or_else(|e| e.into_inner()).write_message(self.obstacles, t, &msg);
-    }
-}
-
 /// Where a run's records go besides the report.
 #[derive(Default)]
 pub struct Recording {
@@ -513,7 +408,7 @@ pub struct Recording {
 /// One run of a stack: the runtime, the physics, the metrics.
 pub struct StackRun {
     /// The stack.
-    pub kind: StackKind,
+    pub stack: Arc<dyn Stack>,
     /// The runtime running the rules and the agents.
     pub rt: SimRuntime,
     /// The ground truth.
@@ -533,19 +428,18 @@ pub struct StackRun {
     running: BTreeMap<String, BTreeSet<String>>,
     per_state: BTreeMap<String, (f64, f64, f64, f64, u64)>,
     final_since: Option<u64>,
-    plans: Option<dla::SharedPlans>,
 }
 
 impl StackRun {
-    /// Sets up a run of `content` (the stack `kind`) on `world`, its
-    /// records going to `recording` too.
+    /// Sets up a run of `content` (on `stack`) on `world`, its records
+    /// going to `recording` too.
     pub fn new(
         content: Arc<Content>,
-        kind: StackKind,
+        stack: Arc<dyn Stack>,
         world: &World,
         cfg: StackConfig,
         recording: Recording,
-    ) -> Result<StackRun, String> {
+    ) -> Result<StackRun, StackError> {
         let mut views = Vec::new();
         world.obstacles_at(0.0, &mut views);
         let physics = Arc::new(Mutex::new(Physics {
@@ -555,37 +449,23 @@ impl StackRun {
             command: Command::default(),
             views,
         }));
-        let mut plans = None;
-        let agents = match kind {
-            StackKind::Outdoor => outdoor::agents(&content, &physics, world, cfg.seed),
-            StackKind::Ugv => ugv::agents(&content, &physics, world, cfg.seed),
-            StackKind::UgvMerge => ugv::build(&content, &physics, world, cfg.seed, true),
-            StackKind::Dla => {
-                let cases = match &cfg.cases {
-                    Some(c) => c.0.clone(),
-                    None => Arc::new(Mutex::new(dla::train(cfg.seed, dla::TRAINING_SECONDS, dla::NOVELTY))),
-                };
-                let shared: dla::SharedPlans = Arc::default();
-                plans = Some(shared.clone());
-                dla::agents(&content, &physics, world, cfg.seed, cases, cfg.learn, shared)
-            }
-        };
-        let bound = agent::bind(&content, agents, true).map_err(|e| e.to_string())?;
+        let agents = stack.agents_for(&content, &physics, world, cfg.seed);
+        let bound = agent::bind(&content, agents, true)?;
         let counts = Arc::new(Mutex::new(StreamCounts::default()));
         let mut sinks: Vec<Box<dyn Sink>> = vec![Box::new(counts.clone())];
         sinks.extend(recording.sinks);
         let scene = match recording.mcap {
             Some(m) => {
                 sinks.push(Box::new(m.clone()));
-                Some(Scene::new(m).map_err(|e| format!("recording: {e}"))?)
+                Some(Scene::new(m)?)
             }
             None => None,
         };
         let mut cfg = cfg;
         if cfg.sample_every == 0 {
-            cfg.sample_every = kind.sample_every();
+            cfg.sample_every = stack.sample_every();
         }
-        let mut rates = kind.rates();
+        let mut rates = stack.rates();
         rates.extend(cfg.rates.clone());
         let config = SimConfig { rates, stop_on_final: false, ..SimConfig::default() };
         let rt = SimRuntime::new(content.clone(), bound, Some(Box::new(Tee(sinks))), config);
@@ -593,10 +473,10 @@ impl StackRun {
         let controller = format!("situ run {} (the rules decide the state)", content.source);
         let moving = world.obstacles.iter().any(|o| o.motion != crate::world::Motion::Static);
         Ok(StackRun {
-            kind,
             rt,
             physics,
-            goal_state: content.state_id(kind.goal_state()),
+            goal_state: content.state_id(stack.goal_state()),
+            stack,
             content,
             scenario: world.name.clone(),
             recorder: Recorder::new(&world.name, &controller, cfg.seed, dt),
@@ -610,13 +490,7 @@ impl StackRun {
             running: BTreeMap::new(),
             per_state: BTreeMap::new(),
             final_since: None,
-            plans,
         })
-    }
-
-    /// DLA: the map, route and path of the run, and its counts.
-    pub fn plans(&self) -> Option<&dla::SharedPlans> {
-        self.plans.as_ref()
     }
 
     /// Simulated time (s).
@@ -773,8 +647,26 @@ impl StackRun {
         }
     }
 
+    /// Runs to the end in real time, a simulated second a wall second (for
+    /// people watching it live); `progress` is called every simulated
+    /// second. The run itself is the same as [`StackRun::run`]'s.
+    pub fn run_in_real_time(&mut self, progress: &mut dyn FnMut(&StackRun)) {
+        let start = std::time::Instant::now();
+        let per_second = (NS / self.cfg.physics_step).max(1);
+        while self.step() {
+            let t = lock(&self.physics).t;
+            let ahead = std::time::Duration::from_secs_f64(t.max(0.0)).saturating_sub(start.elapsed());
+            if !ahead.is_zero() {
+                std::thread::sleep(ahead);
+            }
+            if self.k.is_multiple_of(per_second) {
+                progress(self);
+            }
+        }
+    }
+
     /// Ends the run (and the recording) and gathers the report.
-    pub fn finish(mut self) -> Result<RunReport, String> {
+    pub fn finish(mut self) -> Result<RunReport, StackError> {
         while self.outcome.is_none() {
             self.step();
         }
@@ -814,7 +706,7 @@ impl StackRun {
         let outcome = self.outcome.clone().unwrap_or(Outcome::Timeout { time: self.t(), state: self.state().into() });
         let report = RunReport {
             rules: c.source.clone(),
-            stack: self.kind,
+            stack: self.stack.name(),
             scenario: self.scenario.clone(),
             seed: self.cfg.seed,
             outcome,
@@ -822,7 +714,7 @@ impl StackRun {
             runtime,
             metrics: self.recorder.finish(),
         };
-        recording.map_err(|e| format!("recording: {e}"))?;
+        recording?;
         Ok(report)
     }
 }

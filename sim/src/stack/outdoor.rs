@@ -19,20 +19,20 @@
 //! command); every other input comes through the data stream, so an agent
 //! that is not linked to a source in the current state does not see it
 //! (LPL gets no obstacles in RS: LADAR waits and Fusion sleeps there).
-//! Data older than [`FRESH`] is not used.
+//! Data older than [`FRESH`](crate::agent::FRESH) is not used.
 
-use super::events::{report, Plain};
-use super::{lock, SharedPhysics};
+use super::{lock, SharedPhysics, Stack};
+use crate::agent::{held, hold, names, report, Event, Held, Plain};
 use crate::drive;
 use crate::fusion::{self, FusedObstacle, FusionConfig, FusionOutput};
 use crate::geom::Pose;
 use crate::gpl::{self, GlobalPath};
 use crate::lpl::{self, FailReason, LocalPlan, PlanEvent, PlanInput, PlanKind};
-use crate::sensors::{self, Event, Fix, LadarEvent, ObstacleScan, RfccdEvent, StccdEvent};
+use crate::sensors::{self, Fix, LadarEvent, ObstacleScan, RfccdEvent, StccdEvent};
 use crate::world::{EdgeKind, Goal, World};
 use petgraph::graph::EdgeIndex;
 use situ_compiler::bundle::Content;
-use situ_runtime::agent::{Agent, Body, Context, Datum};
+use situ_runtime::agent::{Agent, Body, Context};
 use std::collections::{BTreeMap, BTreeSet};
 use std::sync::Arc;
 
@@ -51,9 +51,6 @@ pub const AGENTS: &[&str] = &[
     "TeleControl",
     "Recorder",
 ];
-
-/// Data older than this is not used (ns): 3 periods of a 10 Hz sensor.
-pub const FRESH: u64 = 300_000_000;
 
 /// LPL plans a stop before a road it finds blocked, and fails (PLF) when
 /// no new path comes within this time (ns).
@@ -80,36 +77,6 @@ pub enum GplData {
     Path(u32, Arc<GlobalPath>),
     /// No path to the goal.
     NoPath,
-}
-
-/// The latest datum of a kind, and when it was sent.
-#[derive(Debug, Clone)]
-struct Latest {
-    time: u64,
-    body: Body,
-}
-
-impl Latest {
-    fn fresh(&self, now: u64) -> bool {
-        now.saturating_sub(self.time) <= FRESH
-    }
-}
-
-/// Keeps the latest datum of type `T` among `inputs` in `slot`.
-fn take<T: 'static>(inputs: &[Datum], slot: &mut Option<Latest>) {
-    for d in inputs {
-        if d.body.get::<T>().is_some() && slot.as_ref().is_none_or(|l| d.time >= l.time) {
-            *slot = Some(Latest { time: d.time, body: d.body.clone() });
-        }
-    }
-}
-
-fn fresh<T: 'static>(slot: &Option<Latest>, now: u64) -> Option<&T> {
-    slot.as_ref().filter(|l| l.fresh(now)).and_then(|l| l.body.get::<T>())
-}
-
-fn names(list: &[&str]) -> Vec<String> {
-    list.iter().map(|s| s.to_string()).collect()
 }
 
 /// The a priori map: the world without its obstacles (nobody knows those
@@ -220,9 +187,9 @@ impl Agent for Localization {
 /// and the road camera.
 pub struct Fusion {
     cfg: FusionConfig,
-    road: Option<Latest>,
-    ladar: Option<Latest>,
-    stereo: Option<Latest>,
+    road: Option<Held>,
+    ladar: Option<Held>,
+    stereo: Option<Held>,
     content: Arc<Content>,
 }
 
@@ -235,14 +202,14 @@ impl Agent for Fusion {
     }
     fn step(&mut self, cx: &mut Context<'_>) {
         let now = cx.now();
-        take::<RfccdEvent>(cx.inputs(), &mut self.road);
-        take::<ObstacleScan<LadarEvent>>(cx.inputs(), &mut self.ladar);
-        take::<ObstacleScan<StccdEvent>>(cx.inputs(), &mut self.stereo);
-        let ladar = fresh::<ObstacleScan<LadarEvent>>(&self.ladar, now);
-        let stereo = fresh::<ObstacleScan<StccdEvent>>(&self.stereo, now);
+        hold::<RfccdEvent>(cx.inputs(), &mut self.road);
+        hold::<ObstacleScan<LadarEvent>>(cx.inputs(), &mut self.ladar);
+        hold::<ObstacleScan<StccdEvent>>(cx.inputs(), &mut self.stereo);
+        let ladar = held::<ObstacleScan<LadarEvent>>(&self.ladar, now);
+        let stereo = held::<ObstacleScan<StccdEvent>>(&self.stereo, now);
         let out: FusionOutput = match cx.function() {
             Some("fuse_road") => {
-                let (Some(road), Some(ladar)) = (fresh::<RfccdEvent>(&self.road, now), ladar) else { return };
+                let (Some(road), Some(ladar)) = (held::<RfccdEvent>(&self.road, now), ladar) else { return };
                 fusion::fuse_road(road, &ladar.detections, &self.cfg)
             }
             Some("fuse_terrain") => {
@@ -344,8 +311,8 @@ pub struct Lpl {
     no_path: bool,
     fix: Option<Fix>,
     road: Option<u64>,
-    fusion: Option<Latest>,
-    stereo: Option<Latest>,
+    fusion: Option<Held>,
+    stereo: Option<Held>,
     s: f64,
     blocked_since: Option<u64>,
     content: Arc<Content>,
@@ -380,8 +347,8 @@ impl Agent for Lpl {
                 self.road = Some(d.time);
             }
         }
-        take::<FusionOutput>(cx.inputs(), &mut self.fusion);
-        take::<ObstacleScan<StccdEvent>>(cx.inputs(), &mut self.stereo);
+        hold::<FusionOutput>(cx.inputs(), &mut self.fusion);
+        hold::<ObstacleScan<StccdEvent>>(cx.inputs(), &mut self.stereo);
         let kind = match cx.function() {
             Some("plrs") => PlanKind::Straight,
             Some("plrt") => PlanKind::Turn,
@@ -403,9 +370,9 @@ impl Agent for Lpl {
         self.s = s;
         let obstacles: Vec<FusedObstacle> = match kind {
             PlanKind::RoadObstacle | PlanKind::CrossCountryObstacle => {
-                fresh::<FusionOutput>(&self.fusion, now).map(|f| f.obstacles.clone()).unwrap_or_default()
+                held::<FusionOutput>(&self.fusion, now).map(|f| f.obstacles.clone()).unwrap_or_default()
             }
-            PlanKind::CrossCountry => fresh::<ObstacleScan<StccdEvent>>(&self.stereo, now)
+            PlanKind::CrossCountry => held::<ObstacleScan<StccdEvent>>(&self.stereo, now)
                 .map(|s| fusion::merge(&[], &s.detections))
                 .unwrap_or_default(),
             _ => Vec::new(),
@@ -443,7 +410,7 @@ impl Agent for Lpl {
 pub struct Drive {
     drive: drive::Drive,
     physics: SharedPhysics,
-    plan: Option<Latest>,
+    plan: Option<Held>,
     fix: Option<Fix>,
     content: Arc<Content>,
 }
@@ -457,7 +424,7 @@ impl Agent for Drive {
     }
     fn step(&mut self, cx: &mut Context<'_>) {
         let now = cx.now();
-        take::<LocalPlan>(cx.inputs(), &mut self.plan);
+        hold::<LocalPlan>(cx.inputs(), &mut self.plan);
         for d in cx.inputs() {
             if let Some(f) = d.body.get::<Fix>() {
                 self.fix = Some(*f);
@@ -466,7 +433,7 @@ impl Agent for Drive {
         let mut p = lock(&self.physics);
         let steer = p.vehicle.state.steer;
         let cmd = match cx.function() {
-            Some("track") => match (fresh::<LocalPlan>(&self.plan, now), self.fix.and_then(|f| f.pose)) {
+            Some("track") => match (held::<LocalPlan>(&self.plan, now), self.fix.and_then(|f| f.pose)) {
                 (Some(plan), Some(pose)) => self.drive.track(&pose, plan),
                 _ => self.drive.halt(steer),
             },
@@ -585,6 +552,54 @@ impl Agent for Recorder {
                 }
             }
         }
+    }
+}
+
+/// Zhang & Zhu's outdoor vehicle (`rules/outdoor.situ`).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Outdoor;
+
+impl Stack for Outdoor {
+    fn name(&self) -> &'static str {
+        "outdoor"
+    }
+    fn title(&self) -> &'static str {
+        "Outdoor"
+    }
+    fn agents(&self) -> &'static [&'static str] {
+        AGENTS
+    }
+    fn known_as(&self) -> String {
+        format!("of rules/outdoor.situ ({})", AGENTS.join(", "))
+    }
+    fn default_scenario(&self) -> &'static str {
+        "outdoor-default"
+    }
+    fn goal_state(&self) -> &'static str {
+        "GL"
+    }
+    /// TeleControl has no `rate` in the rules (it runs in every state with
+    /// no function): its heartbeat TCHB comes at 10 Hz, the rate the rules'
+    /// `stale after 1s` ("10 heartbeats") assumes.
+    fn rates(&self) -> BTreeMap<String, f64> {
+        [("TeleControl".to_string(), 10.0)].into()
+    }
+    /// The Drive's period (50 Hz), so that the steering rate is the rate of
+    /// its commands.
+    fn sample_every(&self) -> u64 {
+        2
+    }
+    fn default_until(&self) -> f64 {
+        600.0
+    }
+    fn agents_for(
+        &self,
+        content: &Arc<Content>,
+        physics: &SharedPhysics,
+        world: &World,
+        seed: u64,
+    ) -> Vec<Box<dyn Agent>> {
+        agents(content, physics, world, seed)
     }
 }
 

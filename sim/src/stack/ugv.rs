@@ -14,27 +14,23 @@
 //!
 //! The multi-agent merge ([`crate::ugv::Merge`]) is `rules/ugv-merge.situ`:
 //! the same agents, the controllers commanding a Merger that alone commands
-//! the Vehicle ([`super::merge`]).
+//! the Vehicle ([`super::merge`], built on this module; this module knows
+//! nothing of it).
 
-use super::events::{report, Named, Plain};
-use super::merge::AvoidCommand;
-use super::{lock, SharedPhysics};
+use super::{lock, SharedPhysics, Stack};
+use crate::agent::{fresh, names, report, take, Named, Plain, Value as SimValue, FRESH};
 use crate::control::{control_law, limit_cycle, target_reaching, ControlInput, Direction, Ellipse, Gains, Target};
 use crate::geom::{wrap_angle, Pose};
 use crate::noise::Noise;
-use crate::sensors::Value as SimValue;
 use crate::ugv::{lidar_scan, reach, select, LidarObstacle, Side, UgvConfig};
 use crate::vehicle::{Command, VehicleParams};
 use crate::world::World;
 use situ_compiler::bundle::Content;
-use situ_runtime::agent::{Agent, Body, Context, Datum};
+use situ_runtime::agent::{Agent, Body, Context};
 use std::sync::Arc;
 
 /// The agents `rules/ugv.situ` declares.
 pub const AGENTS: &[&str] = &["Lidar", "Gps", "Selector", "Reacher", "Avoider", "Vehicle"];
-
-/// Data older than this is not used (ns): 3 GPS periods.
-pub const FRESH: u64 = 300_000_000;
 
 /// Correlation time of the RTK error (s).
 pub const GPS_TAU: f64 = 2.0;
@@ -50,24 +46,11 @@ pub struct GpsFix {
 #[derive(Debug, Clone, PartialEq)]
 pub struct LidarScan(pub Vec<LidarObstacle>);
 
-pub(super) fn names(list: &[&str]) -> Vec<String> {
-    list.iter().map(|s| s.to_string()).collect()
-}
-
-/// The latest datum of type `T` among `inputs`, if newer than `slot`'s.
-pub(super) fn take<T: Clone + 'static>(inputs: &[Datum], slot: &mut Option<(u64, T)>) {
-    for d in inputs {
-        if let Some(v) = d.body.get::<T>() {
-            if slot.as_ref().is_none_or(|(t, _)| d.time >= *t) {
-                *slot = Some((d.time, v.clone()));
-            }
-        }
-    }
-}
-
-pub(super) fn fresh<T>(slot: &Option<(u64, T)>, now: u64) -> Option<&T> {
-    slot.as_ref().filter(|(t, _)| now.saturating_sub(*t) <= FRESH).map(|(_, v)| v)
-}
+/// What the Avoider of `rules/ugv-merge.situ` sends the Merger: the limit
+/// cycle's control inputs while an obstacle hinders, `None` once nothing
+/// does (the Merger then blends target reaching with itself).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AvoidCommand(pub Option<ControlInput>);
 
 /// Lidar.
 pub struct Lidar {
@@ -316,15 +299,68 @@ impl Agent for VehicleAgent {
     }
 }
 
+/// Dafflon et al.'s urban UGV with the hard switch (`rules/ugv.situ`).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Ugv;
+
+/// What the UGV's stacks (the hard switch and the merge) share.
+pub(super) mod common {
+    /// The built-in scenario run by default.
+    pub const SCENARIO: &str = "dafflon-4";
+    /// The state that means "mission done".
+    pub const GOAL: &str = "Reached";
+    /// 20 Hz, the control period of Dafflon et al.'s closed loop
+    /// ([`crate::baseline::ugv::run`]), so that the stacks' figures compare with it.
+    pub const SAMPLE_EVERY: u64 = 5;
+    /// The longest run by default (s).
+    pub const UNTIL: f64 = 120.0;
+}
+
+impl Stack for Ugv {
+    fn name(&self) -> &'static str {
+        "ugv"
+    }
+    fn title(&self) -> &'static str {
+        "Ugv"
+    }
+    fn agents(&self) -> &'static [&'static str] {
+        AGENTS
+    }
+    fn known_as(&self) -> String {
+        format!("of rules/ugv.situ ({})", AGENTS.join(", "))
+    }
+    fn default_scenario(&self) -> &'static str {
+        common::SCENARIO
+    }
+    fn goal_state(&self) -> &'static str {
+        common::GOAL
+    }
+    fn sample_every(&self) -> u64 {
+        common::SAMPLE_EVERY
+    }
+    fn default_until(&self) -> f64 {
+        common::UNTIL
+    }
+    fn agents_for(
+        &self,
+        content: &Arc<Content>,
+        physics: &SharedPhysics,
+        world: &World,
+        seed: u64,
+    ) -> Vec<Box<dyn Agent>> {
+        agents(content, physics, world, seed)
+    }
+}
+
 /// Every agent of `rules/ugv.situ` on a world, with a seed. The target is
 /// the world's goal, with its heading.
 pub fn agents(content: &Arc<Content>, physics: &SharedPhysics, world: &World, seed: u64) -> Vec<Box<dyn Agent>> {
     build(content, physics, world, seed, false)
 }
 
-/// The agents of `rules/ugv.situ`, or (`merge`) those of
-/// `rules/ugv-merge.situ`: the Avoider sends [`AvoidCommand`]s, the Merger
-/// blends, the Vehicle applies its command.
+/// The agents of `rules/ugv.situ`, or (`merge`) those the merge shares
+/// with it: the Avoider then sends [`AvoidCommand`]s, and the Vehicle is
+/// left to [`super::merge`] (with the Merger).
 pub(super) fn build(
     content: &Arc<Content>,
     physics: &SharedPhysics,
@@ -366,14 +402,9 @@ pub(super) fn build(
             turns: 0.0,
             content: c(),
         }),
-        if merge {
-            Box::new(super::merge::Merger::new(cfg, params, c()))
-        } else {
-            Box::new(VehicleAgent { gains: cfg.gains, params, input: None, physics: ph() })
-        },
     ];
-    if merge {
-        agents.push(Box::new(super::merge::VehicleApply::new(ph())));
+    if !merge {
+        agents.push(Box::new(VehicleAgent { gains: cfg.gains, params, input: None, physics: ph() }));
     }
     agents
 }

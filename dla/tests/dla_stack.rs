@@ -16,8 +16,9 @@
 //!   layer alone.
 
 use situ_compiler::bundle::Content;
+use situ_dla::stack::Dla;
 use situ_sim::scenario::{self, Scenario};
-use situ_sim::stack::{Outcome, Recording, RunReport, StackConfig, StackKind, StackRun};
+use situ_sim::stack::{Outcome, Recording, RunReport, StackConfig, StackRun};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -37,15 +38,16 @@ fn offices() -> Scenario {
 
 /// A run, with the DLA counts (routes, re-plans).
 fn run(content: Arc<Content>, scenario: &Scenario, seed: u64, until: f64) -> (RunReport, u64, u64) {
-    let kind = StackKind::of(&content).expect("the DLA stack");
-    assert_eq!(kind, StackKind::Dla);
+    let kind = situ_dla::registry().of(&content).expect("the DLA stack");
+    assert_eq!(kind.name(), situ_dla::stack::NAME);
+    let stack = Arc::new(Dla::default());
     let cfg = StackConfig { seed, until, ..StackConfig::default() };
-    let mut run = StackRun::new(content, kind, &scenario.world, cfg, Recording { mcap: None, sinks: Vec::new() })
-        .expect("every agent bound");
+    let mut run =
+        StackRun::new(content, stack.clone(), &scenario.world, cfg, Recording { mcap: None, sinks: Vec::new() })
+            .expect("every agent bound");
     run.run(&mut |_| {});
-    let plans = run.plans().cloned().expect("DLA's plans");
     let report = run.finish().expect("finished");
-    let p = plans.lock().unwrap();
+    let p = stack.plans().lock().unwrap();
     (report, p.routes, p.replans)
 }
 
@@ -137,15 +139,15 @@ struct Crossings {
     path: f64,
 }
 
-fn crossings(cases: &situ_sim::stack::dla::CasesHandle) -> Crossings {
-    use situ_sim::stack::{dla, experience};
+fn crossings(cases: &situ_dla::stack::SharedCases) -> Crossings {
+    use situ_dla::missions as experience;
     use std::sync::Mutex;
     let content = compile("reactive-only.situ", &reactive_only());
     let field = scenario::builtin("dla-field").expect("built in").world;
     let (mut done, mut hit, mut time, mut path) = (0, 0, 0.0, 0.0);
     for seed in 1..=6 {
         // A copy each time: nothing is learnt, but the base is not shared.
-        let copy = dla::CasesHandle(Arc::new(Mutex::new(cases.0.lock().unwrap().clone())));
+        let copy = Arc::new(Mutex::new(cases.lock().unwrap().clone()));
         let m = experience::mission(&content, &field, 1, seed, 200.0, false, &copy, &mut |_| {}).unwrap();
         done += usize::from(m.done);
         hit += usize::from(m.collision);
@@ -166,11 +168,11 @@ fn the_trained_reactive_layer_crosses_an_unseen_field_and_crosses_it_sooner_with
     // missions of the whole stack in the offices learning on line (the
     // teacher correcting novel, unsafe and standstill cases); each base,
     // alone and learning nothing, tried across the unseen field.
-    use situ_sim::stack::{dla, experience};
+    use situ_dla::{missions as experience, stack as dla};
     use std::sync::Mutex;
     let content = compile("dla.situ", &source());
     let world = offices().world;
-    let cases = dla::CasesHandle(Arc::new(Mutex::new(dla::train(1, dla::TRAINING_SECONDS, dla::NOVELTY))));
+    let cases = Arc::new(Mutex::new(dla::train(1, dla::TRAINING_SECONDS, dla::NOVELTY)));
     let before = crossings(&cases);
     let mut learnt = Vec::new();
     for k in 0..8 {

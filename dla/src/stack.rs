@@ -1,7 +1,7 @@
 //! The agents of `rules/dla.situ` (Pérez 2006, DLA) on the runtime: the
 //! deliberative layer of Poncela et al. (2002) and the case-based reactive
-//! layer of Urdiales et al. (2006), on the building blocks of
-//! [`crate::dla`].
+//! layer of Urdiales et al. (2006), on the building blocks of this crate;
+//! [`Dla`] is the [`Stack`](situ_sim::stack::Stack) that runs them.
 //!
 //! | agent | reads (data) | does | sends |
 //! |---|---|---|---|
@@ -17,24 +17,25 @@
 //! route (a stand-in for the computing time the paper's claim is about:
 //! the robot must not stop meanwhile), so re-planning is visible in a run.
 
-use super::events::{report, Named};
-use super::ugv::{fresh, names, take};
-use super::{lock, SharedPhysics};
-use crate::dla::cases::{self, Case, CaseBase, Command as CaseCommand, DriverParams, Situation};
-use crate::dla::detour::Detour;
-use crate::dla::grid::{Beam, CellClass, GridParams, OccupancyGrid};
-use crate::dla::pyramid::{Pyramid, PyramidParams, RegionClass};
-use crate::dla::route::{plan_path, plan_route, PathParams, RouteParams};
-use crate::geom::{edges, unit, v2, wrap_angle, Pose, Vec2};
-use crate::noise::Noise;
-use crate::sensors::Value as SimValue;
-use crate::vehicle::{Command, VehicleParams};
-use crate::world::{ObstacleView, World};
+use crate::cases::{self, Case, CaseBase, Command as CaseCommand, DriverParams, Situation};
+use crate::detour::Detour;
+use crate::grid::{Beam, CellClass, GridParams, OccupancyGrid};
+use crate::pyramid::{Pyramid, PyramidParams, RegionClass};
+use crate::route::{plan_path, plan_route, PathParams, RouteParams};
 use situ_compiler::bundle::{Content, Mode};
 use situ_runtime::agent::{Agent, Body, Context};
+use situ_sim::agent::{fresh, names, report, take, Named, Value as SimValue};
+use situ_sim::geom::{edges, unit, v2, wrap_angle, Pose, Vec2};
+use situ_sim::noise::Noise;
+use situ_sim::stack::{lock, SharedPhysics};
+use situ_sim::vehicle::{Command, VehicleParams};
+use situ_sim::world::{ObstacleView, World};
 use std::sync::{Arc, Mutex, OnceLock};
 
+mod dla;
 mod reflexes;
+
+pub use dla::{pictures, Dla, NAME};
 
 use reflexes::{reflexes, scan_points, standstill};
 pub use reflexes::{CRAWL, CREEP, STILL_TURN, SWEEP_MARGIN, SWEEP_TIME, TURN_RADIUS, TURN_SWEEP, TURN_TIGHT};
@@ -239,9 +240,9 @@ pub fn train(seed: u64, seconds: f64, novelty: f64) -> Cases {
         views.push(ObstacleView { index, polygon, height: 1.0, center, radius });
     }
     let free = |p: Vec2, views: &[ObstacleView]| {
-        views
-            .iter()
-            .all(|v| !crate::geom::contains(&v.polygon, p) && crate::geom::dist_point_polygon(&v.polygon, p) > 0.4)
+        views.iter().all(|v| {
+            !situ_sim::geom::contains(&v.polygon, p) && situ_sim::geom::dist_point_polygon(&v.polygon, p) > 0.4
+        })
     };
     let pick = |noise: &mut Noise| loop {
         let p = v2(1.0 + 18.0 * noise.uniform(), 1.0 + 18.0 * noise.uniform());
@@ -393,7 +394,8 @@ impl Agent for Mapper {
     }
 }
 
-fn lock_plans(p: &SharedPlans) -> std::sync::MutexGuard<'_, Plans> {
+/// Locks the plans (a poisoned lock is still the truth).
+pub fn lock_plans(p: &SharedPlans) -> std::sync::MutexGuard<'_, Plans> {
     p.lock().unwrap_or_else(|e| e.into_inner())
 }
 
@@ -736,21 +738,4 @@ pub fn agents(
 pub fn region_counts(p: &Pyramid) -> (usize, usize, usize) {
     let count = |c: RegionClass| p.regions().iter().filter(|r| r.class == c).count();
     (count(RegionClass::Free), count(RegionClass::Occupied), count(RegionClass::Unexplored))
-}
-
-/// The case base handed to a run, compared by identity (a [`StackConfig`](super::StackConfig) is).
-#[derive(Clone)]
-pub struct CasesHandle(pub SharedCases);
-
-impl PartialEq for CasesHandle {
-    fn eq(&self, other: &Self) -> bool {
-        Arc::ptr_eq(&self.0, &other.0)
-    }
-}
-
-impl std::fmt::Debug for CasesHandle {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let n = self.0.lock().map_or(0, |c| c.len());
-        write!(f, "CasesHandle({n} cases)")
-    }
 }

@@ -25,7 +25,8 @@ use crate::vehicle::{Command, Vehicle};
 use crate::world::{ObstacleView, World};
 use serde::Serialize;
 
-/// The system states of `rules/outdoor.situ`.
+/// The system states of `rules/outdoor.situ`. (`bench/handwritten` has its
+/// own copy, `repr(u8)`: that benchmark depends on nothing.)
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
 pub enum State {
     /// System initializing.

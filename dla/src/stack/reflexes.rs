@@ -16,10 +16,10 @@
 //!   cannot; otherwise the command becomes a turn on the spot, or a stop.
 
 use super::driver;
-use crate::dla::cases::Command as CaseCommand;
-use crate::dla::grid::Beam;
-use crate::geom::{v2, Pose, Vec2};
-use crate::vehicle::{integrate, VehicleParams};
+use crate::cases::Command as CaseCommand;
+use crate::grid::Beam;
+use situ_sim::geom::{v2, Pose, Vec2};
+use situ_sim::vehicle::{integrate, VehicleParams};
 
 /// How far to the side of the laser (the robot's centre) a turn on the
 /// spot turns about (m): the indoor robot on full lock, 0.2 m / tan 1.2.
@@ -122,9 +122,9 @@ fn turn_side(points: &[Vec2], side: f64, sweep: f64) -> Option<f64> {
     [side, -side].into_iter().find(|&s| turn_clear_within(points, &here, s, sweep))
 }
 
-/// How far ahead (s) [`sweep_clear`] follows a command.
+/// How far ahead (s) `sweep_clear` follows a command.
 pub const SWEEP_TIME: f64 = 0.5;
-/// What the body keeps from every reading in [`sweep_clear`] (m).
+/// What the body keeps from every reading in `sweep_clear` (m).
 pub const SWEEP_MARGIN: f64 = 0.04;
 
 /// Whether the Base driving `c` (as [`Base`] turns it into a speed and a
@@ -167,7 +167,7 @@ fn ahead_clear(points: &[Vec2], reach: f64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::vehicle::VehicleParams;
+    use situ_sim::vehicle::VehicleParams;
 
     /// A flat wall `x` metres ahead, readings every 2 cm across 1.2 m.
     fn wall(x: f64) -> Vec<Vec2> {

@@ -31,7 +31,7 @@
 //! sorting the links between blocks.
 
 use super::grid::{CellClass, OccupancyGrid};
-use crate::geom::{v2, Vec2};
+use situ_sim::geom::{v2, Vec2};
 
 /// The thresholds of the split and merge.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -20,7 +20,7 @@
 //!   seconds) turns to the other side.
 
 use super::cases::Situation;
-use crate::geom::{wrap_angle, Pose, Vec2};
+use situ_sim::geom::{wrap_angle, Pose, Vec2};
 use std::f64::consts::PI;
 
 /// Seconds without progress after which the robot is caught.
@@ -119,7 +119,7 @@ impl Detour {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geom::v2;
+    use situ_sim::geom::v2;
 
     /// Eight sectors, all open but those listed.
     fn ranges(blocked: &[usize]) -> Vec<f64> {

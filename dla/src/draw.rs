@@ -21,7 +21,7 @@
 
 use super::grid::OccupancyGrid;
 use super::pyramid::{Pyramid, RegionClass};
-use crate::geom::Vec2;
+use situ_sim::geom::Vec2;
 use std::fmt::Write;
 
 /// Number of grey shades the occupancy probabilities are quantised to.

@@ -21,8 +21,8 @@
 
 use super::grid::{CellClass, OccupancyGrid};
 use super::pyramid::{Pyramid, RegionClass};
-use crate::geom::Vec2;
 use petgraph::graph::{NodeIndex, UnGraph};
+use situ_sim::geom::Vec2;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 

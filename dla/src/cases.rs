@@ -41,7 +41,7 @@
 
 use super::grid::Beam;
 use super::nearest::Index;
-use crate::geom::wrap_angle;
+use situ_sim::geom::wrap_angle;
 use std::collections::HashSet;
 use std::f64::consts::{PI, TAU};
 use std::fmt;

@@ -11,7 +11,7 @@
 //! Cell `(x, y)` covers `[origin.x + x·cell, origin.x + (x+1)·cell) ×
 //! [origin.y + y·cell, origin.y + (y+1)·cell)`; its index is `y·width + x`.
 
-use crate::geom::{v2, Pose, Vec2};
+use situ_sim::geom::{v2, Pose, Vec2};
 
 /// One range reading: a direction in the robot's frame, the range measured
 /// and the sensor's maximum range (metres). A range at or beyond the maximum

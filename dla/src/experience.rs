@@ -5,11 +5,11 @@
 //! off (no teacher), counted done or not. What each mission gave, the
 //! tables a person reads, and the curve (`experience.svg`, plotters).
 //!
-//! The missions are run elsewhere (`situ run --missions N`, or a test);
+//! The missions are run by [`crate::missions`] (`situ run --missions N`, or a test);
 //! this module only holds and shows their results.
 
-use crate::plot::{err, PlotError};
 use plotters::prelude::*;
+use situ_sim::plot::{err, PlotError};
 use std::fmt::Write;
 
 /// What one mission gave.

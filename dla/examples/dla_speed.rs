@@ -20,16 +20,16 @@
 //! [`CaseBase::learn`] over obstacle-field situations, one learn and one
 //! retrieval per step, as the running stack does.
 //!
-//! `cargo run --release -p situ-sim --example dla_speed`
-//! `cargo run --release -p situ-sim --example dla_speed -- --retrieval`
+//! `cargo run --release -p situ-dla --example dla_speed`
+//! `cargo run --release -p situ-dla --example dla_speed -- --retrieval`
 //! (only the 8-sector retrieval and the on-line learning: no pyramid, no
 //! 4- and 6-sector runs; ~1/3 of the time); `--kiddo` also measures
 //! kiddo 5's incremental and immutable k-d trees on the same cases.
 //! Targets: pyramid < 20 ms, retrieval < 5 µs per query.
 
-use situ_sim::dla::cases::{drive, Case, CaseBase, Command, DriverParams, Situation};
-use situ_sim::dla::grid::{Beam, GridParams, OccupancyGrid};
-use situ_sim::dla::pyramid::{Pyramid, PyramidParams};
+use situ_dla::cases::{drive, Case, CaseBase, Command, DriverParams, Situation};
+use situ_dla::grid::{Beam, GridParams, OccupancyGrid};
+use situ_dla::pyramid::{Pyramid, PyramidParams};
 use situ_sim::geom::{v2, Pose};
 use situ_sim::noise::Noise;
 use std::hint::black_box;
@@ -156,7 +156,7 @@ fn pyramid(truth: &[bool], noise: &mut Noise) {
     }
     let p = last.expect("built");
     let ms = median(times).as_secs_f64() * 1e3;
-    let free_regions = p.regions().iter().filter(|r| r.class == situ_sim::dla::pyramid::RegionClass::Free).count();
+    let free_regions = p.regions().iter().filter(|r| r.class == situ_dla::pyramid::RegionClass::Free).count();
     println!(
         "pyramid: {} levels, {} orphan blocks, {} regions ({} free); median of 15 builds: {ms:.2} ms (target < 20 ms)",
         p.levels(),

@@ -1,10 +1,10 @@
 //! The DLA building blocks: occupancy grid, split-and-merge pyramid and
 //! topological map, route and potential-field path planners, case base.
 
-use situ_sim::dla::cases::{drive, Case, CaseBase, CaseError, Command, DriverParams, Situation};
-use situ_sim::dla::grid::{Beam, CellClass, GridParams, OccupancyGrid};
-use situ_sim::dla::pyramid::{Pyramid, PyramidParams, RegionClass};
-use situ_sim::dla::route::{plan_path, plan_route, PathParams, RouteParams};
+use situ_dla::cases::{drive, Case, CaseBase, CaseError, Command, DriverParams, Situation};
+use situ_dla::grid::{Beam, CellClass, GridParams, OccupancyGrid};
+use situ_dla::pyramid::{Pyramid, PyramidParams, RegionClass};
+use situ_dla::route::{plan_path, plan_route, PathParams, RouteParams};
 use situ_sim::geom::{v2, Pose, Vec2};
 use situ_sim::noise::Noise;
 use std::path::PathBuf;
@@ -681,7 +681,7 @@ fn check_svg(svg: &str) {
 
 #[test]
 fn drawing_of_two_rooms_shows_route_labels_and_path() {
-    use situ_sim::dla::draw::draw;
+    use situ_dla::draw::draw;
     let g = two_rooms(true);
     let p = Pyramid::build(&g, &params(16));
     let (start, goal) = (cell_center(&g, 3, 3), cell_center(&g, 27, 12));
@@ -721,7 +721,7 @@ fn drawing_of_two_rooms_shows_route_labels_and_path() {
 
 #[test]
 fn drawing_of_a_200_by_200_grid_stays_small() {
-    use situ_sim::dla::draw::draw;
+    use situ_dla::draw::draw;
     // Two rooms of 10 × 20 m in walls, a door, boxes, an unexplored strip,
     // and some noise on the free cells' probabilities.
     let mut g = empty(200, 200);
