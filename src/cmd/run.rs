@@ -334,7 +334,7 @@ fn compare(args: &Args, content: Arc<Content>, kind: &dyn Stack, scenario: &Scen
          Selector's events, the rules avoid_ccw/avoid_cw/way_free, only the selected controller linked \
          to the Vehicle) and the merge (ugv-merge.situ: both controllers command the Merger, which \
          blends them (eqs. 16-19) and alone commands the Vehicle); the sim-loop rows are the sim's own \
-         closed loop (situ_sim::ugv::run), for reference. Steering rates are taken at 20 Hz in all."
+         closed loop (situ_sim::baseline::ugv::run), for reference. Steering rates are taken at 20 Hz in all."
     );
     if let Some(out) = &args.out {
         let json = serde_json::to_string_pretty(&table).expect("the table serializes");
