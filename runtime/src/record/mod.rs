@@ -7,7 +7,7 @@
 pub mod mcap;
 
 use crate::rete::StateChange;
-use situ_compiler::bundle::{Mode, Value};
+use situ_bundle::{Mode, Value};
 
 /// What became of an event.
 #[derive(Debug, Clone, PartialEq)]

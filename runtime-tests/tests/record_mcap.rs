@@ -1,11 +1,11 @@
 //! The recording's boundaries: every flush leaves a valid file, a damaged
 //! file is an error and never an abort or a panic, whatever bit is flipped.
 
-use super::read::{attached_bundle, read_recording, MAX_RECORD};
-use super::staged::PROVISIONAL_END;
-use super::{topics, McapRecorder};
-use crate::record::{EventRecord, Sink, Verdict};
 use situ_compiler::bundle::{self, Content, Encoding, Value};
+use situ_runtime::record::mcap::read::{attached_bundle, read_recording, MAX_RECORD};
+use situ_runtime::record::mcap::staged::PROVISIONAL_END;
+use situ_runtime::record::mcap::{topics, McapRecorder};
+use situ_runtime::record::{EventRecord, Sink, Verdict};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -202,7 +202,7 @@ fn a_flipped_bit_anywhere_never_panics_or_aborts() {
                     );
                     // What reads is replayed without a panic too.
                     if at % 16 == 0 {
-                        let _ = crate::replay::replay_reading(&r, c.clone());
+                        let _ = situ_runtime::replay::replay_reading(&r, c.clone());
                     }
                 }
                 Err(e) => {
