@@ -38,7 +38,9 @@ mod resolve;
 pub mod rete;
 pub mod source;
 pub mod spec;
-pub mod suggest;
+
+/// "Did you mean …?" (`situ_bundle::suggest`, shared with the runtime).
+pub use situ_bundle::suggest;
 
 pub use load::RootError;
 pub use loader::Loader;

@@ -1,5 +1,5 @@
 //! Builds the Rete network of a checked model (the format is
-//! [`bundle::Network`](crate::bundle::Network), documented there).
+//! [`situ_bundle::Network`], documented there).
 //!
 //! Each rule becomes one chain of beta nodes, in this order:
 //! 1. a join on the state fact (its guards' intersection minus its target);
@@ -13,8 +13,10 @@
 //! it is the variable's pattern). Identical alpha nodes, and identical beta
 //! nodes under the same parent, are built once.
 
-use crate::bundle::{self, AlphaNode, BetaKind, BetaNode, Check, Cmp, Network, NetworkStats, Operand, Terminal, Test};
 use crate::model::{self, FieldCheck, Model, Pattern, Rule, VarId};
+use situ_bundle::{
+    self as bundle, AlphaNode, BetaKind, BetaNode, Check, Cmp, Network, NetworkStats, Operand, Terminal, Test,
+};
 use situ_grammar::ast::CmpOp;
 use std::collections::HashMap;
 

@@ -3,30 +3,24 @@
 //! so that the runtime's checkers (`situ_verify`) never look at the
 //! model or the AST. Ids are the bundle's: the model's indices, unchanged.
 //!
+//! The data types are `situ_bundle::spec`'s (re-exported here), so that the
+//! runtime reads scripts without the compiler; this module makes them from a
+//! checked program ([`lower`], [`scripts`]). [`TestSpec`] and
+//! [`PropertySpec`] stay here: they keep the block's [`model::Origin`] (a
+//! file of the compiler's source map and a span) for findings about it.
+//!
 //! [`lower`] also computes the timing of a test's events (language reference
 //! §10.9), so that the runtime posts exactly what the reference describes.
 
-use crate::bundle::{self, Mode, Test as FieldTest, Value};
+use crate::bundle;
 use crate::model;
 use crate::{rete, Checked};
 use serde::Serialize;
 
+pub use situ_bundle::spec::*;
+
 /// The spacing of test events without `at` (§10.9).
 pub const TEST_SPACING_NS: u64 = 10_000_000;
-
-/// Where something was written: `file:line:column` (1-based, characters).
-#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
-pub struct Place {
-    pub file: String,
-    pub line: u32,
-    pub column: u32,
-}
-
-impl std::fmt::Display for Place {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}:{}:{}", self.file, self.line, self.column)
-    }
-}
 
 /// Every test and property of a checked program.
 #[derive(Debug, Clone, Serialize)]
@@ -45,57 +39,6 @@ pub struct TestSpec {
     pub steps: Vec<TestStep>,
 }
 
-/// One clause of a test.
-#[derive(Debug, Clone, Serialize)]
-pub enum TestStep {
-    /// Set the state and facts (stamped at 0) without firing rules or FSMs.
-    Given {
-        state: Option<u32>,
-        facts: Vec<GivenFact>,
-    },
-    /// Post these events, in order, at these times.
-    On {
-        events: Vec<Posted>,
-    },
-    Expect {
-        expectations: Vec<Expect>,
-    },
-}
-
-/// A fact set by `given`: the event with run length `run`, at time 0.
-#[derive(Debug, Clone, Serialize)]
-pub struct GivenFact {
-    pub event: u32,
-    pub payload: Vec<Value>,
-    pub run: u64,
-    pub place: Place,
-}
-
-/// One posted event (a test's `E xN` is N of them).
-#[derive(Debug, Clone, Serialize)]
-pub struct Posted {
-    pub event: u32,
-    pub payload: Vec<Value>,
-    /// Nanoseconds from the start of the test.
-    pub time: u64,
-    pub place: Place,
-}
-
-/// One expectation, with where it is written.
-#[derive(Debug, Clone, Serialize)]
-pub struct Expect {
-    pub what: Expected,
-    pub place: Place,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-pub enum Expected {
-    State(u32),
-    Mode { agent: u32, mode: Mode },
-    Runs { agent: u32, function: u32 },
-    Link { from: u32, to: u32, present: bool },
-}
-
 /// A `property` block.
 #[derive(Debug, Clone, Serialize)]
 pub struct PropertySpec {
@@ -107,59 +50,6 @@ pub struct PropertySpec {
     pub never: bool,
     pub premise: Option<Pred>,
     pub consequent: Consequent,
-}
-
-/// What must hold at a point (of the premise, where there is one).
-#[derive(Debug, Clone, Serialize)]
-pub enum Consequent {
-    Now(Pred),
-    Next(Pred),
-    Eventually { pred: Pred, bound: Option<Bound> },
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-pub enum Bound {
-    Events(u64),
-    Nanos(u64),
-}
-
-/// A predicate on the system at one point of a run.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub enum Pred {
-    Or(Vec<Pred>),
-    And(Vec<Pred>),
-    Not(Box<Pred>),
-    Bool(bool),
-    /// The state is one of these (sorted).
-    State(Vec<u32>),
-    Mode {
-        agent: u32,
-        mode: Mode,
-    },
-    Link {
-        from: u32,
-        to: u32,
-    },
-    Stale(u32),
-    /// The latest live fact of the event's agent is this event, passes the
-    /// tests (on its own fields) and has run length `min_run` or more.
-    Event {
-        event: u32,
-        tests: Vec<FieldTest>,
-        min_run: u64,
-    },
-}
-
-impl Pred {
-    /// Calls `f` on this predicate and every predicate inside it.
-    pub fn visit(&self, f: &mut dyn FnMut(&Pred)) {
-        f(self);
-        match self {
-            Pred::Or(ps) | Pred::And(ps) => ps.iter().for_each(|p| p.visit(f)),
-            Pred::Not(p) => p.visit(f),
-            _ => {}
-        }
-    }
 }
 
 impl PropertySpec {
@@ -303,37 +193,6 @@ fn pred(p: &model::Pred) -> Pred {
             Pred::Event { event: pattern.event.0, tests: rete::pattern_alone(pattern), min_run: pattern.run_length }
         }
     }
-}
-
-/// A `script` block in the runtime's terms (`situ run --script`).
-#[derive(Debug, Clone, Serialize)]
-pub struct ScriptSpec {
-    pub name: String,
-    pub place: Place,
-    pub steps: Vec<ScriptStep>,
-    /// When the last step ends (ns from the start of the run).
-    pub end: u64,
-}
-
-/// One step of a script; times in nanoseconds from the start of the run.
-#[derive(Debug, Clone, Serialize)]
-pub enum ScriptStep {
-    /// One event at `time`.
-    At { time: u64, event: ScriptEvent },
-    /// The event at `from`, `from + period`, … while before `to`.
-    Every { period: u64, from: u64, to: u64, event: ScriptEvent },
-    /// The agent reports nothing in `[from, to)`.
-    Silent { agent: u32, from: u64, to: u64, place: Place },
-    /// The guided generator drives every agent in `[from, from + length)`.
-    Random { from: u64, length: u64, seed: u64, place: Place },
-}
-
-/// A concrete event of a script.
-#[derive(Debug, Clone, Serialize)]
-pub struct ScriptEvent {
-    pub event: u32,
-    pub payload: Vec<Value>,
-    pub place: Place,
 }
 
 /// The scripts of a program without errors.

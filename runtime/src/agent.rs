@@ -10,7 +10,7 @@
 //! [`Agent::step`] gets a [`Context`] with the status, the mode, the
 //! function and the inputs, and leaves its outputs and events in it.
 
-use situ_compiler::bundle::{Content, Mode, Value};
+use situ_bundle::{Content, Mode, Value};
 use std::any::Any;
 use std::fmt;
 use std::sync::Arc;
@@ -302,9 +302,9 @@ pub fn bind(content: &Content, agents: Vec<Box<dyn Agent>>, all: bool) -> Result
 }
 
 /// The functions an agent's table or FSM names.
-fn named_functions(a: &situ_compiler::bundle::AgentDef) -> Vec<&str> {
-    use situ_compiler::bundle::Behaviour;
-    let actions: Vec<&situ_compiler::bundle::Action> = match &a.behaviour {
+fn named_functions(a: &situ_bundle::AgentDef) -> Vec<&str> {
+    use situ_bundle::Behaviour;
+    let actions: Vec<&situ_bundle::Action> = match &a.behaviour {
         Behaviour::Always => Vec::new(),
         Behaviour::Table { actions } => actions.iter().flatten().collect(),
         Behaviour::Fsm(f) => f.states.iter().map(|s| &s.action).collect(),

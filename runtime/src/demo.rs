@@ -15,7 +15,7 @@
 //! read.
 
 use crate::agent::{Agent, Body, Context};
-use situ_compiler::bundle::Value;
+use situ_bundle::Value;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 

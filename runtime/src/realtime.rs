@@ -22,7 +22,7 @@ use crate::record::Sink;
 use crate::rete::StateChange;
 use crate::stack::{AgentRunner, BoardRunner, Shared};
 use crate::summary::Summary;
-use situ_compiler::bundle::Content;
+use situ_bundle::Content;
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};

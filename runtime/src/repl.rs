@@ -19,8 +19,8 @@
 use crate::bulletinboard::Bulletinboard;
 use crate::organise::Organisation;
 use crate::rete::{describe_fact, format_time, show_value, StateChange};
-use situ_compiler::bundle::{Content, FieldType, Mode, Value};
-use situ_compiler::suggest::suggest;
+use situ_bundle::suggest::suggest;
+use situ_bundle::{Content, FieldType, Mode, Value};
 use std::fmt::Write as _;
 use std::sync::Arc;
 
@@ -563,6 +563,3 @@ reload                     read the rules again, keep the facts, say what change
 save FILE                  write the session as a `test` block that reproduces it
 help, quit
 ";
-
-#[cfg(test)]
-mod tests;

@@ -19,7 +19,7 @@ use crate::record::mcap::{read_recording, topics, ReadError, Reading};
 use crate::rete::{format_time, Engine};
 use serde::Serialize;
 use serde_json::Value as Json;
-use situ_compiler::bundle::{Content, FieldType, Value};
+use situ_bundle::{Content, FieldType, Value};
 use std::sync::Arc;
 
 /// The channels of situ's own that a replay reads.

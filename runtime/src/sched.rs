@@ -18,7 +18,7 @@ use crate::record::Sink;
 use crate::rete::StateChange;
 use crate::stack::{AgentRunner, BoardRunner, Shared};
 use crate::summary::Summary;
-use situ_compiler::bundle::Content;
+use situ_bundle::Content;
 use std::cmp::Reverse;
 use std::collections::{BTreeMap, BinaryHeap};
 use std::sync::Arc;

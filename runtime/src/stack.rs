@@ -17,7 +17,7 @@ use crate::bus::{Bus, DataMsg, EventMsg, StatusMsg};
 use crate::organise::Organisation;
 use crate::record::{DataRecord, EventRecord, Fate, Level, ModeRecord, Sink, Verdict};
 use crate::rete::{PostError, StateChange};
-use situ_compiler::bundle::{Content, Mode, Value};
+use situ_bundle::{Content, Mode, Value};
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex, RwLock};
 
@@ -412,10 +412,10 @@ impl BoardRunner {
             .fields
             .iter()
             .map(|f| match f.ty {
-                situ_compiler::bundle::FieldType::I64 => Value::I64(lost.min(i64::MAX as u64) as i64),
-                situ_compiler::bundle::FieldType::F64 => Value::F64(lost as f64),
-                situ_compiler::bundle::FieldType::Bool => Value::Bool(true),
-                situ_compiler::bundle::FieldType::Symbols(_) => Value::Symbol(0),
+                situ_bundle::FieldType::I64 => Value::I64(lost.min(i64::MAX as u64) as i64),
+                situ_bundle::FieldType::F64 => Value::F64(lost as f64),
+                situ_bundle::FieldType::Bool => Value::Bool(true),
+                situ_bundle::FieldType::Symbols(_) => Value::Symbol(0),
             })
             .collect()
     }

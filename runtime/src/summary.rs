@@ -6,7 +6,7 @@ use crate::bus::BusCounters;
 use crate::rete::StateChange;
 use crate::stack::{AgentCounters, BoardCounters};
 use serde::Serialize;
-use situ_compiler::bundle::Content;
+use situ_bundle::Content;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 

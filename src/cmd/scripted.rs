@@ -18,7 +18,7 @@ use situ_compiler::loader::FsLoader;
 use situ_compiler::spec::{self, ScriptSpec};
 use situ_runtime::record::mcap::McapRecorder;
 use situ_runtime::record::Sink;
-use situ_runtime::script::wiring::{self, Snapshot};
+use situ_runtime::script::wiring::Snapshot;
 use situ_runtime::script::{chart, Driver, ScriptRun};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -273,7 +273,7 @@ fn write_out(
     visited.dedup();
     for s in visited {
         let svg = match snapshots.get(s as usize).and_then(Option::as_ref) {
-            Some(snap) => super::graph::svg(&wiring::dot(content, snap)),
+            Some(snap) => super::graph::svg(&situ_compiler::graph::wiring_moment(content, &snap.moment())),
             // A state that was at rest only inside one step of the
             // scheduler: its static wiring.
             None => super::graph::svg(&situ_compiler::graph::wiring(content, Some(s))),

@@ -24,8 +24,9 @@ mod wiring;
 
 pub use fsm::possible as fsm_possible;
 pub use rete::rete;
+pub use situ_bundle::Moment;
 pub use states::{bundle_states, states, StateKind};
-pub use wiring::{wiring, wiring_cell, wiring_legend, wiring_moment, Moment};
+pub use wiring::{wiring, wiring_cell, wiring_legend, wiring_moment};
 
 /// A DOT string literal.
 pub(crate) fn q(s: &str) -> String {

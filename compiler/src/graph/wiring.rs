@@ -10,7 +10,7 @@
 
 use super::fsm::all_possible;
 use super::{header, legend, q};
-use crate::bundle::{Behaviour, Content, FsmLink, Mode};
+use crate::bundle::{Behaviour, Content, FsmLink, Mode, Moment};
 use std::fmt::Write as _;
 
 const RUNNING: &str = "style=filled, fillcolor=\"#c8e6c9\", color=\"#1b5e20\"";
@@ -80,15 +80,6 @@ pub fn wiring_cell(c: &Content, s: u32) -> String {
     body(c, s, "", true, &mut out);
     out.push_str("}\n");
     out
-}
-
-/// What a run saw at one moment: the state, every agent's mode and
-/// function, the links of the moment, and a caption (when, and how).
-pub struct Moment<'a> {
-    pub state: u32,
-    pub agents: &'a [(Mode, Option<String>)],
-    pub links: &'a [(u32, u32)],
-    pub caption: String,
 }
 
 /// The wiring a run saw at one moment, drawn as [`wiring`] draws a state:

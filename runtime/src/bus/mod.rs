@@ -24,7 +24,7 @@
 pub mod inproc;
 
 use crate::agent::Body;
-use situ_compiler::bundle::Value;
+use situ_bundle::Value;
 use std::time::Instant;
 
 /// An event on its way to the Bulletinboard.

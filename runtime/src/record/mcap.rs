@@ -34,7 +34,7 @@ use super::{DataRecord, EventRecord, Level, ModeRecord, Sink, Verdict};
 use crate::rete::{describe_fact, format_time, MatchedFact, StateChange};
 use mcap::records::MessageHeader;
 use serde_json::{json, Value as Json};
-use situ_compiler::bundle::{Content, FieldType, Value};
+use situ_bundle::{Content, FieldType, Value};
 use staged::Staged;
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -46,8 +46,6 @@ use std::time::{Duration, Instant};
 
 pub mod read;
 pub mod staged;
-#[cfg(test)]
-mod tests;
 
 pub use read::{attached_bundle, read_file, read_messages, read_recording, read_topics, FileError, ReadError, Reading};
 

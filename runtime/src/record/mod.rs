@@ -13,7 +13,7 @@ pub mod mcap;
 pub mod timeline;
 
 use crate::rete::StateChange;
-use situ_compiler::bundle::{Mode, Value};
+use situ_bundle::{Mode, Value};
 
 /// What became of an event.
 #[derive(Debug, Clone, PartialEq)]

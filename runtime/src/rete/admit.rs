@@ -5,7 +5,7 @@
 
 use super::net::Kind;
 use super::{Engine, PostError};
-use situ_compiler::bundle::Value;
+use situ_bundle::Value;
 
 impl Engine {
     /// How far ahead of the clock it arrives at an event may be stamped

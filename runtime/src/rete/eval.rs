@@ -2,7 +2,7 @@
 //! integer compares with a float by exact numeric value, NaN satisfies no
 //! comparison (not even `!=`), symbols and booleans only (in)equality.
 
-use situ_compiler::bundle::{Check, Cmp, Operand, Test, Value};
+use situ_bundle::{Check, Cmp, Operand, Test, Value};
 use std::cmp::Ordering;
 
 /// `a op b`.

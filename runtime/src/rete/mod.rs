@@ -34,7 +34,7 @@ mod net;
 mod report;
 
 use net::{AlphaKind, Net, OperandRt, TestKind, TestRt, NONE};
-use situ_compiler::bundle::{Content, Value};
+use situ_bundle::{Content, Value};
 use std::sync::Arc;
 
 pub use eval::{compare, in_range, passes, passes_with};
@@ -806,6 +806,3 @@ struct FactRec {
     run: u64,
     values: (u32, u32),
 }
-
-#[cfg(test)]
-mod tests;

@@ -2,7 +2,7 @@
 //! arrays indexed by node, with the successor lists precomputed, so that an
 //! event touches only the nodes of its own event and the chains below them.
 
-use situ_compiler::bundle::{AlphaNode, BetaKind, Check, Cmp, Content, Operand, Value};
+use situ_bundle::{AlphaNode, BetaKind, Check, Cmp, Content, Operand, Value};
 
 /// No node, no event.
 pub const NONE: u32 = u32::MAX;
@@ -137,7 +137,7 @@ fn range(start: usize, end: usize) -> (u32, u32) {
 
 impl Net {
     /// The dense form of a validated bundle (see
-    /// `situ_compiler::bundle::codec::validate`: every index is in range).
+    /// `situ_bundle::codec::validate`: every index is in range).
     pub fn new(c: &Content) -> Net {
         let na = c.agents.len();
         let ne = c.events.len();
@@ -320,10 +320,10 @@ impl Net {
         for e in &c.events {
             let s = kinds.len();
             kinds.extend(e.fields.iter().map(|f| match &f.ty {
-                situ_compiler::bundle::FieldType::F64 => Kind::F64,
-                situ_compiler::bundle::FieldType::I64 => Kind::I64,
-                situ_compiler::bundle::FieldType::Bool => Kind::Bool,
-                situ_compiler::bundle::FieldType::Symbols(s) => Kind::Symbol(s.len() as u32),
+                situ_bundle::FieldType::F64 => Kind::F64,
+                situ_bundle::FieldType::I64 => Kind::I64,
+                situ_bundle::FieldType::Bool => Kind::Bool,
+                situ_bundle::FieldType::Symbols(s) => Kind::Symbol(s.len() as u32),
             }));
             event_kinds.push(range(s, kinds.len()));
         }
@@ -370,7 +370,7 @@ fn operand(o: &Operand) -> OperandRt {
     }
 }
 
-fn test(t: &situ_compiler::bundle::Test) -> TestRt {
+fn test(t: &situ_bundle::Test) -> TestRt {
     let kind = match &t.check {
         Check::Compare { op, rhs } => TestKind::Compare { op: *op, rhs: operand(rhs) },
         Check::Range { lo, hi, inclusive } => {

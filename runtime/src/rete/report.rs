@@ -2,7 +2,7 @@
 //! step and their explanation in source terms, why an event was refused,
 //! and values and times as situ writes them.
 
-use situ_compiler::bundle::{Content, FieldType, Value};
+use situ_bundle::{Content, FieldType, Value};
 
 /// A fact as matched by a firing, for explanations.
 #[derive(Debug, Clone, PartialEq)]

@@ -6,7 +6,7 @@
 //! the same bytes.
 
 use super::report::Tracked;
-use situ_compiler::bundle::{Content, Mode};
+use situ_bundle::{Content, Mode};
 use std::fmt::Write as _;
 
 const WIDTH: f64 = 1200.0;

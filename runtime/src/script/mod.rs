@@ -34,8 +34,8 @@ use crate::record::{Sink, Tee};
 use crate::sched::{SimConfig, SimRuntime};
 use explore::Explorer;
 use report::{agent_times, ScriptReport, Track};
-use situ_compiler::bundle::Content;
-use situ_compiler::spec::ScriptSpec;
+use situ_bundle::spec::ScriptSpec;
+use situ_bundle::Content;
 use standin::{Inbox, StandIn};
 use std::sync::Arc;
 use timeline::{Due, Timeline};
@@ -293,7 +293,7 @@ impl ScriptRun {
             .collect();
         Ok(ScriptReport {
             rules: self.content.source.clone(),
-            bundle_sha256: situ_compiler::bundle::codec::content_sha256(&self.content),
+            bundle_sha256: situ_bundle::codec::content_sha256(&self.content),
             driver: self.driver.clone(),
             ended,
             problems: tracked.problems.iter().map(|(t, p)| format!("{:.3} s: {p}", *t as f64 * 1e-9)).collect(),

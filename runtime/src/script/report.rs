@@ -7,7 +7,7 @@ use crate::record::{DataRecord, EventRecord, Level, ModeRecord, Sink};
 use crate::rete::StateChange;
 use crate::summary::Summary;
 use serde::Serialize;
-use situ_compiler::bundle::{Content, Mode};
+use situ_bundle::{Content, Mode};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::sync::{Arc, Mutex};

@@ -6,7 +6,7 @@
 //! script has due now.
 
 use crate::agent::{Agent, Body, Context};
-use situ_compiler::bundle::{Content, Mode, Value};
+use situ_bundle::{Content, Mode, Value};
 use std::collections::VecDeque;
 use std::sync::{Arc, Mutex};
 

@@ -1,15 +1,15 @@
 //! The wiring of a state as a run saw it (`wiring-STATE.svg` of `situ run
 //! --out`): every agent with the mode and function it had when the state
 //! first came to rest (FSMs included: what their history made of them),
-//! the links of that moment, a title and a legend. Written as DOT by the
-//! compiler's wiring writer and laid out by the command line with the
+//! the links of that moment, a title and a legend. Drawn from
+//! [`Snapshot::moment`] as DOT by the compiler's wiring writer
+//! (`situ_compiler::graph::wiring_moment`) and laid out by the command line with the
 //! layout of `situ graph` (Graphviz when installed, else the built-in one),
 //! so that the run's pictures and `situ graph`'s are one renderer.
 //! Deterministic.
 
 use crate::organise::Organisation;
-use situ_compiler::bundle::{Content, Mode};
-use situ_compiler::graph::Moment;
+use situ_bundle::{Mode, Moment};
 
 /// The organisation at one moment.
 #[derive(Debug, Clone, PartialEq)]
@@ -33,15 +33,12 @@ impl Snapshot {
             links: org.links(),
         }
     }
-}
 
-/// The DOT of a snapshot, written by the compiler's wiring writer (the
-/// styles, title and legend of `situ graph --view wiring`); the command
-/// line lays it out as it lays out `situ graph`'s pictures.
-pub fn dot(content: &Content, snap: &Snapshot) -> String {
-    let caption = format!("as the run first saw it, at {:.3} s", snap.time as f64 * 1e-9);
-    situ_compiler::graph::wiring_moment(
-        content,
-        &Moment { state: snap.state, agents: &snap.agents, links: &snap.links, caption },
-    )
+    /// The snapshot as the compiler's wiring writer draws it
+    /// (`situ_compiler::graph::wiring_moment`: the styles, title and legend
+    /// of `situ graph --view wiring`), captioned with when the run saw it.
+    pub fn moment(&self) -> Moment<'_> {
+        let caption = format!("as the run first saw it, at {:.3} s", self.time as f64 * 1e-9);
+        Moment { state: self.state, agents: &self.agents, links: &self.links, caption }
+    }
 }

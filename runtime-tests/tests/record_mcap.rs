@@ -1,11 +1,11 @@
 //! The recording's boundaries: every flush leaves a valid file, a damaged
 //! file is an error and never an abort or a panic, whatever bit is flipped.
 
-use super::read::{attached_bundle, read_recording, ReadError, MAX_RECORD};
-use super::staged::PROVISIONAL_END;
-use super::{topics, McapRecorder};
-use crate::record::{EventRecord, Sink, Verdict};
 use situ_compiler::bundle::{self, Content, Encoding, Value};
+use situ_runtime::record::mcap::read::{attached_bundle, read_recording, ReadError, MAX_RECORD};
+use situ_runtime::record::mcap::staged::PROVISIONAL_END;
+use situ_runtime::record::mcap::{topics, McapRecorder};
+use situ_runtime::record::{EventRecord, Sink, Verdict};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -207,7 +207,7 @@ fn a_flipped_bit_anywhere_never_panics_or_aborts() {
                     );
                     // What reads is replayed without a panic too.
                     if at % 16 == 0 {
-                        let _ = crate::replay::replay_reading(&r, c.clone());
+                        let _ = situ_runtime::replay::replay_reading(&r, c.clone());
                     }
                 }
                 Err(e) => {
@@ -225,7 +225,8 @@ fn a_flipped_bit_anywhere_never_panics_or_aborts() {
 /// anything of situ's; what is not a recording file says so too.
 #[test]
 fn replay_and_file_errors_are_typed() {
-    use crate::replay::{replay, ReplayError};
+    use situ_runtime::record::mcap::read::{read_file, FileError};
+    use situ_runtime::replay::{replay, ReplayError};
     let c = content();
     assert_eq!(replay(b"not a recording", c.clone()).unwrap_err(), ReplayError::Read(ReadError::NotMcap));
     match replay(::mcap::MAGIC, c.clone()).unwrap_err() {
@@ -233,9 +234,9 @@ fn replay_and_file_errors_are_typed() {
         e => panic!("{e}"),
     }
     let dir = tempfile::tempdir().unwrap();
-    let e = super::read_file(dir.path()).unwrap_err();
-    assert!(matches!(e, super::FileError::NotAFile), "{e}");
+    let e = read_file(dir.path()).unwrap_err();
+    assert!(matches!(e, FileError::NotAFile), "{e}");
     assert_eq!(e.to_string(), "not a regular file: a recording is a file");
-    let e = super::read_file(&dir.path().join("missing.mcap")).unwrap_err();
-    assert!(matches!(e, super::FileError::Io(_)) && e.to_string().starts_with("cannot read it: "), "{e}");
+    let e = read_file(&dir.path().join("missing.mcap")).unwrap_err();
+    assert!(matches!(e, FileError::Io(_)) && e.to_string().starts_with("cannot read it: "), "{e}");
 }

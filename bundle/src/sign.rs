@@ -3,7 +3,7 @@
 //! The envelope's SHA-256 guards against damage; anyone who edits a bundle
 //! can recompute it. A signed bundle also carries an ed25519 signature
 //! (`signature: {key_id, ed25519}` in JSON, a trailer in binary, see
-//! [`super::codec`]) over [`message`]: the format's identity and the
+//! [`crate::codec`]) over [`message`]: the format's identity and the
 //! content hash of the envelope. It is checked after the envelope's own
 //! checks (format, version, hash, indexes), so a bundle that fails them is
 //! refused for that first; then [`verify`] tells a bundle signed by a
@@ -13,64 +13,22 @@
 //! Keys are text files with a header line ([`SECRET_HEADER`],
 //! [`PUBLIC_HEADER`]) and `field: value` lines; a key's id is the first
 //! [`KEY_ID_BYTES`] bytes of the SHA-256 of its public key, in hex. Nothing
-//! here reads or writes a file, or draws randomness: `situ key new` hands
+//! here reads or writes a file, or draws randomness: [`crate::key::create`] hands
 //! [`SecretKey::from_seed`] 32 bytes from the operating system.
 
-use super::codec::{self, Decoded, Encoding, LoadError};
-use super::{Content, FORMAT_NAME, FORMAT_VERSION};
+use crate::codec::{self, Decoded, Encoding, LoadError};
+use crate::signature::{hex, unhex};
+pub use crate::signature::{KeyId, Signature, KEY_ID_BYTES};
+use crate::{Content, FORMAT_NAME, FORMAT_VERSION};
 use ed25519_dalek::{Signer, SigningKey, VerifyingKey};
-use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::fmt;
-
-/// How many bytes of the public key's SHA-256 make its id.
-pub const KEY_ID_BYTES: usize = 8;
 
 /// The first line of a secret key file.
 pub const SECRET_HEADER: &str = "situ ed25519 secret key v1";
 
 /// The first line of a public key file.
 pub const PUBLIC_HEADER: &str = "situ ed25519 public key v1";
-
-/// The id of a key: the first bytes of the SHA-256 of its public key.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct KeyId(pub [u8; KEY_ID_BYTES]);
-
-impl fmt::Display for KeyId {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&hex(&self.0))
-    }
-}
-
-/// A bundle's signature: the key that made it and the ed25519 signature of
-/// [`message`].
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Signature {
-    pub key_id: KeyId,
-    pub ed25519: [u8; 64],
-}
-
-/// The signature as the JSON envelope writes it: hex strings.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub(crate) struct SignatureJson {
-    pub key_id: String,
-    pub ed25519: String,
-}
-
-impl Signature {
-    pub(crate) fn to_json(&self) -> SignatureJson {
-        SignatureJson { key_id: self.key_id.to_string(), ed25519: hex(&self.ed25519) }
-    }
-
-    /// The signature of a JSON envelope; the error says which field is
-    /// malformed.
-    pub(crate) fn from_json(s: &SignatureJson) -> Result<Signature, String> {
-        let key_id = unhex::<KEY_ID_BYTES>(&s.key_id)
-            .ok_or_else(|| format!("`signature.key_id` is not {} hex digits", 2 * KEY_ID_BYTES))?;
-        let ed25519 = unhex::<64>(&s.ed25519).ok_or("`signature.ed25519` is not 128 hex digits")?;
-        Ok(Signature { key_id: KeyId(key_id), ed25519 })
-    }
-}
 
 /// A secret (signing) key. Its `Debug` shows only its id.
 #[derive(Clone)]
@@ -86,17 +44,10 @@ impl fmt::Debug for SecretKey {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PublicKey(VerifyingKey);
 
-/// Why a key file is refused.
-#[derive(Debug, Clone, PartialEq, Eq)]
+/// Why a key file's text is refused (the message says what is wrong).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
 pub struct KeyError(pub String);
-
-impl fmt::Display for KeyError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for KeyError {}
 
 impl SecretKey {
     /// The key of a 32-byte seed (from a good random source).
@@ -240,46 +191,31 @@ pub fn encode_signed(content: &Content, encoding: Encoding, key: &SecretKey) -> 
 }
 
 /// Why a bundle is not trusted.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum TrustError {
     /// Not a bundle that loads at all (damaged, edited without re-hashing…).
-    Load(LoadError),
+    #[error(transparent)]
+    Load(#[from] LoadError),
     /// A bundle without a signature.
+    #[error(
+        "the bundle is not signed, and only bundles signed by a trusted key ({}) are accepted: sign it with `situ build --sign KEY`",
+        ids(trusted)
+    )]
     Unsigned { trusted: Vec<KeyId> },
     /// Signed by a key that is not trusted.
+    #[error("the bundle is signed by key {key_id}, which is not trusted (trusted: {})", ids(trusted))]
     Untrusted { key_id: KeyId, trusted: Vec<KeyId> },
     /// Says it is signed by a trusted key, but the signature does not verify:
     /// the bundle was changed after it was signed.
+    #[error(
+        "the bundle's signature by key {key_id} does not verify: it was changed after it was signed; rebuild and sign it again"
+    )]
     BadSignature { key_id: KeyId },
 }
 
 fn ids(keys: &[KeyId]) -> String {
     keys.iter().map(KeyId::to_string).collect::<Vec<_>>().join(", ")
 }
-
-impl fmt::Display for TrustError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            TrustError::Load(e) => e.fmt(f),
-            TrustError::Unsigned { trusted } => write!(
-                f,
-                "the bundle is not signed, and only bundles signed by a trusted key ({}) are accepted: sign it with `situ build --sign KEY`",
-                ids(trusted)
-            ),
-            TrustError::Untrusted { key_id, trusted } => write!(
-                f,
-                "the bundle is signed by key {key_id}, which is not trusted (trusted: {})",
-                ids(trusted)
-            ),
-            TrustError::BadSignature { key_id } => write!(
-                f,
-                "the bundle's signature by key {key_id} does not verify: it was changed after it was signed; rebuild and sign it again"
-            ),
-        }
-    }
-}
-
-impl std::error::Error for TrustError {}
 
 /// Checks the signature of a decoded bundle against the trusted keys; the
 /// id of the key that signed it.
@@ -306,22 +242,6 @@ pub fn decode_trusted(bytes: &[u8], trusted: &[PublicKey]) -> Result<(Content, K
     Ok((decoded.content, key_id))
 }
 
-fn hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02x}")).collect()
-}
-
-fn unhex<const N: usize>(text: &str) -> Option<[u8; N]> {
-    let text = text.trim();
-    if text.len() != 2 * N || !text.is_ascii() {
-        return None;
-    }
-    let mut out = [0u8; N];
-    for (i, byte) in out.iter_mut().enumerate() {
-        *byte = u8::from_str_radix(&text[2 * i..2 * i + 2], 16).ok()?;
-    }
-    Some(out)
-}
-
 /// A name or a line from a file, safe to print on one line.
 fn one_line(s: &str) -> String {
     s.chars().filter(|c| !c.is_control()).take(80).collect()
@@ -331,99 +251,8 @@ fn one_line(s: &str) -> String {
 mod tests {
     use super::*;
 
-    const RULES: &str = include_str!("../../../examples/fig5/fig5.situ");
-
-    fn content() -> Content {
-        let checked = crate::check_source("fig5.situ", RULES);
-        assert_eq!(checked.errors(), 0, "{:?}", checked.diagnostics);
-        super::super::build(&checked)
-    }
-
     fn key(n: u8) -> SecretKey {
         SecretKey::from_seed(&[n; 32])
-    }
-
-    #[test]
-    fn a_signed_bundle_verifies_with_its_key_in_both_encodings() {
-        let c = content();
-        for enc in [Encoding::Json, Encoding::Binary] {
-            let bytes = encode_signed(&c, enc, &key(1));
-            let (back, id) = decode_trusted(&bytes, &[key(2).public(), key(1).public()]).expect("trusted");
-            assert_eq!(back, c, "{enc:?}");
-            assert_eq!(id, key(1).key_id());
-            // Without trust it loads as any bundle does.
-            assert_eq!(codec::decode(&bytes).expect("loads"), c);
-        }
-    }
-
-    #[test]
-    fn an_edited_bundle_with_a_recomputed_hash_is_refused_naming_the_key() {
-        let c = content();
-        let text = String::from_utf8(encode_signed(&c, Encoding::Json, &key(1))).unwrap();
-        let envelope: serde_json::Value = serde_json::from_str(&text).unwrap();
-        let old = envelope["sha256"].as_str().unwrap().to_string();
-        // Move the threshold, then put the hash of the new content in place.
-        let start = text.find("\"content\":").unwrap() + "\"content\":".len();
-        let body = &text[start..text.rfind('}').unwrap()];
-        let edited_body = body.replacen("30.0", "3.0", 1);
-        assert_ne!(edited_body, body);
-        let new = codec::sha256_hex(edited_body.as_bytes());
-        let edited = text.replacen(body, &edited_body, 1).replacen(&old, &new, 1);
-        // The envelope alone accepts it: the hash is right.
-        let decoded = codec::decode_envelope(edited.as_bytes()).expect("the hash matches");
-        assert_ne!(decoded.content, c);
-        let err = decode_trusted(edited.as_bytes(), &[key(1).public()]).unwrap_err();
-        assert_eq!(err, TrustError::BadSignature { key_id: key(1).key_id() });
-        assert!(err.to_string().contains(&key(1).key_id().to_string()), "{err}");
-    }
-
-    #[test]
-    fn a_bundle_signed_by_another_key_is_refused() {
-        let bytes = encode_signed(&content(), Encoding::Binary, &key(3));
-        let err = decode_trusted(&bytes, &[key(1).public()]).unwrap_err();
-        assert_eq!(err, TrustError::Untrusted { key_id: key(3).key_id(), trusted: vec![key(1).key_id()] });
-        let text = err.to_string();
-        assert!(text.contains(&key(3).key_id().to_string()) && text.contains(&key(1).key_id().to_string()));
-    }
-
-    #[test]
-    fn a_signature_claiming_a_trusted_key_but_made_by_another_is_refused() {
-        // Signed by key 3, relabelled as key 1's.
-        let c = content();
-        let mut bytes = encode_signed(&c, Encoding::Binary, &key(3));
-        let at = bytes.len() - 64 - KEY_ID_BYTES;
-        bytes[at..at + KEY_ID_BYTES].copy_from_slice(&key(1).key_id().0);
-        let err = decode_trusted(&bytes, &[key(1).public()]).unwrap_err();
-        assert_eq!(err, TrustError::BadSignature { key_id: key(1).key_id() });
-    }
-
-    #[test]
-    fn an_unsigned_bundle_is_refused_under_trust_and_loads_without() {
-        let c = content();
-        for enc in [Encoding::Json, Encoding::Binary] {
-            let bytes = codec::encode(&c, enc);
-            let err = decode_trusted(&bytes, &[key(1).public()]).unwrap_err();
-            assert_eq!(err, TrustError::Unsigned { trusted: vec![key(1).key_id()] });
-            assert!(err.to_string().contains(&key(1).key_id().to_string()));
-            assert_eq!(codec::decode(&bytes).expect("loads"), c);
-        }
-    }
-
-    #[test]
-    fn a_damaged_signed_bundle_is_refused_for_its_damage_first() {
-        let mut bytes = encode_signed(&content(), Encoding::Binary, &key(1));
-        let at = bytes.len() - 64 - KEY_ID_BYTES - 8 - 1;
-        bytes[at] ^= 1; // the last content byte
-        let err = decode_trusted(&bytes, &[key(1).public()]).unwrap_err();
-        assert!(matches!(err, TrustError::Load(LoadError::Modified { .. })), "{err:?}");
-    }
-
-    #[test]
-    fn a_malformed_signature_field_is_damage() {
-        let text = String::from_utf8(encode_signed(&content(), Encoding::Json, &key(1))).unwrap();
-        let id = key(1).key_id().to_string();
-        let broken = text.replacen(&id, "not-hex", 1);
-        assert!(matches!(codec::decode(broken.as_bytes()), Err(LoadError::Damaged { .. })));
     }
 
     #[test]

@@ -8,7 +8,7 @@
 //!    scheduler runs them: from the broadcast to the last agent seeing it,
 //!    p50 / p99 / max, over 10,000 broadcasts.
 //!
-//! `cargo run --release -p situ-runtime --example stack_bench`
+//! `cargo run --release -p situ-runtime-tests --example stack_bench`
 
 use situ_compiler::bundle::Content;
 use situ_runtime::agent::{self, Agent, Body, Context};

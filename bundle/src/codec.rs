@@ -2,13 +2,13 @@
 //! make a damaged file an error that says what is wrong, never a panic and
 //! never a half-read network.
 //!
-//! - **JSON** (the default): the envelope of [`super`]'s documentation, with
+//! - **JSON** (the default): the envelope of [crate]'s documentation, with
 //!   the content pretty-printed, for people and diffs.
 //! - **Binary** (`situ build --binary`): `SITUBNDL`, the format version
 //!   (u32 LE), the content length (u64 LE), the SHA-256 of the content, the
 //!   compiler version (u32 LE length, UTF-8), then the content in postcard.
 //!
-//! A signed bundle ([`super::sign`]) has a `signature` field after `sha256`
+//! A signed bundle ([`crate::sign`]) has a `signature` field after `sha256`
 //! in JSON (`{"key_id": HEX, "ed25519": HEX}`), and in binary a trailer
 //! after the content: `SITUSIG1`, the key id (8 bytes), the signature (64
 //! bytes). Unsigned bundles are as before, and still load.
@@ -18,14 +18,13 @@
 //! is the recorded one, that the content decodes, and that every index in it
 //! is in range ([`validate`]). Each failure is its own [`LoadError`]. A
 //! signature is only read here (a malformed one is damage); whether it is
-//! trusted is [`super::sign::verify`]'s question.
+//! trusted is [`crate::sign::verify`]'s question.
 
-use super::sign::{KeyId, Signature, SignatureJson, KEY_ID_BYTES};
-use super::{Content, FORMAT_NAME, FORMAT_VERSION};
+use crate::signature::{KeyId, Signature, SignatureJson, KEY_ID_BYTES};
+use crate::{Content, FORMAT_NAME, FORMAT_VERSION};
 use serde::{Deserialize, Serialize};
 use serde_json::value::RawValue;
 use sha2::{Digest, Sha256};
-use std::fmt;
 
 /// How a bundle is written.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -44,48 +43,42 @@ const SIGNATURE_TRAILER: usize = 8 + KEY_ID_BYTES + 64;
 pub const COMPILER_VERSION: &str = env!("CARGO_PKG_VERSION");
 
 /// Why a file is not a bundle this runtime can load.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum LoadError {
     /// Not a situ bundle at all (another kind of file).
+    #[error("not a situ bundle: {reason}")]
     NotABundle { reason: String },
     /// A bundle cut short: the file ends before the content does.
+    #[error("the bundle is truncated: {reason}")]
     Truncated { reason: String },
     /// A bundle whose JSON was damaged (invalid JSON inside).
+    #[error("the bundle is damaged: {reason}")]
     Damaged { reason: String },
     /// Written by a newer situ, in a format this one does not know.
+    #[error(
+        "the bundle has format version {found} (written by situ {compiler}); this situ reads version {supported}: upgrade situ or rebuild the bundle"
+    )]
     NewerFormat { found: u32, supported: u32, compiler: String },
     /// Written by an older situ, in a format this one no longer reads.
+    #[error(
+        "the bundle has format version {found} (written by situ {compiler}); this situ reads version {supported}: rebuild it with `situ build`"
+    )]
     OlderFormat { found: u32, supported: u32, compiler: String },
     /// The content is not the one that was hashed: it was edited.
+    #[error(
+        "the bundle was modified after it was built: its content hashes to {found}, not to the recorded {expected}; rebuild it with `situ build`"
+    )]
     Modified { expected: String, found: String },
     /// The hash matches but the content is not a valid bundle of this format.
+    #[error("the bundle is invalid: {reason}")]
     Invalid { reason: String },
 }
 
-impl fmt::Display for LoadError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            LoadError::NotABundle { reason } => write!(f, "not a situ bundle: {reason}"),
-            LoadError::Truncated { reason } => write!(f, "the bundle is truncated: {reason}"),
-            LoadError::Damaged { reason } => write!(f, "the bundle is damaged: {reason}"),
-            LoadError::NewerFormat { found, supported, compiler } => write!(
-                f,
-                "the bundle has format version {found} (written by situ {compiler}); this situ reads version {supported}: upgrade situ or rebuild the bundle"
-            ),
-            LoadError::OlderFormat { found, supported, compiler } => write!(
-                f,
-                "the bundle has format version {found} (written by situ {compiler}); this situ reads version {supported}: rebuild it with `situ build`"
-            ),
-            LoadError::Modified { expected, found } => write!(
-                f,
-                "the bundle was modified after it was built: its content hashes to {found}, not to the recorded {expected}; rebuild it with `situ build`"
-            ),
-            LoadError::Invalid { reason } => write!(f, "the bundle is invalid: {reason}"),
-        }
-    }
-}
-
-impl std::error::Error for LoadError {}
+/// Why a content is not a valid bundle of this format ([`validate`]): an
+/// index out of range or a value that does not fit its field, said in words.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct Invalid(pub String);
 
 #[derive(Serialize)]
 struct EnvelopeOut<'a> {
@@ -127,7 +120,7 @@ pub fn encode(content: &Content, encoding: Encoding) -> Vec<u8> {
 }
 
 /// The file bytes of a bundle, signed by `sign` (given the content hash)
-/// when there is one ([`super::sign::encode_signed`]).
+/// when there is one ([`crate::sign::encode_signed`]).
 pub(crate) fn encode_with(content: &Content, encoding: Encoding, sign: Option<&dyn Fn(&str) -> Signature>) -> Vec<u8> {
     match encoding {
         Encoding::Json => {
@@ -183,7 +176,7 @@ pub struct Decoded {
 }
 
 /// [`decode`], keeping the envelope's hash and signature (for
-/// [`super::sign::verify`]).
+/// [`crate::sign::verify`]).
 pub fn decode_envelope(bytes: &[u8]) -> Result<Decoded, LoadError> {
     let decoded = if bytes.starts_with(MAGIC) {
         decode_binary(&bytes[MAGIC.len()..])?
@@ -192,7 +185,7 @@ pub fn decode_envelope(bytes: &[u8]) -> Result<Decoded, LoadError> {
     } else {
         decode_json(bytes)?
     };
-    validate(&decoded.content).map_err(|reason| LoadError::Invalid { reason })?;
+    validate(&decoded.content).map_err(|Invalid(reason)| LoadError::Invalid { reason })?;
     Ok(decoded)
 }
 
@@ -300,7 +293,11 @@ fn decode_binary(bytes: &[u8]) -> Result<Decoded, LoadError> {
 
 /// Checks that every index of the content points at something, and that
 /// values fit their fields: what a runtime relies on to never panic.
-pub fn validate(c: &Content) -> Result<(), String> {
+pub fn validate(c: &Content) -> Result<(), Invalid> {
+    check_indexes(c).map_err(Invalid)
+}
+
+fn check_indexes(c: &Content) -> Result<(), String> {
     let (ns, na, ne) = (c.states.len(), c.agents.len(), c.events.len());
     let idx = |what: &str, i: u32, n: usize| {
         if (i as usize) < n {
@@ -324,12 +321,12 @@ pub fn validate(c: &Content) -> Result<(), String> {
     }
     for a in &c.agents {
         if let Some(hz) = a.rate_hz {
-            if !super::rate_in_range(hz) {
+            if !crate::rate_in_range(hz) {
                 return Err(format!(
                     "agent `{}` has rate {hz} Hz (a rate must be between {} and {} Hz)",
                     a.name,
-                    super::MIN_RATE_HZ,
-                    super::MAX_RATE_HZ
+                    crate::MIN_RATE_HZ,
+                    crate::MAX_RATE_HZ
                 ));
             }
         }
@@ -337,7 +334,7 @@ pub fn validate(c: &Content) -> Result<(), String> {
             idx(&format!("an event of agent `{}`: event", a.name), e, ne)?;
         }
         let nf = a.functions.len();
-        let action = |act: &super::Action| -> Result<(), String> {
+        let action = |act: &crate::Action| -> Result<(), String> {
             if let Some(f) = act.function {
                 idx(&format!("a function of agent `{}`: function", a.name), f, nf)?;
             }
@@ -347,22 +344,22 @@ pub fn validate(c: &Content) -> Result<(), String> {
             Ok(())
         };
         match &a.behaviour {
-            super::Behaviour::Always => {}
-            super::Behaviour::Table { actions } => {
+            crate::Behaviour::Always => {}
+            crate::Behaviour::Table { actions } => {
                 if actions.len() != ns {
                     return Err(format!("the table of `{}` has {} states, not {ns}", a.name, actions.len()));
                 }
                 actions.iter().flatten().try_for_each(action)?;
             }
-            super::Behaviour::Fsm(f) => {
+            crate::Behaviour::Fsm(f) => {
                 idx(&format!("the initial FSM state of `{}`: state", a.name), f.initial, f.states.len())?;
                 f.states.iter().try_for_each(|s| action(&s.action))?;
                 for t in &f.transitions {
                     idx("an FSM transition's state", t.from, f.states.len())?;
                     idx("an FSM transition's state", t.to, f.states.len())?;
                     match &t.trigger {
-                        super::Trigger::States(s) => s.iter().try_for_each(|&s| idx("a trigger state", s, ns))?,
-                        super::Trigger::Event(e) => idx("a trigger event", *e, ne)?,
+                        crate::Trigger::States(s) => s.iter().try_for_each(|&s| idx("a trigger state", s, ns))?,
+                        crate::Trigger::Event(e) => idx("a trigger event", *e, ne)?,
                     }
                 }
             }
@@ -377,11 +374,11 @@ pub fn validate(c: &Content) -> Result<(), String> {
     let net = &c.network;
     for node in &net.alpha {
         match node {
-            super::AlphaNode::State { states } => {
+            crate::AlphaNode::State { states } => {
                 states.iter().try_for_each(|&s| idx("an alpha node's state", s, ns))?
             }
-            super::AlphaNode::Stale { agent } => idx("an alpha node's agent", *agent, na)?,
-            super::AlphaNode::Event { event, tests, .. } => {
+            crate::AlphaNode::Stale { agent } => idx("an alpha node's agent", *agent, na)?,
+            crate::AlphaNode::Event { event, tests, .. } => {
                 idx("an alpha node's event", *event, ne)?;
                 for t in tests {
                     validate_test(c, *event, t, false)?;
@@ -397,7 +394,7 @@ pub fn validate(c: &Content) -> Result<(), String> {
         }
         idx("a beta node's alpha node", b.alpha, net.alpha.len())?;
         let event = match &net.alpha[b.alpha as usize] {
-            super::AlphaNode::Event { event, .. } => Some(*event),
+            crate::AlphaNode::Event { event, .. } => Some(*event),
             _ => None,
         };
         for t in &b.tests {
@@ -434,8 +431,8 @@ pub fn validate(c: &Content) -> Result<(), String> {
 
 /// A test on a field of `event`: the field exists, a constant fits its type,
 /// and an operand from another fact exists (only in beta tests).
-fn validate_test(c: &Content, event: u32, t: &super::Test, beta: bool) -> Result<(), String> {
-    use super::{Check, FieldType, Operand, Value};
+fn validate_test(c: &Content, event: u32, t: &crate::Test, beta: bool) -> Result<(), String> {
+    use crate::{Check, FieldType, Operand, Value};
     let e = &c.events[event as usize];
     let Some(field) = e.fields.get(t.field as usize) else {
         return Err(format!("event `{}` has no field {}", e.name, t.field));

@@ -1,7 +1,8 @@
 //! Unit tests per node kind and per rule of inference.
 
-use super::*;
-use situ_compiler::bundle::Value::{self, *};
+use situ_bundle::Value::{self, *};
+use situ_runtime::rete::*;
+use std::sync::Arc;
 
 const MS: u64 = 1_000_000;
 
@@ -27,7 +28,7 @@ impl T {
         let front: Vec<_> = c.diagnostics.iter().filter(|d| d.code < "E0300").collect();
         assert!(front.is_empty(), "{front:?}");
         let content = situ_compiler::bundle::build(&c);
-        situ_compiler::bundle::codec::validate(&content).expect("a valid bundle");
+        situ_bundle::codec::validate(&content).expect("a valid bundle");
         T { e: Engine::new(Arc::new(content)) }
     }
 

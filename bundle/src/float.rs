@@ -73,7 +73,7 @@ impl Visitor<'_> for Float {
 
 #[cfg(test)]
 mod tests {
-    use crate::bundle::Value;
+    use crate::Value;
 
     #[test]
     fn json_writes_non_finite_values_by_name_and_reads_them_back() {

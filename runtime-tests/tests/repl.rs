@@ -1,4 +1,7 @@
-use super::*;
+//! The REPL session of `situ_runtime::repl` on compiled sources.
+
+use situ_runtime::repl::*;
+use std::sync::Arc;
 
 const RULES: &str = "states { RS initial RO EM }\n\
     agent LADAR sensor { stale after 300ms event LAOBS { distance: f64, kind: {car, tree} } event LAOBN }\n\
