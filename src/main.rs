@@ -198,10 +198,7 @@ fn dispatch(command: Command) -> cmd::Outcome {
         Command::Explain(args) => cmd::explain::run(&args),
         Command::Build(args) => cmd::build::run(&args),
         Command::Key { what } => Ok(cmd::key::run(what)),
-        Command::Bench(args) => {
-            args.trust.read()?;
-            cmd::bench::run(&args)
-        }
+        Command::Bench(args) => cmd::bench::run(&args),
         Command::Test(args) => cmd::test::run(&args),
         Command::Gen { what } => cmd::gen::run(what),
         Command::Export(args) => cmd::export::run(&args),
@@ -229,10 +226,20 @@ fn dispatch(command: Command) -> cmd::Outcome {
             duration,
             trust,
         } => {
-            trust.read()?;
+            let trust = trust.policy()?;
             let local = stack == cmd::distributed::Stack::Sim && transport == cmd::distributed::Transport::Inproc;
             Ok(if local && (script.is_some() || random.is_some()) {
-                cmd::scripted::run(cmd::scripted::Args { file, script, random, until, out, record, foxglove, serve })
+                cmd::scripted::run(cmd::scripted::Args {
+                    file,
+                    script,
+                    random,
+                    until,
+                    out,
+                    record,
+                    foxglove,
+                    serve,
+                    trust,
+                })
             } else if local {
                 let dla = cmd::run::DlaArgs { cases, learn: !no_learning, missions, evaluate };
                 cmd::run::run(cmd::run::Args {
@@ -246,6 +253,7 @@ fn dispatch(command: Command) -> cmd::Outcome {
                     foxglove,
                     serve,
                     dla,
+                    trust,
                 })
             } else {
                 cmd::distributed::run(cmd::distributed::Args {
@@ -259,17 +267,14 @@ fn dispatch(command: Command) -> cmd::Outcome {
                     record,
                     foxglove,
                     serve,
+                    trust,
                 })
             })
         }
         Command::Repl(args) => cmd::repl::run(&args.file),
         Command::Lsp => Ok(cmd::lsp::run()),
-        Command::Replay(args) => {
-            args.trust.read()?;
-            cmd::replay::run(&args)
-        }
+        Command::Replay(args) => cmd::replay::run(&args),
         Command::Up { deploy, file, stack, duration, trust } => {
-            trust.read()?;
             Ok(cmd::distributed::up(&deploy, &file, stack, duration, &trust.trust))
         }
         Command::Graph(args) => cmd::graph::run(&args),

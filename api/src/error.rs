@@ -2,7 +2,8 @@
 //! where, and keeps what a client needs to show it (the findings of a
 //! source that does not check, the bundle's own error).
 
-use situ_compiler::bundle::{sign::TrustError, LoadError};
+use situ_compiler::bundle::sign::TrustError;
+use situ_compiler::bundle::LoadError;
 use situ_compiler::{Checked, RootError};
 use std::path::PathBuf;
 
@@ -28,7 +29,17 @@ pub enum Error {
     /// A bundle is damaged, of another format version, or was changed.
     #[error(transparent)]
     Bundle(#[from] LoadError),
-    /// A bundle is not signed by a trusted key.
+    /// A bundle is not signed by a trusted key (a damaged one is
+    /// [`Error::Bundle`], under any policy).
     #[error(transparent)]
-    Trust(#[from] TrustError),
+    Trust(TrustError),
+}
+
+impl From<TrustError> for Error {
+    fn from(e: TrustError) -> Self {
+        match e {
+            TrustError::Load(e) => Error::Bundle(e),
+            e => Error::Trust(e),
+        }
+    }
 }

@@ -23,7 +23,7 @@ mod program;
 mod suite;
 
 pub use error::Error;
-pub use program::{build, check, format, load, load_path, BuildOptions, Built, Input, Loaded, Program, Trust};
-pub use situ_compiler::bundle::{Content, Encoding};
+pub use program::{build, check, format, load, load_path, BuildOptions, Built, Input, Program};
+pub use situ_compiler::bundle::{Content, Encoding, Loaded, Trust};
 pub use situ_compiler::{Checked, Diagnostic, Severity};
 pub use suite::{test, SuiteReport, TestOptions, Verdict};

@@ -2,8 +2,8 @@
 //! (signed or not), and load a source or a bundle under a trust policy.
 
 use crate::Error;
-use situ_compiler::bundle::sign::{self, KeyId, PublicKey, SecretKey};
-use situ_compiler::bundle::{self, codec, Content, Encoding};
+use situ_compiler::bundle::sign::{self, KeyId, SecretKey};
+use situ_compiler::bundle::{self, codec, Content, Encoding, Loaded, Trust};
 use situ_compiler::loader::{read_bounded, FsLoader, MAX_BUNDLE_BYTES};
 use situ_compiler::Checked;
 use std::path::Path;
@@ -77,43 +77,10 @@ pub fn build(checked: &Checked, options: &BuildOptions) -> Result<Built, Error> 
     Ok(Built { bytes, sha256, content, signed_by: options.key.as_ref().map(SecretKey::key_id) })
 }
 
-/// Which bundles may load: any valid one, or only those signed by one of
-/// these keys (a source, which carries no signature, is then refused).
-#[derive(Debug, Clone, Default)]
-pub enum Trust {
-    #[default]
-    Any,
-    Keys(Vec<PublicKey>),
-}
-
-impl Trust {
-    /// The policy of a list of trusted keys: none trusts any valid bundle.
-    pub fn keys(keys: Vec<PublicKey>) -> Trust {
-        if keys.is_empty() {
-            Trust::Any
-        } else {
-            Trust::Keys(keys)
-        }
-    }
-}
-
-/// A bundle loaded under a trust policy, and the key that signed it when
-/// the policy asked for one.
-#[derive(Debug, Clone)]
-pub struct Loaded {
-    pub content: Content,
-    pub signed_by: Option<KeyId>,
-}
-
-/// Decodes and verifies a bundle's bytes under `trust`.
+/// Decodes and verifies a bundle's bytes under `trust` (any valid bundle, or
+/// only those signed by one of its keys), naming the key that signed it.
 pub fn load(bytes: &[u8], trust: &Trust) -> Result<Loaded, Error> {
-    match trust {
-        Trust::Any => Ok(Loaded { content: bundle::decode(bytes)?, signed_by: None }),
-        Trust::Keys(keys) => {
-            let (content, key) = sign::decode_trusted(bytes, keys)?;
-            Ok(Loaded { content, signed_by: Some(key) })
-        }
-    }
+    Ok(situ_compiler::bundle::load(bytes, trust)?)
 }
 
 /// A program ready to run, and its checked source when it came from one.
@@ -132,7 +99,7 @@ pub struct Program {
 /// signature.
 pub fn load_path(path: &Path, trust: &Trust, deny_warnings: bool) -> Result<Program, Error> {
     if path.extension().is_some_and(|e| e == "situ") {
-        if let Trust::Keys(_) = trust {
+        if trust.requires_signature() {
             return Err(Error::UnsignedSource { path: path.to_path_buf() });
         }
         let checked = check(Input::Path(path))?;
@@ -145,7 +112,7 @@ pub fn load_path(path: &Path, trust: &Trust, deny_warnings: bool) -> Result<Prog
     let bytes = read_bounded(path, MAX_BUNDLE_BYTES, "a bundle")
         .map_err(|source| Error::Read { path: path.to_path_buf(), source })?;
     let loaded = load(&bytes, trust)?;
-    Ok(Program { content: Arc::new(loaded.content), checked: None, bytes: Some(bytes), signed_by: loaded.signed_by })
+    Ok(Program { content: Arc::new(loaded.content), checked: None, bytes: Some(bytes), signed_by: loaded.signer })
 }
 
 fn findings(checked: &Checked) -> Error {

@@ -52,12 +52,12 @@ fn trust_asks_for_a_trusted_signature() {
     let signed = build(&checked, &BuildOptions { key: Some(key.clone()), ..BuildOptions::default() }).expect("signed");
     assert_eq!(signed.signed_by, Some(key.key_id()));
 
-    let trust = Trust::keys(vec![key.public()]);
-    assert_eq!(load(&signed.bytes, &trust).expect("a trusted signature").signed_by, Some(key.key_id()));
+    let trust = Trust::from_keys(vec![key.public()]);
+    assert_eq!(load(&signed.bytes, &trust).expect("a trusted signature").signer, Some(key.key_id()));
     assert!(matches!(load(&unsigned.bytes, &trust), Err(Error::Trust(_))));
-    assert!(matches!(load(&signed.bytes, &Trust::keys(vec![other.public()])), Err(Error::Trust(_))));
+    assert!(matches!(load(&signed.bytes, &Trust::from_keys(vec![other.public()])), Err(Error::Trust(_))));
     assert!(load(&unsigned.bytes, &Trust::Any).is_ok(), "without keys any valid bundle loads");
-    assert!(matches!(Trust::keys(Vec::new()), Trust::Any));
+    assert!(!Trust::from_keys(Vec::new()).requires_signature());
 }
 
 #[test]
@@ -77,7 +77,7 @@ fn load_path_reads_sources_and_bundles_and_refuses_sources_under_trust() {
     assert!(program.checked.is_some() && program.bytes.is_none());
 
     let key = SecretKey::from_seed(&[7; 32]);
-    let trust = Trust::keys(vec![key.public()]);
+    let trust = Trust::from_keys(vec![key.public()]);
     assert!(matches!(load_path(&source, &trust, false), Err(Error::UnsignedSource { .. })));
 
     let built = build(&door(), &BuildOptions { key: Some(key), ..BuildOptions::default() }).expect("signed");

@@ -45,7 +45,8 @@ pub struct Args {
 const MAX_STREAM_BYTES: u64 = 256 * 1024 * 1024;
 
 pub fn run(args: &Args) -> Outcome {
-    let program = super::program::load(&args.file, false).map_err(CliError::Reported)?;
+    let trust = args.trust.policy()?;
+    let program = super::program::load(&args.file, false, &trust).map_err(CliError::Reported)?;
     let content = program.content;
     let mut stream_text = None;
     let events = match &args.stream_in {

@@ -62,6 +62,8 @@ pub struct Args {
     /// Serve the Supervisor's page of the run live at this address (the
     /// process of the Bulletinboard).
     pub serve: Option<String>,
+    /// The policy of `--trust`.
+    pub trust: situ_compiler::bundle::Trust,
 }
 
 /// The flag Ctrl-C and SIGTERM raise.
@@ -134,7 +136,7 @@ pub fn run(args: Args) -> u8 {
         eprintln!("error: --duration must be a positive number of seconds");
         return USAGE;
     }
-    let program = match super::program::load(&args.file, false) {
+    let program = match super::program::load(&args.file, false, &args.trust) {
         Ok(p) => p,
         Err(code) => return code,
     };
@@ -340,7 +342,11 @@ fn local_processes(_deploy: &Path, _agents: &[String]) -> Result<Vec<(String, bo
 /// processes get the same `--trust` keys (each checks the bundle itself)
 /// and each warns when the deployment is open (no `[tls]`).
 pub fn up(deploy: &Path, file: &Path, stack: Stack, duration: f64, trust: &[PathBuf]) -> u8 {
-    let program = match super::program::load(file, false) {
+    let policy = match super::program::trust_of(trust) {
+        Ok(t) => t,
+        Err(code) => return code,
+    };
+    let program = match super::program::load(file, false, &policy) {
         Ok(p) => p,
         Err(code) => return code,
     };

@@ -40,7 +40,7 @@ fn agent_code(agent: &str, file: &std::path::Path, lang: &str, output: Option<Pa
             Lang::NAMES.join(", ")
         )));
     };
-    let program = program::load(file, false).map_err(CliError::Reported)?;
+    let program = program::load(file, false, &situ_compiler::bundle::Trust::Any).map_err(CliError::Reported)?;
     let generated = codegen::agent(&program.content, agent, lang).map_err(|e| CliError::Usage(e.to_string()))?;
     let dir = output.unwrap_or_else(|| PathBuf::from("."));
     if dir.as_os_str() == "-" {

@@ -81,10 +81,11 @@ pub struct Trust {
 }
 
 impl Trust {
-    /// Reads the keys: from now on every bundle this process loads must be
-    /// signed by one of them (none: every valid bundle loads).
-    pub fn read(&self) -> Result<(), CliError> {
-        program::trust(&self.trust).map_err(CliError::Reported)
+    /// The policy of these keys, which the command passes to every load:
+    /// each bundle must be signed by one of them (none: every valid bundle
+    /// loads).
+    pub fn policy(&self) -> Result<situ_compiler::bundle::Trust, CliError> {
+        program::trust_of(&self.trust).map_err(CliError::Reported)
     }
 }
 

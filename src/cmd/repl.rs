@@ -42,7 +42,7 @@ pub struct Args {
 }
 
 pub fn run(file: &Path) -> Outcome {
-    let program = super::program::load(file, false).map_err(CliError::Reported)?;
+    let program = super::program::load(file, false, &situ_compiler::bundle::Trust::Any).map_err(CliError::Reported)?;
     let mut session = Session::new(program.content);
     let terminal = std::io::stdin().is_terminal();
     if terminal {
@@ -131,7 +131,7 @@ fn carry_out(file: &Path, session: &mut Session, reply: Reply) -> bool {
             }
         }
         Reply::Quit => return false,
-        Reply::Reload => match super::program::load(file, false) {
+        Reply::Reload => match super::program::load(file, false, &situ_compiler::bundle::Trust::Any) {
             Ok(p) => match session.reload(p.content) {
                 Ok(report) => println!("{report}"),
                 Err(e) => println!("error: {e}"),

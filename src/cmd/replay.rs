@@ -44,6 +44,7 @@ pub struct Args {
 }
 
 pub fn run(args: &Args) -> Outcome {
+    let trust = args.trust.policy()?;
     let (recording, bundle_path, format) = (args.recording.as_path(), args.bundle.as_ref(), args.format);
     let bytes = match read_file(recording) {
         Ok(b) => b,
@@ -58,10 +59,10 @@ pub fn run(args: &Args) -> Outcome {
         }
     };
     let content = match bundle_path {
-        Some(p) => super::program::load(p, false).map_err(CliError::Reported)?.content,
-        None => match attached_bundle(&bytes)
-            .map(|b| super::program::decode_bundle(&b, &format!("the bundle attached to `{}`", recording.display())))
-        {
+        Some(p) => super::program::load(p, false, &trust).map_err(CliError::Reported)?.content,
+        None => match attached_bundle(&bytes).map(|b| {
+            super::program::decode_bundle(&b, &format!("the bundle attached to `{}`", recording.display()), &trust)
+        }) {
             Some(Ok(c)) => Arc::new(c),
             Some(Err(e)) => {
                 return Err(CliError::Usage(format!("the bundle attached to `{}`: {e}", recording.display())));

@@ -83,8 +83,8 @@ pub fn run(args: Args) -> Outcome {
             return Err(CliError::Usage(format!("--duration {s}: give a number of seconds above 0")));
         }
     };
-    args.trust.read()?;
-    let program = super::program::load(&args.file, false).map_err(CliError::Reported)?;
+    let trust = args.trust.policy()?;
+    let program = super::program::load(&args.file, false, &trust).map_err(CliError::Reported)?;
     let text = match read_bounded(&args.map, MAX_FILE_BYTES, "a map")
         .and_then(|b| String::from_utf8(b).map_err(|_| std::io::Error::other("the map is not UTF-8 text")))
     {

@@ -48,6 +48,8 @@ pub struct Args {
     /// Serve the Supervisor's page of the run live at this address.
     pub serve: Option<String>,
     pub dla: DlaArgs,
+    /// The policy of `--trust`.
+    pub trust: situ_compiler::bundle::Trust,
 }
 
 /// DLA's options (`rules/dla.situ`).
@@ -79,7 +81,7 @@ struct DlaCases {
 }
 
 pub fn run(args: Args) -> u8 {
-    let program = match super::program::load(&args.file, false) {
+    let program = match super::program::load(&args.file, false, &args.trust) {
         Ok(p) => p,
         Err(code) => return code,
     };
@@ -89,7 +91,7 @@ pub fn run(args: Args) -> u8 {
         Ok(k) => k,
         Err(_) if args.scenario.is_none() && args.compare.is_none() && args.dla.missions.is_none() => {
             // Any other robot: its first script, every agent a stand-in.
-            let Args { file, until, out, record, foxglove, serve, .. } = args;
+            let Args { file, until, out, record, foxglove, serve, trust, .. } = args;
             return super::scripted::run(super::scripted::Args {
                 file,
                 script: None,
@@ -99,6 +101,7 @@ pub fn run(args: Args) -> u8 {
                 record,
                 foxglove,
                 serve,
+                trust,
             });
         }
         Err(e) => {
@@ -316,7 +319,7 @@ fn compare(args: &Args, content: Arc<Content>, kind: &dyn Stack, scenario: &Scen
         }
     };
     if let Some(sibling) = sibling {
-        match super::program::load(&sibling.path, false) {
+        match super::program::load(&sibling.path, false, &args.trust) {
             Ok(p) => programs.set(sibling.strategy, p.content),
             Err(code) => return code,
         }

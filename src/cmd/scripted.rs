@@ -34,6 +34,8 @@ pub struct Args {
     pub foxglove: Option<String>,
     /// Serve the Supervisor's page of the run live at this address.
     pub serve: Option<String>,
+    /// The policy of `--trust`.
+    pub trust: situ_compiler::bundle::Trust,
 }
 
 /// The rules and the scripts they can be run with.
@@ -49,16 +51,16 @@ struct Loaded {
     checked: Option<situ_compiler::Checked>,
 }
 
-fn load(file: &Path, script_file: Option<&Path>) -> Result<Loaded, u8> {
+fn load(file: &Path, script_file: Option<&Path>, trust: &situ_compiler::bundle::Trust) -> Result<Loaded, u8> {
     if !super::program::is_source(file) {
         if script_file.is_some() {
             eprintln!("error: a script file is read with the rules' source: run the `.situ` file, not a bundle");
             return Err(USAGE);
         }
-        let p = super::program::load(file, false)?;
+        let p = super::program::load(file, false, trust)?;
         return Ok(Loaded { content: p.content, scripts: Vec::new(), bundle: true, bytes: p.bytes, checked: None });
     }
-    super::program::refuse_source_under_trust(file)?;
+    super::program::refuse_source(file, trust)?;
     let extra: Vec<&Path> = script_file.into_iter().collect();
     let checked = situ_compiler::check_with(file, &extra, &FsLoader).map_err(|e| {
         eprintln!("error: {e}");
@@ -103,7 +105,7 @@ fn pick(scripts: &[ScriptSpec], bundle: bool, file: &Path, name: Option<&str>) -
 
 pub fn run(args: Args) -> u8 {
     let script_file = args.script.as_deref().map(Path::new).filter(|p| p.is_file());
-    let loaded = match load(&args.file, script_file) {
+    let loaded = match load(&args.file, script_file, &args.trust) {
         Ok(l) => l,
         Err(code) => return code,
     };

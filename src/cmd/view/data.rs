@@ -37,7 +37,7 @@ impl Site {
                     "--rules goes with a recording (`.mcap`); `{name}` is the rules already"
                 )));
             }
-            let p = program::load(file, false).map_err(CliError::Reported)?;
+            let p = program::load(file, false, &situ_compiler::bundle::Trust::Any).map_err(CliError::Reported)?;
             let kind = if p.checked.is_some() { "rules" } else { "bundle" };
             let checked = p.checked.or_else(|| source_of(&p.content));
             return Ok(Site::new(name, kind, p.content, checked.as_ref(), None));
@@ -51,11 +51,12 @@ impl Site {
         if let Some(why) = &reading.cut {
             eprintln!("warning: `{name}` is cut short: {why}; the page shows the part before the cut");
         }
-        let attached =
-            attached_bundle(&bytes).map(|b| program::decode_bundle(&b, &format!("the bundle attached to `{name}`")));
+        let attached = attached_bundle(&bytes).map(|b| {
+            program::decode_bundle(&b, &format!("the bundle attached to `{name}`"), &situ_compiler::bundle::Trust::Any)
+        });
         let (content, checked) = match (rules, attached) {
             (Some(r), attached) => {
-                let p = program::load(r, false).map_err(CliError::Reported)?;
+                let p = program::load(r, false, &situ_compiler::bundle::Trust::Any).map_err(CliError::Reported)?;
                 if let Some(Ok(a)) = attached {
                     if !same_rules(&a, &p.content) {
                         return Err(CliError::Usage(format!(
