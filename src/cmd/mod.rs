@@ -13,6 +13,7 @@ pub mod graph;
 pub mod key;
 pub mod lsp;
 pub mod manners;
+pub mod mission;
 pub mod program;
 pub mod recheck;
 pub mod repl;
