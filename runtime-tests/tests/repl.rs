@@ -16,7 +16,7 @@ fn session(src: &str) -> Session {
     Session::new(Arc::new(situ_compiler::bundle::build(&checked)))
 }
 
-fn text(r: Result<Reply, String>) -> String {
+fn text(r: Result<Reply, ReplError>) -> String {
     match r {
         Ok(Reply::Text(t)) => t,
         other => panic!("expected text, got {other:?}"),
@@ -43,7 +43,8 @@ fn time_passes_and_undo_takes_it_back() {
     assert!(text(s.execute("undo")).contains("RS at 0.000s"));
     assert_eq!(s.state(), "RS");
     assert!(s.execute("undo").is_ok());
-    assert_eq!(s.execute("undo"), Err("nothing to undo".into()));
+    assert_eq!(s.execute("undo"), Err(ReplError::NothingToUndo));
+    assert_eq!(ReplError::NothingToUndo.to_string(), "nothing to undo");
 }
 
 #[test]
@@ -61,7 +62,7 @@ fn bad_lines_are_errors_and_change_nothing() {
         ("LAOBN x0", "repeat count"),
         ("save", "one file name"),
     ] {
-        let e = s.execute(line).expect_err(line);
+        let e = s.execute(line).expect_err(line).to_string();
         assert!(e.contains(expected), "{line}: {e}");
     }
     assert_eq!(s.state(), "RS");

@@ -102,16 +102,16 @@ impl Session {
 
     /// Runs one command line; an error is a message for the person, and
     /// the session goes on unchanged.
-    pub fn execute(&mut self, line: &str) -> Result<Reply, String> {
+    pub fn execute(&mut self, line: &str) -> Result<Reply, ReplError> {
         let line = line.split("//").next().unwrap_or("").trim();
         let mut words = line.split_whitespace();
         let Some(first) = words.next() else { return Ok(Reply::Text(String::new())) };
         let rest: Vec<&str> = words.collect();
-        let none = |r: &[&str], what: &str| -> Result<(), String> {
+        let none = |r: &[&str], what: &str| -> Result<(), ReplError> {
             if r.is_empty() {
                 Ok(())
             } else {
-                Err(format!("`{what}` takes nothing after it"))
+                Err(ReplError::TakesNothing(what.to_string()))
             }
         };
         match first {
@@ -127,34 +127,32 @@ impl Session {
             "quit" | "exit" => Ok(Reply::Quit),
             "save" => match rest.as_slice() {
                 [file] => Ok(Reply::Save(file.to_string())),
-                _ => Err("`save FILE`: one file name".into()),
+                _ => Err(ReplError::SaveUsage),
             },
             "wait" => match rest.as_slice() {
                 [d] => self.wait(parse_duration(d)?).map(Reply::Text),
-                _ => Err("`wait DURATION`, e.g. `wait 300ms`".into()),
+                _ => Err(ReplError::WaitUsage),
             },
             _ => self.post_line(first, &rest).map(Reply::Text),
         }
     }
 
-    fn post_line(&mut self, name: &str, args: &[&str]) -> Result<String, String> {
+    fn post_line(&mut self, name: &str, args: &[&str]) -> Result<String, ReplError> {
         let c = self.content.clone();
         let (agent, event_name) = match name.split_once('.') {
             Some((a, e)) => (Some(a), e),
             None => (None, name),
         };
         let Some(event) = c.event_id(event_name) else {
-            let mut msg = format!("no event or command `{name}`");
-            if let Some(s) = suggest(event_name, c.events.iter().map(|e| e.name.as_str())) {
-                msg.push_str(&format!("; did you mean `{s}`?"));
-            }
-            return Err(format!("{msg} (`help` lists the commands)"));
+            let suggestion = suggest(event_name, c.events.iter().map(|e| e.name.as_str())).map(str::to_string);
+            return Err(ReplError::Unknown { name: name.to_string(), suggestion });
         };
         let def = &c.events[event as usize];
         if let Some(a) = agent {
             let owner = &c.agents[def.agent as usize].name;
             if a != owner {
-                return Err(format!("`{event_name}` is an event of `{owner}`, not of `{a}`"));
+                let (event, owner, agent) = (event_name.to_string(), owner.clone(), a.to_string());
+                return Err(ReplError::NotItsAgent { event, owner, agent });
             }
         }
         let mut payload: Vec<Option<Value>> = vec![None; def.fields.len()];
@@ -162,31 +160,29 @@ impl Session {
         for arg in args {
             if let Some(n) = arg.strip_prefix('x').and_then(|n| n.parse::<u64>().ok()) {
                 if n == 0 || n > MAX_REPEAT {
-                    return Err(format!("a repeat count is 1 to {MAX_REPEAT}, not {n}"));
+                    return Err(ReplError::Repeat(n));
                 }
                 repeat = n;
                 continue;
             }
             let Some((field, value)) = arg.split_once('=') else {
-                return Err(format!("`{arg}`: write each field as `name=value`, a repeat as `x3`"));
+                return Err(ReplError::NotAField(arg.to_string()));
             };
             let Some(i) = def.fields.iter().position(|f| f.name == field) else {
                 let names: Vec<&str> = def.fields.iter().map(|f| f.name.as_str()).collect();
-                let mut msg = format!("`{event_name}` has no field `{field}`");
-                if let Some(s) = suggest(field, names.iter().copied()) {
-                    msg.push_str(&format!("; did you mean `{s}`?"));
-                }
-                return Err(msg);
+                let suggestion = suggest(field, names.iter().copied()).map(str::to_string);
+                return Err(ReplError::NoField { event: event_name.to_string(), field: field.to_string(), suggestion });
             };
             if payload[i].is_some() {
-                return Err(format!("`{field}` is given twice"));
+                return Err(ReplError::Twice(field.to_string()));
             }
             payload[i] = Some(parse_value(&def.fields[i].ty, field, value)?);
         }
         let missing: Vec<&str> =
             def.fields.iter().zip(&payload).filter(|(_, v)| v.is_none()).map(|(f, _)| f.name.as_str()).collect();
         if !missing.is_empty() {
-            return Err(format!("`{event_name}` needs every field: {} missing", missing.join(", ")));
+            let missing = missing.into_iter().map(str::to_string).collect();
+            return Err(ReplError::Missing { event: event_name.to_string(), missing });
         }
         let payload: Vec<Value> = payload.into_iter().flatten().collect();
         let mut out = Vec::new();
@@ -232,9 +228,9 @@ impl Session {
         text
     }
 
-    fn wait(&mut self, d: u64) -> Result<String, String> {
+    fn wait(&mut self, d: u64) -> Result<String, ReplError> {
         if d > MAX_WAIT_NS {
-            return Err("wait at most a day at a time".into());
+            return Err(ReplError::WaitTooLong);
         }
         self.now += d;
         let result = self.board.advance(self.now);
@@ -342,8 +338,8 @@ impl Session {
     }
 
     /// Takes back the last post or wait: the session is replayed without it.
-    fn undo(&mut self) -> Result<String, String> {
-        let Some(undone) = self.steps.pop() else { return Err("nothing to undo".into()) };
+    fn undo(&mut self) -> Result<String, ReplError> {
+        let Some(undone) = self.steps.pop() else { return Err(ReplError::NothingToUndo) };
         let steps = std::mem::take(&mut self.steps);
         self.replay_steps(steps);
         let what = match undone {
@@ -376,11 +372,11 @@ impl Session {
 
     /// Takes new rules, keeping the facts (a hot swap), and says what
     /// changed; on failure the old rules stay.
-    pub fn reload(&mut self, new: Arc<Content>) -> Result<String, String> {
+    pub fn reload(&mut self, new: Arc<Content>) -> Result<String, ReplError> {
         let old = self.content.clone();
         // The history in the new rules' ids, by name, for `undo` and `save`.
         let steps: Option<Vec<Step>> = self.steps.iter().map(|s| remap(&old, &new, s)).collect();
-        let report = self.board.swap(new.clone()).map_err(|e| format!("{e:?}; the old rules stay"))?;
+        let report = self.board.swap(new.clone()).map_err(ReplError::Swap)?;
         let fsm: Vec<(String, Option<u32>)> = (0..old.agents.len() as u32)
             .map(|a| (old.agents[a as usize].name.clone(), self.org.fsm_state(a)))
             .collect();
@@ -499,7 +495,7 @@ fn remap(old: &Content, new: &Content, step: &Step) -> Option<Step> {
 }
 
 /// `300ms`, `1.5s`, `2min`, `10us`, `5ns`.
-pub fn parse_duration(text: &str) -> Result<u64, String> {
+pub fn parse_duration(text: &str) -> Result<u64, DurationError> {
     let split = text.find(|c: char| !(c.is_ascii_digit() || c == '.')).unwrap_or(text.len());
     let (number, unit) = text.split_at(split);
     let scale: f64 = match unit {
@@ -508,18 +504,22 @@ pub fn parse_duration(text: &str) -> Result<u64, String> {
         "ms" => 1e6,
         "s" => 1e9,
         "min" => 60e9,
-        _ => return Err(format!("`{text}` is not a duration: a number and ns, us, ms, s or min (`300ms`)")),
+        _ => return Err(DurationError::NoUnit(text.to_string())),
     };
-    let value: f64 = number.parse().map_err(|_| format!("`{text}` is not a duration (`300ms`)"))?;
+    let value: f64 = number.parse().map_err(|_| DurationError::NotANumber(text.to_string()))?;
     let ns = (value * scale).round();
     if !(ns.is_finite() && (0.0..=MAX_WAIT_NS as f64).contains(&ns)) {
-        return Err(format!("`{text}`: wait at most a day at a time"));
+        return Err(DurationError::TooLong(text.to_string()));
     }
     Ok(ns as u64)
 }
 
-fn parse_value(ty: &FieldType, field: &str, text: &str) -> Result<Value, String> {
-    let bad = |what: &str| format!("`{field}` is {what}, not `{text}`");
+fn parse_value(ty: &FieldType, field: &str, text: &str) -> Result<Value, ReplError> {
+    let bad = |what: &str| ReplError::BadValue {
+        field: field.to_string(),
+        expected: what.to_string(),
+        text: text.to_string(),
+    };
     match ty {
         FieldType::F64 => match text.parse::<f64>() {
             Ok(v) if v.is_finite() => Ok(Value::F64(v)),
@@ -549,6 +549,57 @@ fn duration(ns: u64) -> String {
 
 fn first_line(text: &str) -> &str {
     text.lines().next().unwrap_or("")
+}
+
+/// Why a command line was not taken; the session goes on unchanged. Its
+/// text is the message for the person at the prompt.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ReplError {
+    #[error("`{0}` takes nothing after it")]
+    TakesNothing(String),
+    #[error("`save FILE`: one file name")]
+    SaveUsage,
+    #[error("`wait DURATION`, e.g. `wait 300ms`")]
+    WaitUsage,
+    #[error("no event or command `{name}`{} (`help` lists the commands)", did_you_mean(.suggestion))]
+    Unknown { name: String, suggestion: Option<String> },
+    #[error("`{event}` is an event of `{owner}`, not of `{agent}`")]
+    NotItsAgent { event: String, owner: String, agent: String },
+    #[error("a repeat count is 1 to {MAX_REPEAT}, not {0}")]
+    Repeat(u64),
+    #[error("`{0}`: write each field as `name=value`, a repeat as `x3`")]
+    NotAField(String),
+    #[error("`{event}` has no field `{field}`{}", did_you_mean(.suggestion))]
+    NoField { event: String, field: String, suggestion: Option<String> },
+    #[error("`{0}` is given twice")]
+    Twice(String),
+    #[error("`{field}` is {expected}, not `{text}`")]
+    BadValue { field: String, expected: String, text: String },
+    #[error("`{event}` needs every field: {} missing", .missing.join(", "))]
+    Missing { event: String, missing: Vec<String> },
+    #[error("wait at most a day at a time")]
+    WaitTooLong,
+    #[error(transparent)]
+    Duration(#[from] DurationError),
+    #[error("nothing to undo")]
+    NothingToUndo,
+    #[error("{0:?}; the old rules stay")]
+    Swap(crate::bulletinboard::SwapError),
+}
+
+/// Why a text is not a duration of the session.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum DurationError {
+    #[error("`{0}` is not a duration: a number and ns, us, ms, s or min (`300ms`)")]
+    NoUnit(String),
+    #[error("`{0}` is not a duration (`300ms`)")]
+    NotANumber(String),
+    #[error("`{0}`: wait at most a day at a time")]
+    TooLong(String),
+}
+
+fn did_you_mean(suggestion: &Option<String>) -> String {
+    suggestion.as_ref().map_or(String::new(), |s| format!("; did you mean `{s}`?"))
 }
 
 const HELP: &str = "\
