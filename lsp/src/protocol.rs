@@ -253,20 +253,43 @@ pub fn request(world: &World, method: &str, params: &Value) -> Answer {
 
 // ---------------------------------------------------------------- notifications
 
+/// Why a notification of the client was not applied to the documents (the
+/// text is shown to the user; the documents stay as they were).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum SyncError {
+    /// The notification lacks what it must carry (`didOpen without a URI`).
+    #[error("{0}")]
+    Incomplete(&'static str),
+    /// Its document is not a `file:` URI of a path.
+    #[error("{0}")]
+    Uri(String),
+    #[error("didChange of `{}`, which is not open", .0.display())]
+    NotOpen(PathBuf),
+    #[error("a change with a bad range: {0}")]
+    BadRange(String),
+    #[error("change {index} of `{}` has an impossible range {}:{}-{}:{}; the change was not applied", path.display(), range.start.line, range.start.character, range.end.line, range.end.character)]
+    ImpossibleRange { index: usize, path: PathBuf, range: lsp_types::Range },
+    /// The handler of the notification failed (a bug of situ, reported).
+    #[error("`{0}` failed")]
+    Failed(String),
+}
+
 /// Applies didOpen, didChange, didClose and friends to the documents; why
 /// not, for the user.
-pub fn sync(world: &mut World, method: &str, p: &Value) -> Result<(), String> {
+pub fn sync(world: &mut World, method: &str, p: &Value) -> Result<(), SyncError> {
     match method {
         "textDocument/didOpen" => {
-            let uri = p.pointer("/textDocument/uri").and_then(Value::as_str).ok_or("didOpen without a URI")?;
-            let text = p.pointer("/textDocument/text").and_then(Value::as_str).ok_or("didOpen without a text")?;
+            let uri = p.pointer("/textDocument/uri").and_then(Value::as_str);
+            let uri = uri.ok_or(SyncError::Incomplete("didOpen without a URI"))?;
+            let text = p.pointer("/textDocument/text").and_then(Value::as_str);
+            let text = text.ok_or(SyncError::Incomplete("didOpen without a text"))?;
             let version = p.pointer("/textDocument/version").and_then(Value::as_i64).unwrap_or(0) as i32;
-            let path = uri_path(uri).map_err(|e| e.message)?;
+            let path = uri_path(uri).map_err(|e| SyncError::Uri(e.message))?;
             world.open(path, Doc::new(uri.to_string(), text.to_string(), version));
         }
         "textDocument/didChange" => did_change(world, p)?,
         "textDocument/didClose" => {
-            let path = doc_path(p).map_err(|e| e.message)?;
+            let path = doc_path(p).map_err(|e| SyncError::Uri(e.message))?;
             world.close(&path);
         }
         "workspace/didChangeWatchedFiles" => {
@@ -281,35 +304,28 @@ pub fn sync(world: &mut World, method: &str, p: &Value) -> Result<(), String> {
 }
 
 /// The changes, applied in order; none when one of them is bad.
-fn did_change(world: &mut World, p: &Value) -> Result<(), String> {
-    let path = doc_path(p).map_err(|e| e.message)?;
-    let doc = world.docs.get(&path).ok_or_else(|| format!("didChange of `{}`, which is not open", path.display()))?;
-    let changes = p.get("contentChanges").and_then(Value::as_array).ok_or("didChange without contentChanges")?;
+fn did_change(world: &mut World, p: &Value) -> Result<(), SyncError> {
+    let path = doc_path(p).map_err(|e| SyncError::Uri(e.message))?;
+    let doc = world.docs.get(&path).ok_or_else(|| SyncError::NotOpen(path.clone()))?;
+    let changes = p.get("contentChanges").and_then(Value::as_array);
+    let changes = changes.ok_or(SyncError::Incomplete("didChange without contentChanges"))?;
     let mut text = doc.text.clone();
     for (i, c) in changes.iter().enumerate() {
-        let new = c.get("text").and_then(Value::as_str).ok_or("a change without text")?;
+        let new = c.get("text").and_then(Value::as_str).ok_or(SyncError::Incomplete("a change without text"))?;
         match c.get("range") {
             None | Some(Value::Null) => text = new.to_string(),
             Some(range) => {
                 let range: lsp_types::Range =
-                    serde_json::from_value(range.clone()).map_err(|e| format!("a change with a bad range: {e}"))?;
-                let span = LineIndex::new(&text).span(&text, range).ok_or_else(|| {
-                    format!(
-                        "change {} of `{}` has an impossible range {}:{}-{}:{}; the change was not applied",
-                        i + 1,
-                        path.display(),
-                        range.start.line,
-                        range.start.character,
-                        range.end.line,
-                        range.end.character
-                    )
-                })?;
+                    serde_json::from_value(range.clone()).map_err(|e| SyncError::BadRange(e.to_string()))?;
+                let span = LineIndex::new(&text).span(&text, range);
+                let span =
+                    span.ok_or_else(|| SyncError::ImpossibleRange { index: i + 1, path: path.clone(), range })?;
                 text.replace_range(span.start..span.end, new);
             }
         }
     }
     let version = p.pointer("/textDocument/version").and_then(Value::as_i64).map(|v| v as i32);
-    let doc = world.docs.get_mut(&path).ok_or("the document went away")?;
+    let doc = world.docs.get_mut(&path).ok_or(SyncError::NotOpen(path.clone()))?;
     doc.version = version.unwrap_or(doc.version);
     doc.lines = LineIndex::new(&text);
     doc.text = text;

@@ -165,9 +165,9 @@ impl<W: Write> Server<W> {
         let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             protocol::sync(&mut self.world, &n.method, &n.params)
         }))
-        .unwrap_or_else(|_| Err(format!("`{}` failed", n.method)));
-        if let Err(message) = outcome {
-            self.complain(message);
+        .unwrap_or_else(|_| Err(protocol::SyncError::Failed(n.method.clone())));
+        if let Err(e) = outcome {
+            self.complain(e.to_string());
         }
         None
     }
