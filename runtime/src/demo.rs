@@ -92,3 +92,22 @@ pub fn fig5(obstacle_after: Duration, log: Log) -> Vec<Box<dyn Agent>> {
         })
         .collect()
 }
+
+/// An agent the demo does not have.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("the demo stack has no agent `{missing}` (it has {})", .known.join(", "))]
+pub struct UnknownAgent {
+    pub missing: String,
+    pub known: Vec<String>,
+}
+
+/// The agents of [`fig5`] named in `names` (each must be one of them), the
+/// obstacle after 1.5 s.
+pub fn agents(names: &[String], log: Log) -> Result<Vec<Box<dyn Agent>>, UnknownAgent> {
+    let all = fig5(Duration::from_millis(1500), log);
+    let known: Vec<String> = all.iter().map(|a| a.name().to_string()).collect();
+    if let Some(missing) = names.iter().find(|n| !known.contains(n)) {
+        return Err(UnknownAgent { missing: missing.clone(), known });
+    }
+    Ok(all.into_iter().filter(|a| names.iter().any(|n| n == a.name())).collect())
+}

@@ -79,15 +79,7 @@ pub fn stop_flag() -> Arc<AtomicBool> {
 fn agents_of(stack: Stack, names: &[String]) -> Result<Vec<Box<dyn Agent>>, String> {
     match stack {
         Stack::None => Ok(Vec::new()),
-        Stack::Demo => {
-            let log: demo::Log = Arc::new(Mutex::new(Vec::new()));
-            let all = demo::fig5(Duration::from_millis(1500), log);
-            let known: Vec<&str> = all.iter().map(|a| a.name()).collect();
-            if let Some(missing) = names.iter().find(|n| !known.contains(&n.as_str())) {
-                return Err(format!("the demo stack has no agent `{missing}` (it has {})", known.join(", ")));
-            }
-            Ok(all.into_iter().filter(|a| names.iter().any(|n| n == a.name())).collect())
-        }
+        Stack::Demo => demo::agents(names, Arc::new(Mutex::new(Vec::new()))).map_err(|e| e.to_string()),
         Stack::Sim => {
             Err("the simulated vehicle runs in one process, in simulated time: use `--stack demo` or `--stack none`"
                 .into())

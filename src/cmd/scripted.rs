@@ -19,7 +19,7 @@ use situ_compiler::spec::{self, ScriptSpec};
 use situ_runtime::record::mcap::McapRecorder;
 use situ_runtime::record::Sink;
 use situ_runtime::script::wiring::Snapshot;
-use situ_runtime::script::{chart, Driver, ScriptRun};
+use situ_runtime::script::{chart, Driver, PickError, ScriptRun};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -80,27 +80,26 @@ fn load(file: &Path, script_file: Option<&Path>, trust: &situ_compiler::bundle::
     Ok(Loaded { content, scripts, bundle: false, bytes: None, checked: Some(checked) })
 }
 
-/// The script named `name` (the first without one), or why not.
+/// The script named `name` (the first without one), or why not, said with
+/// the file's name and what the user can do instead.
 fn pick(scripts: &[ScriptSpec], bundle: bool, file: &Path, name: Option<&str>) -> Result<ScriptSpec, String> {
-    match name {
-        None => scripts.first().cloned().ok_or_else(|| {
-            format!(
-                "`{}` has no reference stack (those of rules/outdoor.situ and rules/ugv.situ) and no `script` \
-                 block: give `--script FILE` or `--random SEED`",
-                file.display()
-            )
-        }),
-        Some(n) => scripts.iter().find(|s| s.name == n).cloned().ok_or_else(|| {
-            let names: Vec<String> = scripts.iter().map(|s| format!("\"{}\"", s.name)).collect();
-            if bundle {
-                format!("a bundle carries no scripts: run `{}`'s source to use script \"{n}\"", file.display())
-            } else if names.is_empty() {
-                format!("no script \"{n}\": `{}` has no `script` block, and no file `{n}` exists", file.display())
-            } else {
-                format!("no script \"{n}\" (and no such file); the scripts are: {}", names.join(", "))
-            }
-        }),
-    }
+    situ_runtime::script::pick(scripts, name).cloned().map_err(|e| match e {
+        PickError::NoScripts => format!(
+            "`{}` has no reference stack (those of rules/outdoor.situ and rules/ugv.situ) and no `script` \
+             block: give `--script FILE` or `--random SEED`",
+            file.display()
+        ),
+        PickError::NoSuchScript { name: n, known } if known.is_empty() && bundle => {
+            format!("a bundle carries no scripts: run `{}`'s source to use script \"{n}\"", file.display())
+        }
+        PickError::NoSuchScript { name: n, known } if known.is_empty() => {
+            format!("no script \"{n}\": `{}` has no `script` block, and no file `{n}` exists", file.display())
+        }
+        PickError::NoSuchScript { name: n, known } => {
+            let names: Vec<String> = known.iter().map(|s| format!("\"{s}\"")).collect();
+            format!("no script \"{n}\" (and no such file); the scripts are: {}", names.join(", "))
+        }
+    })
 }
 
 pub fn run(args: Args) -> u8 {

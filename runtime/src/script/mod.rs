@@ -316,3 +316,35 @@ impl ScriptRun {
         self.rt.now()
     }
 }
+
+/// Why no script was picked.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum PickError {
+    /// No name was given and the rules have no `script` block.
+    #[error("the rules have no `script` block")]
+    NoScripts,
+    /// No script has this name; `known` are the scripts there are.
+    #[error("no script \"{name}\"{}", known_scripts(.known))]
+    NoSuchScript { name: String, known: Vec<String> },
+}
+
+fn known_scripts(known: &[String]) -> String {
+    if known.is_empty() {
+        String::new()
+    } else {
+        let names: Vec<String> = known.iter().map(|n| format!("\"{n}\"")).collect();
+        format!("; the scripts are: {}", names.join(", "))
+    }
+}
+
+/// The script a run plays: the one named `name`, or the first of the rules
+/// when no name is given.
+pub fn pick<'a>(scripts: &'a [ScriptSpec], name: Option<&str>) -> Result<&'a ScriptSpec, PickError> {
+    match name {
+        None => scripts.first().ok_or(PickError::NoScripts),
+        Some(n) => scripts.iter().find(|s| s.name == n).ok_or_else(|| PickError::NoSuchScript {
+            name: n.to_string(),
+            known: scripts.iter().map(|s| s.name.clone()).collect(),
+        }),
+    }
+}
