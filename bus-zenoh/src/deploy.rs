@@ -140,7 +140,7 @@ impl Process {
 
 /// How far ahead of the Bulletinboard's clock an event may be stamped,
 /// when the file does not say (the runtime's default).
-pub const DEFAULT_MAX_SKEW_MS: u64 = situ_runtime::stack::DEFAULT_MAX_SKEW / 1_000_000;
+pub const DEFAULT_MAX_SKEW_MS: u64 = situ_runtime::runner::DEFAULT_MAX_SKEW / 1_000_000;
 
 /// The largest `max_skew_ms` a file may give: beyond, one event could age
 /// every fact of a typical stack past its `stale after`.

@@ -8,7 +8,7 @@ use situ_compiler::bundle::{Content, Value};
 use situ_runtime::bus::inproc::{Capacity, InProc};
 use situ_runtime::bus::{Bus, EventMsg};
 use situ_runtime::record::{SharedMemory, Sink, Verdict};
-use situ_runtime::stack::{BoardRunner, Shared, DEFAULT_MAX_SKEW};
+use situ_runtime::runner::{BoardRunner, Shared, DEFAULT_MAX_SKEW};
 use std::sync::Arc;
 
 const MS: u64 = 1_000_000;

@@ -20,7 +20,7 @@ use crate::bus::inproc::{Capacity, InProc};
 use crate::bus::{Bus, Doorbell};
 use crate::record::Sink;
 use crate::rete::StateChange;
-use crate::stack::{AgentRunner, BoardRunner, Shared};
+use crate::runner::{AgentRunner, BoardRunner, Shared};
 use crate::summary::Summary;
 use situ_bundle::Content;
 use std::collections::BTreeMap;
@@ -64,7 +64,7 @@ impl Default for RealtimeConfig {
             status_every: Duration::from_millis(200),
             safe_after: Duration::from_millis(600),
             stop: None,
-            max_skew: Duration::from_nanos(crate::stack::DEFAULT_MAX_SKEW),
+            max_skew: Duration::from_nanos(crate::runner::DEFAULT_MAX_SKEW),
         }
     }
 }

@@ -16,7 +16,7 @@ use crate::bus::inproc::{Capacity, InProc};
 use crate::bus::Bus;
 use crate::record::Sink;
 use crate::rete::StateChange;
-use crate::stack::{AgentRunner, BoardRunner, Shared};
+use crate::runner::{AgentRunner, BoardRunner, Shared};
 use crate::summary::Summary;
 use situ_bundle::Content;
 use std::cmp::Reverse;

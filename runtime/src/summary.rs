@@ -4,7 +4,7 @@
 
 use crate::bus::BusCounters;
 use crate::rete::StateChange;
-use crate::stack::{AgentCounters, BoardCounters};
+use crate::runner::{AgentCounters, BoardCounters};
 use serde::Serialize;
 use situ_bundle::Content;
 use std::collections::BTreeMap;

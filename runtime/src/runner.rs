@@ -1,4 +1,4 @@
-//! The running stack: agents stepping through their running cycle, and the
+//! Running the agents of a stack: agents stepping through their running cycle, and the
 //! Bulletinboard turning their events into the state it broadcasts. The
 //! pieces here are shared by the simulated-time scheduler (one thread,
 //! deterministic) and the real-time one (a thread per agent):
