@@ -16,7 +16,7 @@ use situ_compiler::bundle::Content;
 use situ_runtime::bus::inproc::{Capacity, InProc};
 use situ_runtime::bus::{Bus, EventMsg};
 use situ_runtime::rete::Engine;
-use situ_runtime::stack::{BoardRunner, Shared};
+use situ_runtime::runner::{BoardRunner, Shared};
 use situ_runtime::stream::{self, Event};
 use std::sync::Arc;
 

@@ -1,7 +1,7 @@
-//! Reading an input file whole, with a bound: the one way a bundle, a key
-//! or a source is read from disk.
+//! Files: reading an input whole, with a bound (the one way a bundle, a key
+//! or a source is read from disk), and writing an output atomically.
 
-use std::io;
+use std::io::{self, Write};
 use std::path::Path;
 
 /// The largest bundle a command reads.
@@ -68,4 +68,40 @@ fn not_regular(file_type: &std::fs::FileType) -> &'static str {
     }
     let _ = file_type;
     "a special file"
+}
+
+/// Writes a file so that it is never half written: a new temporary file
+/// next to it, synced, then a rename (the one way situ writes an output). A `secret` file is created readable by its owner only; another
+/// keeps the permissions of the file it replaces.
+pub fn write_atomically(path: &Path, bytes: &[u8], secret: bool) -> io::Result<()> {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let file_name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let tmp = dir.join(format!(".{file_name}.situ-tmp.{}", std::process::id()));
+    let mut options = std::fs::OpenOptions::new();
+    options.write(true);
+    if secret {
+        // A new file, so that the mode is the one it is created with.
+        options.create_new(true);
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::OpenOptionsExt;
+            options.mode(0o600);
+        }
+    } else {
+        options.create(true).truncate(true);
+    }
+    let result = options.open(&tmp).and_then(|mut f| {
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        if !secret {
+            if let Ok(meta) = std::fs::metadata(path) {
+                std::fs::set_permissions(&tmp, meta.permissions())?;
+            }
+        }
+        std::fs::rename(&tmp, path)
+    });
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
 }

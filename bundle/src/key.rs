@@ -8,7 +8,7 @@
 use crate::file::read_bounded;
 use crate::sign::{KeyError, KeyId, PublicKey, SecretKey, SECRET_HEADER};
 use std::ffi::OsString;
-use std::io::{self, Write};
+use std::io;
 use std::path::{Path, PathBuf};
 
 /// The largest key file read (a key file is a few hundred bytes).
@@ -127,46 +127,10 @@ pub fn create(name: &Path, force: bool) -> Result<NewKey, KeyFileError> {
 pub fn write_pair(name: &Path, key: &SecretKey) -> Result<(), KeyFileError> {
     let (secret_path, public_path) = (with_ext(name, "key"), with_ext(name, "pub"));
     let label = name.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    write_atomically(&secret_path, key.to_text(&label).as_bytes(), true)
+    crate::file::write_atomically(&secret_path, key.to_text(&label).as_bytes(), true)
         .map_err(|source| KeyFileError::Write { path: secret_path.clone(), source })?;
-    write_atomically(&public_path, key.public().to_text(&label).as_bytes(), false)
+    crate::file::write_atomically(&public_path, key.public().to_text(&label).as_bytes(), false)
         .map_err(|source| KeyFileError::Write { path: public_path.clone(), source })
-}
-
-/// Writes a file atomically: a new temporary file next to it, then a
-/// rename. A `secret` file is created readable by its owner only; another
-/// keeps the permissions of the file it replaces.
-fn write_atomically(path: &Path, bytes: &[u8], secret: bool) -> io::Result<()> {
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let file_name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = dir.join(format!(".{file_name}.situ-tmp.{}", std::process::id()));
-    let mut options = std::fs::OpenOptions::new();
-    options.write(true);
-    if secret {
-        // A new file, so that the mode is the one it is created with.
-        options.create_new(true);
-        #[cfg(unix)]
-        {
-            use std::os::unix::fs::OpenOptionsExt;
-            options.mode(0o600);
-        }
-    } else {
-        options.create(true).truncate(true);
-    }
-    let result = options.open(&tmp).and_then(|mut f| {
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        if !secret {
-            if let Ok(meta) = std::fs::metadata(path) {
-                std::fs::set_permissions(&tmp, meta.permissions())?;
-            }
-        }
-        std::fs::rename(&tmp, path)
-    });
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
 }
 
 #[cfg(test)]

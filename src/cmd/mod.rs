@@ -141,22 +141,10 @@ pub fn host_port(addr: &str) -> Option<(&str, u16)> {
     Some((host, port.parse().ok()?))
 }
 
-/// Writes a file so that it is never half written: a temporary file next to
-/// it, then a rename (keeping the permissions of a file it replaces).
+/// Writes a file so that it is never half written (a temporary file next
+/// to it, then a rename, keeping the permissions of a file it replaces).
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.situ-tmp.{}", std::process::id()));
-    let result = std::fs::write(&tmp, bytes).and_then(|()| {
-        if let Ok(meta) = std::fs::metadata(path) {
-            std::fs::set_permissions(&tmp, meta.permissions())?;
-        }
-        std::fs::rename(&tmp, path)
-    });
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
+    situ_compiler::bundle::file::write_atomically(path, bytes, false)
 }
 
 #[cfg(test)]
