@@ -169,7 +169,7 @@ fn every_code_has_inputs() {
     announced.extend(announced_in("tests/checks"));
     let mut failures = Vec::new();
     // The ROS 2 map's codes have their inputs in tests/ros2/ (tests/ros2_map.rs)
-    // and in situ-ros2's own tests.
+    // and in situ-ros2-map's own tests.
     // The verdicts' codes (E05xx, W05xx) are raised by `situ test`: their
     // inputs are in tests/verify/ (tests/verify.rs, tests/test_cmd.rs).
     let mine = |c: &str| !situ_compiler::codes::is_ros2_map(c) && !situ_compiler::codes::is_verdict(c);

@@ -12,7 +12,7 @@
 //! disk, and at the end; each time whole (written aside, then renamed).
 
 use serde::Serialize;
-use situ_ros2::msgs::CATALOGUE;
+use situ_ros2_map::msgs::CATALOGUE;
 use situ_runtime::record::mcap::staged::Staged;
 use std::collections::BTreeMap;
 use std::fs::{self, File};

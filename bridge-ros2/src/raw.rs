@@ -1,13 +1,13 @@
 //! A DDS sample's bytes as they came, encapsulation header included: the
 //! reader type of the bridge's topics and of its service replies. The map's
-//! decoder ([`situ_ros2::cdr`]) reads them, not serde.
+//! decoder ([`situ_ros2_map::cdr`]) reads them, not serde.
 
 use rustdds::no_key;
 use rustdds::RepresentationIdentifier;
 use std::fmt;
 
 /// A sample's bytes as they came, encapsulation header included: the
-/// map's decoder ([`situ_ros2::cdr`]) reads them, not serde.
+/// map's decoder ([`situ_ros2_map::cdr`]) reads them, not serde.
 pub struct Raw(pub Vec<u8>);
 
 /// The adapter that keeps a sample's bytes.

@@ -12,7 +12,7 @@
 //! Bounded like the decoder: nothing is allocated beyond what the input
 //! holds, and a length or count past its end is an error.
 
-use situ_ros2::msgs::{self, FieldType, CATALOGUE};
+use situ_ros2_map::msgs::{self, FieldType, CATALOGUE};
 
 /// Whether `cdr`'s encapsulation is one [`to_xcdr1`] reads.
 pub fn is_xcdr2(cdr: &[u8]) -> bool {

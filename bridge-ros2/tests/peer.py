@@ -29,7 +29,7 @@ import time
 import typing
 from dataclasses import dataclass, field
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "ros2", "tests"))
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "ros2-map", "tests"))
 
 try:
     import cyclonedds.idl.types as t

@@ -1,5 +1,5 @@
 //! XCDR2 read into XCDR1 against Eclipse Cyclone DDS, an implementation
-//! independent of the bridge's: every message of `ros2/tests/cdr_samples.py`
+//! independent of the bridge's: every message of `ros2-map/tests/cdr_samples.py`
 //! (21 types, both byte orders) serialized by the `cyclonedds` package in
 //! XCDR2 (`bridge-ros2/tests/xcdr2_samples.py`), as final types (`00 06`,
 //! `00 07`) and as appendable ones (the delimited `00 08`, `00 09`), decodes,
@@ -11,8 +11,8 @@
 
 use serde_json::Value as Json;
 use situ_bridge_ros2::xcdr2;
-use situ_ros2::cdr::Decoder;
-use situ_ros2::msgs;
+use situ_ros2_map::cdr::Decoder;
+use situ_ros2_map::msgs;
 
 fn hex(s: &str) -> Vec<u8> {
     (0..s.len()).step_by(2).map(|i| u8::from_str_radix(&s[i..i + 2], 16).unwrap()).collect()

@@ -1,4 +1,4 @@
-"""The messages of ros2/tests/cdr_samples.py serialized by Eclipse Cyclone DDS
+"""The messages of ros2-map/tests/cdr_samples.py serialized by Eclipse Cyclone DDS
 (the `cyclonedds` package) in XCDR1 and in XCDR2, both byte orders; with
 `--appendable`, every type of them declared appendable first: XCDR2 is then
 the delimited form (`00 08`/`00 09`) and `xcdr1_hex` is left out (Cyclone
@@ -16,7 +16,7 @@ import pathlib
 import sys
 
 HERE = pathlib.Path(__file__).resolve().parent
-spec = importlib.util.spec_from_file_location("cdr_samples", HERE.parent.parent / "ros2" / "tests" / "cdr_samples.py")
+spec = importlib.util.spec_from_file_location("cdr_samples", HERE.parent.parent / "ros2-map" / "tests" / "cdr_samples.py")
 samples = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(samples)  # exits 3 itself when cyclonedds is missing
 from cyclonedds.idl import Endianness, IdlStruct  # noqa: E402

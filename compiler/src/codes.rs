@@ -119,7 +119,7 @@ pub fn is_verdict(code: &str) -> bool {
 }
 
 /// Whether the code is a ROS 2 map's (E04xx, W04xx: `situ check
-/// --ros2-map`, crate `situ-ros2`): a map raises it, never rules alone.
+/// --ros2-map`, crate `situ-ros2-map`): a map raises it, never rules alone.
 pub fn is_ros2_map(code: &str) -> bool {
     code.get(1..3) == Some("04")
 }

@@ -37,7 +37,7 @@ fn examples_raise_their_code_and_fixes_are_clean() {
             failures.push(format!("{}: needs a ```situ block under Example and under Use instead", c.code));
             continue;
         }
-        // A map raises the ROS 2 map's codes, not rules alone: situ-ros2's
+        // A map raises the ROS 2 map's codes, not rules alone: situ-ros2-map's
         // `the_examples_of_the_codes_are_real` holds their examples to them.
         // Likewise `situ test` raises the verdicts' codes: situ-verify's
         // `the_examples_of_the_verdict_codes_are_real` holds theirs.

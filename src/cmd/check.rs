@@ -68,7 +68,7 @@ fn check_map(checked: &mut situ_compiler::Checked, map: &Path, loader: &dyn Load
         return Ok(());
     }
     let file = checked.sources.add(SourceFile::new(map.display().to_string(), text));
-    let found = situ_ros2::check_map(&checked.model, &checked.sources.get(file).text, file);
+    let found = situ_ros2_map::check_map(&checked.model, &checked.sources.get(file).text, file);
     checked.diagnostics.extend(found);
     Ok(())
 }

@@ -100,7 +100,7 @@ pub fn run(args: Args) -> Outcome {
             let mut sources = SourceMap::new();
             let name = format!("{} (a bundle: no source)", args.file.display());
             let file = sources.add(SourceFile::new(name, ""));
-            (sources, situ_ros2::skeleton::model_of(&program.content, file))
+            (sources, situ_ros2_map::skeleton::model_of(&program.content, file))
         }
     };
     let file = sources.add(SourceFile::new(args.map.display().to_string(), text));

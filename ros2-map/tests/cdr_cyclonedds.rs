@@ -10,9 +10,9 @@
 use serde_json::Value as Json;
 use situ_compiler::bundle::Value;
 use situ_grammar::diag::FileId;
-use situ_ros2::cdr::{Decoder, Value as Msg};
-use situ_ros2::eval::Produced;
-use situ_ros2::Translator;
+use situ_ros2_map::cdr::{Decoder, Value as Msg};
+use situ_ros2_map::eval::Produced;
+use situ_ros2_map::Translator;
 use std::path::Path;
 use std::process::Command;
 

@@ -3,14 +3,14 @@
 //! LaserScan messages of N ranges, from their CDR bytes to the events
 //! (decode, `when`, payload), one message after another.
 //!
-//!   cargo run --release -p situ-ros2 --example translate_rate -- [RANGES] [MESSAGES]
+//!   cargo run --release -p situ-ros2-map --example translate_rate -- [RANGES] [MESSAGES]
 //!
 //! Prints the rate and the per-message latency (p50, p99, max). The issue's
 //! goal: the bridge keeps up with 10 kHz of LaserScan-sized messages.
 
 use situ_compiler::loader::FsLoader;
 use situ_grammar::diag::FileId;
-use situ_ros2::Translator;
+use situ_ros2_map::Translator;
 use std::path::Path;
 use std::time::Instant;
 

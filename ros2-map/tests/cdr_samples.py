@@ -6,7 +6,7 @@ Prints one JSON line per message:
 where `expect` holds every leaf of the message by its field path as the map
 writes it (`status[0].values[1].key`), NaN and infinities as the strings
 "nan", "inf", "-inf", and `f32` lists the paths of float32 leaves.
-Run by ros2/tests/cdr_cyclonedds.rs; exits 3 when cyclonedds is missing.
+Run by ros2-map/tests/cdr_cyclonedds.rs; exits 3 when cyclonedds is missing.
 """
 
 import dataclasses
