@@ -29,6 +29,21 @@ pub enum Error {
     /// A bundle is damaged, of another format version, or was changed.
     #[error(transparent)]
     Bundle(#[from] LoadError),
+    /// A recording is not one situ can read (not MCAP, damaged, too large).
+    #[error(transparent)]
+    Recording(#[from] situ_runtime::record::mcap::read::ReadError),
+    /// A recording carries no bundle and none was given.
+    #[error("the recording has no bundle attached: give one")]
+    NoAttachedBundle,
+    /// A recording holds nothing of situ's, or not of these rules.
+    #[error(transparent)]
+    Replay(#[from] situ_runtime::replay::ReplayError),
+    /// No script to play (none in the rules, or none of that name).
+    #[error(transparent)]
+    Script(#[from] situ_runtime::script::PickError),
+    /// An output could not be written.
+    #[error("cannot write {what}: {source}")]
+    Write { what: &'static str, source: std::io::Error },
     /// A bundle is not signed by a trusted key (a damaged one is
     /// [`Error::Bundle`], under any policy).
     #[error(transparent)]

@@ -1,4 +1,5 @@
-//! situ as a library: the operations a user performs on situation rules,
+//! situ as a library: the operations a user performs on situation rules
+//! (check, format, build, load, test, run on a script, replay),
 //! with typed options, results and errors. The command line (`situ`) is a
 //! client of this crate, as the Python package and the C API are: it parses
 //! arguments, calls these functions, prints what they return and maps
@@ -20,10 +21,14 @@
 
 mod error;
 mod program;
+mod runs;
 mod suite;
 
 pub use error::Error;
 pub use program::{build, check, format, load, load_path, BuildOptions, Built, Input, Program};
+pub use runs::{replay, run_script, Drive, Replayed};
 pub use situ_compiler::bundle::{Content, Encoding, Loaded, Trust};
 pub use situ_compiler::{Checked, Diagnostic, Severity};
+pub use situ_runtime::replay::ReplayReport;
+pub use situ_runtime::script::report::ScriptReport;
 pub use suite::{test, SuiteReport, TestOptions, Verdict};

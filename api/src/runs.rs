@@ -1,0 +1,92 @@
+//! Runs without a robot: a rules file on one of its scripts or on the guided
+//! random generator (every agent a stand-in that follows its table or FSM),
+//! and a recording replayed on a bundle.
+
+use crate::{Error, Program, Trust};
+use situ_compiler::bundle::sign::KeyId;
+use situ_compiler::bundle::{self, Content, Encoding};
+use situ_compiler::spec;
+use situ_runtime::record::mcap::read::{attached_bundle, read_recording};
+use situ_runtime::record::mcap::McapRecorder;
+use situ_runtime::record::Sink;
+use situ_runtime::replay::{replay_reading, ReplayReport};
+use situ_runtime::script::report::ScriptReport;
+use situ_runtime::script::{pick, Driver, ScriptRun};
+use std::path::Path;
+use std::sync::Arc;
+
+/// What drives a scripted run.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Drive {
+    /// The rules' `script` block of this name, or their first one.
+    Script(Option<String>),
+    /// The guided random generator, from this seed.
+    Random(u64),
+}
+
+/// Runs a program on a script or on the random generator, in simulated
+/// time, to `until` (ns; default: the script's end, or five minutes of
+/// random events), recorded to `record` (MCAP, the bundle attached; written
+/// beside it and renamed when whole). Scripts are read from the program's
+/// source: a bundle carries none.
+pub fn run_script(
+    program: &Program,
+    drive: &Drive,
+    until: Option<u64>,
+    record: Option<&Path>,
+) -> Result<ScriptReport, Error> {
+    let driver = match drive {
+        Drive::Random(seed) => Driver::Random { seed: *seed },
+        Drive::Script(name) => {
+            let scripts = program.checked.as_ref().map(spec::scripts).unwrap_or_default();
+            Driver::Script(pick(&scripts, name.as_deref())?.clone())
+        }
+    };
+    let write = |source| Error::Write { what: "the run's recording", source };
+    let partial = record.map(|p| {
+        let name = p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        p.with_file_name(format!(".{name}.situ-tmp.{}", std::process::id()))
+    });
+    let sink: Option<Box<dyn Sink>> = match &partial {
+        None => None,
+        Some(path) => {
+            let bytes = program.bytes.clone().unwrap_or_else(|| bundle::encode(&program.content, Encoding::Json));
+            Some(Box::new(McapRecorder::create(path, program.content.clone(), &bytes).map_err(write)?))
+        }
+    };
+    let mut run = ScriptRun::new(program.content.clone(), driver, until, sink);
+    run.run(&mut |_| {});
+    let report = run.finish().map_err(write)?;
+    if let (Some(partial), Some(path)) = (&partial, record) {
+        std::fs::rename(partial, path).map_err(write)?;
+    }
+    Ok(report)
+}
+
+/// A replay: where the states of a recording and of the bundle differ, and
+/// which bundle it was (the one given, or the one attached to the recording,
+/// with the key that signed it when the policy asked for one).
+#[derive(Debug)]
+pub struct Replayed {
+    pub report: ReplayReport,
+    /// The messages read (up to a cut, for a recording cut short).
+    pub messages: usize,
+    pub attached: bool,
+    pub signed_by: Option<KeyId>,
+}
+
+/// Feeds the events of a recording to `bundle`, or to the bundle attached to
+/// the recording (verified under `trust`), and says where the states differ.
+pub fn replay(recording: &[u8], bundle: Option<Arc<Content>>, trust: &Trust) -> Result<Replayed, Error> {
+    let reading = read_recording(recording)?;
+    let (content, attached, signed_by) = match bundle {
+        Some(c) => (c, false, None),
+        None => {
+            let bytes = attached_bundle(recording).ok_or(Error::NoAttachedBundle)?;
+            let loaded = crate::load(&bytes, trust)?;
+            (Arc::new(loaded.content), true, loaded.signer)
+        }
+    };
+    let report = replay_reading(&reading, content)?;
+    Ok(Replayed { report, messages: reading.messages.len(), attached, signed_by })
+}
