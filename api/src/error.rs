@@ -35,6 +35,10 @@ pub enum Error {
     /// A recording carries no bundle and none was given.
     #[error("the recording has no bundle attached: give one")]
     NoAttachedBundle,
+    /// The bundle attached to a recording does not load (damaged, or not
+    /// signed by a trusted key).
+    #[error("the bundle attached to the recording: {0}")]
+    Attached(Box<Error>),
     /// A recording holds nothing of situ's, or not of these rules.
     #[error(transparent)]
     Replay(#[from] situ_runtime::replay::ReplayError),

@@ -26,7 +26,7 @@ mod suite;
 
 pub use error::Error;
 pub use program::{build, check, format, load, load_path, BuildOptions, Built, Input, Program};
-pub use runs::{replay, run_script, Drive, Replayed};
+pub use runs::{replay, run_script, Drive, Recording, Replayed};
 pub use situ_compiler::bundle::{Content, Encoding, Loaded, Trust};
 pub use situ_compiler::{Checked, Diagnostic, Severity};
 pub use situ_runtime::replay::ReplayReport;

@@ -6,7 +6,7 @@ use crate::{Error, Program, Trust};
 use situ_compiler::bundle::sign::KeyId;
 use situ_compiler::bundle::{self, Content, Encoding};
 use situ_compiler::spec;
-use situ_runtime::record::mcap::read::{attached_bundle, read_recording};
+use situ_runtime::record::mcap::read::{attached_bundle, read_recording, Reading};
 use situ_runtime::record::mcap::McapRecorder;
 use situ_runtime::record::Sink;
 use situ_runtime::replay::{replay_reading, ReplayReport};
@@ -63,30 +63,52 @@ pub fn run_script(
     Ok(report)
 }
 
-/// A replay: where the states of a recording and of the bundle differ, and
-/// which bundle it was (the one given, or the one attached to the recording,
-/// with the key that signed it when the policy asked for one).
+/// A recording read and checked whole (up to a cut, for a run that was
+/// killed), ready to be replayed on a bundle.
+pub struct Recording {
+    bytes: Vec<u8>,
+    reading: Reading,
+}
+
+impl Recording {
+    /// Reads a recording's bytes: MCAP, undamaged up to its end or a cut.
+    pub fn read(bytes: Vec<u8>) -> Result<Recording, Error> {
+        let reading = read_recording(&bytes)?;
+        Ok(Recording { bytes, reading })
+    }
+
+    /// The messages read (up to the cut, for a recording cut short).
+    pub fn messages(&self) -> usize {
+        self.reading.messages.len()
+    }
+
+    /// Feeds the recorded events to `bundle`, or to the bundle attached to
+    /// the recording (verified under `trust`), and says where the states
+    /// differ.
+    pub fn replay(&self, bundle: Option<Arc<Content>>, trust: &Trust) -> Result<Replayed, Error> {
+        let (content, signed_by) = match bundle {
+            Some(c) => (c, None),
+            None => {
+                let bytes = attached_bundle(&self.bytes).ok_or(Error::NoAttachedBundle)?;
+                let loaded = crate::load(&bytes, trust).map_err(|e| Error::Attached(Box::new(e)))?;
+                (Arc::new(loaded.content), loaded.signer)
+            }
+        };
+        let report = replay_reading(&self.reading, content)?;
+        Ok(Replayed { report, signed_by })
+    }
+}
+
+/// A replay: where the states of the recording and of the bundle differ,
+/// and, for a bundle attached to the recording and verified under a policy
+/// that asks for signatures, the key that signed it.
 #[derive(Debug)]
 pub struct Replayed {
     pub report: ReplayReport,
-    /// The messages read (up to a cut, for a recording cut short).
-    pub messages: usize,
-    pub attached: bool,
     pub signed_by: Option<KeyId>,
 }
 
-/// Feeds the events of a recording to `bundle`, or to the bundle attached to
-/// the recording (verified under `trust`), and says where the states differ.
+/// [`Recording::read`] then [`Recording::replay`].
 pub fn replay(recording: &[u8], bundle: Option<Arc<Content>>, trust: &Trust) -> Result<Replayed, Error> {
-    let reading = read_recording(recording)?;
-    let (content, attached, signed_by) = match bundle {
-        Some(c) => (c, false, None),
-        None => {
-            let bytes = attached_bundle(recording).ok_or(Error::NoAttachedBundle)?;
-            let loaded = crate::load(&bytes, trust)?;
-            (Arc::new(loaded.content), true, loaded.signer)
-        }
-    };
-    let report = replay_reading(&reading, content)?;
-    Ok(Replayed { report, messages: reading.messages.len(), attached, signed_by })
+    Recording::read(recording.to_vec())?.replay(bundle, trust)
 }

@@ -16,9 +16,9 @@
 //! swapped or edited is refused (exit 2, naming the key).
 
 use super::{CliError, Outcome, Trust, FAILED, OK};
-use situ_runtime::record::mcap::{attached_bundle, read_file, read_recording};
+use situ_api::{Error, Recording};
+use situ_runtime::record::mcap::read_file;
 use std::path::PathBuf;
-use std::sync::Arc;
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
 pub enum Format {
@@ -46,46 +46,30 @@ pub struct Args {
 pub fn run(args: &Args) -> Outcome {
     let trust = args.trust.policy()?;
     let (recording, bundle_path, format) = (args.recording.as_path(), args.bundle.as_ref(), args.format);
-    let bytes = match read_file(recording) {
-        Ok(b) => b,
-        Err(e) => {
-            return Err(CliError::Usage(format!("`{}`: {e}", recording.display())));
-        }
+    let name = recording.display();
+    let bytes = read_file(recording).map_err(|e| CliError::Usage(format!("`{name}`: {e}")))?;
+    let read = Recording::read(bytes).map_err(|e| match e {
+        Error::Recording(e) => CliError::Usage(format!("`{name}` is not a readable recording: {e}")),
+        e => CliError::Usage(format!("`{name}`: {e}")),
+    })?;
+    let bundle = match bundle_path {
+        Some(p) => Some(super::program::load(p, false, &trust).map_err(CliError::Reported)?.content),
+        None => None,
     };
-    let reading = match read_recording(&bytes) {
-        Ok(r) => r,
-        Err(e) => {
-            return Err(CliError::Usage(format!("`{}` is not a readable recording: {e}", recording.display())));
-        }
-    };
-    let content = match bundle_path {
-        Some(p) => super::program::load(p, false, &trust).map_err(CliError::Reported)?.content,
-        None => match attached_bundle(&bytes).map(|b| {
-            super::program::decode_bundle(&b, &format!("the bundle attached to `{}`", recording.display()), &trust)
-        }) {
-            Some(Ok(c)) => Arc::new(c),
-            Some(Err(e)) => {
-                return Err(CliError::Usage(format!("the bundle attached to `{}`: {e}", recording.display())));
-            }
-            None => {
-                return Err(CliError::Usage(format!(
-                    "`{}` has no bundle attached: give one with --bundle",
-                    recording.display()
-                )));
-            }
-        },
-    };
-    let report = match situ_runtime::replay::replay_reading(&reading, content) {
-        Ok(r) => r,
-        Err(e) => {
-            return Err(CliError::Usage(format!("`{}`: {e}", recording.display())));
-        }
-    };
+    let replayed = read.replay(bundle, &trust).map_err(|e| match e {
+        Error::NoAttachedBundle => CliError::Usage(format!("`{name}` has no bundle attached: give one with --bundle")),
+        Error::Attached(e) => CliError::Usage(format!("the bundle attached to `{name}`: {e}")),
+        e => CliError::Usage(format!("`{name}`: {e}")),
+    })?;
+    if let Some(key_id) = replayed.signed_by {
+        eprintln!("the bundle attached to `{name}`: signed by trusted key {key_id}");
+    }
+    let report = replayed.report;
     if let Some(why) = &report.cut_reason {
         eprintln!(
             "warning: `{}` is cut short ({} messages read): {why}; the replay covers the part before the cut",
             recording.display(),
-            reading.messages.len()
+            read.messages()
         );
     }
     match format {
