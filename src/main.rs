@@ -48,19 +48,7 @@ enum Command {
     /// The ROS 2 bridge: topics to events, the situation to topics, lifecycle nodes driven by the tables (docs/ros2.md; `--features ros2`).
     Ros2(cmd::ros2::Args),
     /// Start every local process of a deployment (Zenoh) and stop them cleanly on Ctrl-C.
-    Up {
-        /// The deployment file.
-        deploy: PathBuf,
-        /// The rules (a `.situ` source or a bundle).
-        file: PathBuf,
-        #[arg(long, value_enum, default_value_t = cmd::distributed::Stack::Demo)]
-        stack: cmd::distributed::Stack,
-        /// How long each process runs, in seconds.
-        #[arg(long, default_value_t = 10.0)]
-        duration: f64,
-        #[command(flatten)]
-        trust: cmd::Trust,
-    },
+    Up(cmd::distributed::UpArgs),
     /// Pictures: the wiring of a state, the Rete network, the state transitions.
     Graph(cmd::graph::Args),
     /// Serve the Supervisor's console on 127.0.0.1 until Ctrl-C: the state graph, the wiring of a state, the rules, and for a recording a timeline; exit 2 on a damaged recording, other rules, or a port in use.
@@ -131,9 +119,7 @@ fn dispatch(command: Command) -> cmd::Outcome {
         Command::Repl(args) => cmd::repl::run(&args.file),
         Command::Lsp => Ok(cmd::lsp::run()),
         Command::Replay(args) => cmd::replay::run(&args),
-        Command::Up { deploy, file, stack, duration, trust } => {
-            Ok(cmd::distributed::up(&deploy, &file, stack, duration, &trust.trust))
-        }
+        Command::Up(args) => Ok(cmd::distributed::up(&args)),
         Command::Graph(args) => cmd::graph::run(&args),
         Command::Ros2(args) => cmd::ros2::run(args),
         Command::View(args) => cmd::view::run(&args),

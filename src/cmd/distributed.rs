@@ -333,7 +333,25 @@ fn local_processes(_deploy: &Path, _agents: &[String]) -> Result<Vec<(String, bo
 /// `situ up DEPLOY FILE [--stack …] [--duration S] [--trust PUBKEY]…`: the
 /// processes get the same `--trust` keys (each checks the bundle itself)
 /// and each warns when the deployment is open (no `[tls]`).
-pub fn up(deploy: &Path, file: &Path, stack: Stack, duration: f64, trust: &[PathBuf]) -> u8 {
+// The arguments of `situ up` (its help is the doc comment of `Command::Up`).
+#[derive(clap::Args, Debug)]
+pub struct UpArgs {
+    /// The deployment file.
+    pub deploy: PathBuf,
+    /// The rules (a `.situ` source or a bundle).
+    pub file: PathBuf,
+    #[arg(long, value_enum, default_value_t = Stack::Demo)]
+    pub stack: Stack,
+    /// How long each process runs, in seconds.
+    #[arg(long, default_value_t = 10.0)]
+    pub duration: f64,
+    #[command(flatten)]
+    pub trust: super::Trust,
+}
+
+pub fn up(args: &UpArgs) -> u8 {
+    let (deploy, file, stack, duration, trust) =
+        (args.deploy.as_path(), args.file.as_path(), args.stack, args.duration, args.trust.trust.as_slice());
     let policy = match super::program::trust_of(trust) {
         Ok(t) => t,
         Err(code) => return code,
