@@ -13,7 +13,9 @@ python3 -m pip install --quiet --disable-pip-version-check -r examples/python/re
 bash scripts/install-graphviz.sh # situ graph lays pictures out with Graphviz; tests/graph_cmd.rs needs it
 bash scripts/install-chromium.sh # tests/view_cmd.rs drives situ view's page in headless Chromium
 echo "== the runtime depends on the bundle crate, not on the compiler (cargo tree -p situ-runtime)"
-leaked=$(cargo tree -p situ-runtime | grep -E "pest|miette|grammar|petgraph|situ-compiler" || true)
+tree=$(cargo tree -p situ-runtime) # dev-dependencies included
+grep -q "^situ-runtime " <<<"$tree" || { echo "cargo tree printed no tree for situ-runtime" >&2; exit 1; }
+leaked=$(grep -E "pest|miette|grammar|petgraph|situ-compiler" <<<"$tree" || true)
 if [ -n "$leaked" ]; then
     echo "situ-runtime reaches the compiler's dependencies:"
     echo "$leaked"
