@@ -25,7 +25,7 @@ mod runs;
 mod suite;
 
 pub use error::Error;
-pub use program::{build, check, format, load, load_path, BuildOptions, Built, Input, Program};
+pub use program::{build, check, format, is_source, load, load_path, BuildOptions, Built, Input, Program};
 pub use runs::{replay, run_script, Drive, Recording, Replayed};
 pub use situ_compiler::bundle::{Content, Encoding, Loaded, Trust};
 pub use situ_compiler::{Checked, Diagnostic, Severity};

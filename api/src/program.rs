@@ -83,6 +83,11 @@ pub fn load(bytes: &[u8], trust: &Trust) -> Result<Loaded, Error> {
     Ok(situ_compiler::bundle::load(bytes, trust)?)
 }
 
+/// Whether a path names a source file (`.situ`), else a bundle.
+pub fn is_source(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e == "situ")
+}
+
 /// A program ready to run, and its checked source when it came from one.
 #[derive(Debug, Clone)]
 pub struct Program {
@@ -98,7 +103,7 @@ pub struct Program {
 /// and verified). Under [`Trust::Keys`] a source is refused: it carries no
 /// signature.
 pub fn load_path(path: &Path, trust: &Trust, deny_warnings: bool) -> Result<Program, Error> {
-    if path.extension().is_some_and(|e| e == "situ") {
+    if is_source(path) {
         if trust.requires_signature() {
             return Err(Error::UnsignedSource { path: path.to_path_buf() });
         }

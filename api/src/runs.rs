@@ -43,10 +43,7 @@ pub fn run_script(
         }
     };
     let write = |source| Error::Write { what: "the run's recording", source };
-    let partial = record.map(|p| {
-        let name = p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        p.with_file_name(format!(".{name}.situ-tmp.{}", std::process::id()))
-    });
+    let partial = record.map(bundle::file::partial_path);
     let sink: Option<Box<dyn Sink>> = match &partial {
         None => None,
         Some(path) => {

@@ -2,7 +2,7 @@
 //! or a source is read from disk), and writing an output atomically.
 
 use std::io::{self, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The largest bundle a command reads.
 pub const MAX_BUNDLE_BYTES: u64 = 256 * 1024 * 1024;
@@ -70,13 +70,20 @@ fn not_regular(file_type: &std::fs::FileType) -> &'static str {
     "a special file"
 }
 
-/// Writes a file so that it is never half written: a new temporary file
-/// next to it, synced, then a rename (the one way situ writes an output). A `secret` file is created readable by its owner only; another
-/// keeps the permissions of the file it replaces.
-pub fn write_atomically(path: &Path, bytes: &[u8], secret: bool) -> io::Result<()> {
+/// Where an output is written before it is whole: a hidden file beside
+/// `path`, named for it and for this process, renamed onto `path` at the end.
+pub fn partial_path(path: &Path) -> PathBuf {
     let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let file_name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = dir.join(format!(".{file_name}.situ-tmp.{}", std::process::id()));
+    dir.join(format!(".{file_name}.situ-tmp.{}", std::process::id()))
+}
+
+/// Writes a file so that it is never half written: a new temporary file
+/// next to it ([`partial_path`]), synced, then a rename (the one way situ
+/// writes an output). A `secret` file is created readable by its owner
+/// only; another keeps the permissions of the file it replaces.
+pub fn write_atomically(path: &Path, bytes: &[u8], secret: bool) -> io::Result<()> {
+    let tmp = partial_path(path);
     let mut options = std::fs::OpenOptions::new();
     options.write(true);
     if secret {

@@ -10,12 +10,7 @@ use situ_compiler::loader::FsLoader;
 use situ_compiler::{render, Checked};
 use std::path::{Path, PathBuf};
 
-pub use situ_api::Program;
-
-/// Whether a path names a source file (else a bundle).
-pub fn is_source(path: &Path) -> bool {
-    path.extension().is_some_and(|e| e == "situ")
-}
+pub use situ_api::{is_source, Program};
 
 /// The trust policy of `--trust` public keys (none: every valid bundle
 /// loads, signed or not); prints why a key file is refused and returns the

@@ -148,10 +148,7 @@ pub fn run(args: Args) -> u8 {
     }
     // The recording is written beside its place and renamed when whole.
     let record_to = args.record.clone().or_else(|| args.out.as_ref().map(|d| d.join("recording.mcap")));
-    let partial = record_to.as_ref().map(|p| {
-        let name = p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        p.with_file_name(format!(".{name}.situ-tmp.{}", std::process::id()))
-    });
+    let partial = record_to.as_deref().map(situ_compiler::bundle::file::partial_path);
     let file = match &partial {
         Some(path) => {
             let bytes = loaded.bytes.clone().unwrap_or_else(|| bundle::encode(&content, Encoding::Json));

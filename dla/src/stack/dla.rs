@@ -7,7 +7,6 @@ use situ_runtime::agent::Agent;
 use situ_sim::scenario::Scenario;
 use situ_sim::stack::{RunReport, SharedPhysics, Stack};
 use situ_sim::world::World;
-use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 
 /// Pérez's DLA (`rules/dla.situ`): deliberative and case-based reactive
@@ -61,9 +60,6 @@ impl Stack for Dla {
     }
     fn goal_state(&self) -> &'static str {
         "Arrived"
-    }
-    fn rates(&self) -> BTreeMap<String, f64> {
-        BTreeMap::new()
     }
     /// The reactive layer's 10 Hz.
     fn sample_every(&self) -> u64 {
