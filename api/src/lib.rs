@@ -19,11 +19,15 @@
 //! # Ok::<(), situ_api::Error>(())
 //! ```
 
+mod board;
 mod error;
 mod program;
 mod runs;
 mod suite;
 
+pub use board::{
+    AgentNow, Arg, Board, BoardError, Change, Clock, Counters, Fact, FactNow, FieldValue, Fired, Posted, Reloaded, Why,
+};
 pub use error::Error;
 pub use program::{build, check, format, is_source, load, load_path, BuildOptions, Built, Input, Program};
 pub use runs::{replay, run_script, Drive, Recording, Replayed};

@@ -37,6 +37,7 @@ pub mod bench;
 pub mod bulletinboard;
 pub mod bus;
 pub mod demo;
+pub mod local;
 pub mod organise;
 pub mod realtime;
 pub mod record;

@@ -16,9 +16,8 @@
 //! sees each new state at rest. The session does no I/O: reloading and
 //! saving are asked of the caller, which reads and writes the files.
 
-use crate::bulletinboard::Bulletinboard;
-use crate::organise::Organisation;
-use crate::rete::{describe_fact, format_time, show_value, StateChange};
+use crate::local::{LocalBoard, NotTaken, Taken};
+use crate::rete::{describe_fact, format_time, show_value};
 use situ_bundle::suggest::suggest;
 use situ_bundle::{Content, FieldType, Mode, Value};
 use std::fmt::Write as _;
@@ -50,23 +49,15 @@ const MAX_WAIT_NS: u64 = 86_400_000_000_000;
 
 pub struct Session {
     content: Arc<Content>,
-    board: Bulletinboard,
-    org: Organisation,
-    now: u64,
+    /// The board and organisation, with the admission rule every caller
+    /// that reports on the agents' behalf shares.
+    local: LocalBoard,
     steps: Vec<Step>,
-    last: Option<StateChange>,
 }
 
 impl Session {
     pub fn new(content: Arc<Content>) -> Session {
-        Session {
-            board: Bulletinboard::new(content.clone()),
-            org: Organisation::new(content.clone()),
-            content,
-            now: 0,
-            steps: Vec::new(),
-            last: None,
-        }
+        Session { local: LocalBoard::new(content.clone()), content, steps: Vec::new() }
     }
 
     pub fn content(&self) -> &Arc<Content> {
@@ -75,7 +66,7 @@ impl Session {
 
     /// The state at rest now.
     pub fn state(&self) -> &str {
-        &self.content.states[self.board.state() as usize].name
+        self.local.state_name()
     }
 
     /// Names to complete: commands, agents, events, `field=` of every event, symbols.
@@ -115,9 +106,8 @@ impl Session {
             }
         };
         match first {
-            "state" => {
-                none(&rest, first).map(|()| Reply::Text(format!("{} at {}", self.state(), format_time(self.now))))
-            }
+            "state" => none(&rest, first)
+                .map(|()| Reply::Text(format!("{} at {}", self.state(), format_time(self.local.now())))),
             "why" => none(&rest, first).map(|()| Reply::Text(self.why())),
             "agents" => none(&rest, first).map(|()| Reply::Text(self.agents())),
             "facts" => none(&rest, first).map(|()| Reply::Text(self.facts())),
@@ -199,32 +189,27 @@ impl Session {
     /// Why a run would not take this event now, if it would not, as the
     /// line that says so: its agent sleeps (a sleeping agent is not
     /// stepped, so it reports nothing: language reference §10.7, §10.11),
-    /// or the acceptance rule of every part of situ refuses it (§10.4,
-    /// [`Engine::admit`](crate::rete::Engine::admit)). Nothing changes.
-    fn not_taken(&self, event: u32, payload: &[Value]) -> Option<String> {
-        let c = &self.content;
-        let agent = c.events[event as usize].agent;
-        if self.org.mode(agent) == Mode::Sleeping {
-            return Some(format!(
-                "dropped: `{}` sleeps in {}, and a sleeping agent is not stepped: a run never reports its `{}` now; nothing changed",
-                c.agents[agent as usize].name,
-                self.state(),
-                c.events[event as usize].name
-            ));
-        }
-        let refused = self.board.engine().admit(event, self.now, payload).err()?;
-        Some(format!("refused: {}; nothing changed", refused.describe(c)))
+    /// or the acceptance rule of every part of situ refuses it (§10.4).
+    /// The rule is [`LocalBoard::not_taken`]'s. Nothing changes.
+    fn not_taken(&mut self, event: u32, payload: &[Value]) -> Option<String> {
+        let why = self.local.not_taken(event, self.local.now(), payload)?;
+        let verb = match why {
+            NotTaken::Sleeping { .. } => "dropped",
+            NotTaken::Refused(_) => "refused",
+        };
+        Some(format!("{verb}: {}; nothing changed", why.describe(&self.content, self.state())))
     }
 
     /// Posts one event now that [`not_taken`](Self::not_taken) lets
     /// through, as the runtime does: the agent's FSM first, then the rules,
     /// then every FSM on a new state.
     fn post(&mut self, event: u32, payload: Vec<Value>) -> String {
-        let agent = self.content.events[event as usize].agent;
-        self.org.on_event(agent, event);
-        let result = self.board.post(event, self.now, &payload);
-        let text = self.after(result);
-        self.steps.push(Step::Post { event, payload, time: self.now, state: self.board.state() });
+        let time = self.local.now();
+        let text = match self.local.post(event, time, &payload) {
+            Ok(taken) => self.after(taken),
+            Err(why) => format!("not taken: {}", why.describe(&self.content, self.state())),
+        };
+        self.steps.push(Step::Post { event, payload, time, state: self.local.state() });
         text
     }
 
@@ -232,44 +217,35 @@ impl Session {
         if d > MAX_WAIT_NS {
             return Err(ReplError::WaitTooLong);
         }
-        self.now += d;
-        let result = self.board.advance(self.now);
-        let text = self.after(result);
-        self.steps.push(Step::Wait { to: self.now, state: self.board.state() });
-        Ok(if text.is_empty() { format!("{} at {}", self.state(), format_time(self.now)) } else { text })
+        let to = self.local.now() + d;
+        let taken = self.local.advance(to);
+        let text = self.after(taken);
+        self.steps.push(Step::Wait { to, state: self.local.state() });
+        Ok(if text.is_empty() { format!("{} at {}", self.state(), format_time(to)) } else { text })
     }
 
-    fn after(&mut self, result: Result<Option<StateChange>, crate::rete::PostError>) -> String {
-        match result {
-            Ok(Some(change)) if change.changed() => {
-                self.org.on_state(change.to);
-                let text = format!(
-                    "{} -> {} ({})",
-                    self.content.states[change.from as usize].name,
-                    self.content.states[change.to as usize].name,
-                    change
-                        .firings
-                        .iter()
-                        .map(|f| self.content.rules[f.rule as usize].name.as_str())
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                );
-                self.last = Some(change);
-                text
-            }
-            Ok(_) => String::new(),
-            Err(e) => {
-                let state = self.board.state();
-                if self.org.state() != state {
-                    self.org.on_state(state);
-                }
-                format!("error: {} (now in {})", e.describe(&self.content), self.state())
-            }
+    fn after(&self, taken: Taken) -> String {
+        if let Some(e) = taken.error {
+            return format!("error: {} (now in {})", e.describe(&self.content), self.state());
+        }
+        match taken.change {
+            Some(change) if change.changed() => format!(
+                "{} -> {} ({})",
+                self.content.states[change.from as usize].name,
+                self.content.states[change.to as usize].name,
+                change
+                    .firings
+                    .iter()
+                    .map(|f| self.content.rules[f.rule as usize].name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+            _ => String::new(),
         }
     }
 
     fn why(&self) -> String {
-        match &self.last {
+        match self.local.last_change() {
             None => format!("{} is the initial state: no rule has fired yet", self.state()),
             Some(change) => {
                 let mut s = change.explain(&self.content);
@@ -289,12 +265,12 @@ impl Session {
         let mut s = String::new();
         for (a, def) in c.agents.iter().enumerate() {
             let a = a as u32;
-            let mode = self.org.mode(a);
+            let mode = self.local.organisation().mode(a);
             let mut line = format!("{:<width$}  {}", def.name, mode.adjective());
-            if let Some(f) = self.org.function(a).filter(|_| mode != Mode::Sleeping) {
+            if let Some(f) = self.local.organisation().function(a).filter(|_| mode != Mode::Sleeping) {
                 let _ = write!(line, " {f}()");
             }
-            if let Some(action) = self.org.action(a).filter(|_| mode == Mode::Running) {
+            if let Some(action) = self.local.organisation().action(a).filter(|_| mode == Mode::Running) {
                 let names = |ids: &[u32]| {
                     ids.iter().map(|&i| c.agents[i as usize].name.as_str()).collect::<Vec<_>>().join(", ")
                 };
@@ -308,7 +284,8 @@ impl Session {
             let _ = writeln!(s, "{line}");
         }
         let links: Vec<String> = self
-            .org
+            .local
+            .organisation()
             .links()
             .iter()
             .map(|&(x, y)| format!("{} -> {}", c.agents[x as usize].name, c.agents[y as usize].name))
@@ -320,19 +297,19 @@ impl Session {
 
     fn facts(&self) -> String {
         let c = &self.content;
-        let engine = self.board.engine();
+        let engine = self.local.bulletinboard().engine();
         let mut lines = Vec::new();
         for (a, def) in c.agents.iter().enumerate() {
             let a = a as u32;
             if engine.is_stale(a) {
                 lines.push(format!("{}: stale", def.name));
             } else if let Some(f) = engine.fact(a) {
-                let age = self.now.saturating_sub(f.time);
+                let age = self.local.now().saturating_sub(f.time);
                 lines.push(format!("{}: {} (age {})", def.name, describe_fact(c, &f), format_time(age)));
             }
         }
         if lines.is_empty() {
-            return format!("no facts at {}", format_time(self.now));
+            return format!("no facts at {}", format_time(self.local.now()));
         }
         lines.join("\n")
     }
@@ -346,25 +323,23 @@ impl Session {
             Step::Post { event, .. } => format!("took back {}", self.content.events[event as usize].name),
             Step::Wait { .. } => "took back a wait".to_string(),
         };
-        Ok(format!("{what}; {} at {}", self.state(), format_time(self.now)))
+        Ok(format!("{what}; {} at {}", self.state(), format_time(self.local.now())))
     }
 
     fn replay_steps(&mut self, steps: Vec<Step>) {
-        self.board = Bulletinboard::new(self.content.clone());
-        self.org = Organisation::new(self.content.clone());
-        self.now = 0;
-        self.last = None;
+        self.local = LocalBoard::new(self.content.clone());
         for step in steps {
             match step {
                 Step::Post { event, payload, time, .. } => {
-                    self.now = time;
-                    // Taken before, but the rules may have been reloaded since.
-                    if self.not_taken(event, &payload).is_none() {
-                        self.post(event, payload);
+                    // Taken before, but the rules may have been reloaded
+                    // since: one no longer taken is left out.
+                    if self.local.post(event, time, &payload).is_ok() {
+                        self.steps.push(Step::Post { event, payload, time, state: self.local.state() });
                     }
                 }
                 Step::Wait { to, .. } => {
-                    let _ = self.wait(to.saturating_sub(self.now));
+                    self.local.advance(to);
+                    self.steps.push(Step::Wait { to, state: self.local.state() });
                 }
             }
         }
@@ -376,18 +351,8 @@ impl Session {
         let old = self.content.clone();
         // The history in the new rules' ids, by name, for `undo` and `save`.
         let steps: Option<Vec<Step>> = self.steps.iter().map(|s| remap(&old, &new, s)).collect();
-        let report = self.board.swap(new.clone()).map_err(ReplError::Swap)?;
-        let fsm: Vec<(String, Option<u32>)> = (0..old.agents.len() as u32)
-            .map(|a| (old.agents[a as usize].name.clone(), self.org.fsm_state(a)))
-            .collect();
+        let report = self.local.reload(new.clone()).map_err(ReplError::Swap)?;
         self.content = new.clone();
-        self.org = Organisation::new(new.clone());
-        self.org.set_state(self.board.state());
-        for (name, state) in fsm {
-            if let (Some(a), Some(s)) = (new.agent_id(&name), state) {
-                self.org.set_fsm_state(a, s);
-            }
-        }
         let mut out = Vec::new();
         let rules = |c: &Content| c.rules.iter().map(|r| (r.name.clone(), r.source.text.clone())).collect::<Vec<_>>();
         let (was, now) = (rules(&old), rules(&new));
@@ -411,12 +376,10 @@ impl Session {
             out.push(format!("fact of {agent} dropped: {why}"));
         }
         if let Some(c) = report.change.as_ref().filter(|c| c.changed()) {
-            self.org.on_state(c.to);
             out.push(format!(
                 "the new rules fired: {} -> {}",
                 new.states[c.from as usize].name, new.states[c.to as usize].name
             ));
-            self.last = Some(c.clone());
         }
         match steps {
             Some(s) => self.steps = s,
