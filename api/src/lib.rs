@@ -35,4 +35,4 @@ pub use situ_compiler::bundle::{Content, Encoding, Loaded, Trust};
 pub use situ_compiler::{Checked, Diagnostic, Severity};
 pub use situ_runtime::replay::ReplayReport;
 pub use situ_runtime::script::report::ScriptReport;
-pub use suite::{test, SuiteReport, TestOptions, Verdict};
+pub use suite::{test, test_records, SuiteReport, TestOptions, Verdict};

@@ -8,7 +8,6 @@
 //! a file has errors, 2 on usage or I/O errors.
 
 use super::{FAILED, OK, USAGE};
-use serde_json::json;
 use situ_compiler::bundle::Content;
 use situ_compiler::loader::FsLoader;
 use situ_compiler::render;
@@ -209,45 +208,17 @@ fn property_failure(content: &Content, p: &PropertySpec, r: &Report) -> Option<S
     }
 }
 
-/// One JSON object per test or property, one per line, and the summary.
+/// One JSON object per test or property, one per line, and the summary
+/// (the records are the library's: `situ_api::test_records`).
 fn json_lines(report: &SuiteReport) {
     for file in &report.files {
-        let path = &file.path;
-        let r = match &file.outcome {
-            FileOutcome::Unreadable(e) => {
-                eprintln!("error: {e}");
-                continue;
-            }
-            FileOutcome::Errors(checked) => {
-                print!("{}", render::json_lines(checked));
-                continue;
-            }
-            FileOutcome::Ran(_, r) => r,
-        };
-        for t in &r.tests {
-            let list: Vec<_> = t
-                .outcome
-                .failures
-                .iter()
-                .map(|f| json!({"place": f.place.to_string(), "message": f.message}))
-                .collect();
-            println!(
-                "{}",
-                json!({"kind": "test", "file": path.display().to_string(), "name": t.spec.name,
-                       "place": t.spec.place.to_string(), "passed": t.outcome.passed(), "events": t.outcome.events,
-                       "failures": list})
-            );
-        }
-        for p in &r.properties {
-            println!("{}", property_json(&r.content, path, &p.spec, &p.report));
+        if let FileOutcome::Unreadable(e) = &file.outcome {
+            eprintln!("error: {e}");
         }
     }
-    let s = report.summary;
-    println!(
-        "{}",
-        json!({"kind": "summary", "passed": s.passed, "failed": s.failed, "undecided": s.undecided,
-               "allow_undecided": report.allow_undecided})
-    );
+    for record in situ_api::test_records(report) {
+        println!("{record}");
+    }
 }
 
 /// One SARIF 2.1.0 log: each file's findings with its verdicts as findings.
@@ -367,60 +338,6 @@ fn brief_run(content: &Content, run: &Counterexample) -> String {
         v
     };
     format!("{n} event{}: {}", if n == 1 { "" } else { "s" }, events.join(", "))
-}
-
-fn property_json(content: &Content, path: &std::path::Path, p: &PropertySpec, r: &Report) -> serde_json::Value {
-    let verdict = |v: &Option<Verdict>| {
-        v.as_ref().map(|v| {
-            let kind = match v {
-                Verdict::Proved { .. } | Verdict::Inductive { sampled: None, .. } => "proved",
-                Verdict::Inductive { .. } => "exhausted",
-                Verdict::Disagree { .. } => "disagree",
-                Verdict::Exhausted { .. } => "exhausted",
-                Verdict::Bounded { .. } => "bounded",
-                Verdict::NotFound { .. } => "not_found",
-                Verdict::GaveUp { .. } => "gave_up",
-                Verdict::Failed(_) => "failed",
-            };
-            json!({"verdict": kind, "summary": v.summary()})
-        })
-    };
-    let run = |c: &Counterexample| -> Vec<serde_json::Value> {
-        c.steps
-            .iter()
-            .map(|s| {
-                json!({"event": show_event(content, s.event, &s.payload), "time_ns": s.time,
-                       "state": content.states[s.state as usize].name, "fired": s.fired})
-            })
-            .collect()
-    };
-    let cex = match &r.conclusion {
-        Conclusion::Violated { by, how, counterexample: c } => Some(json!({
-            "found_by": format!("{}, {how}", by.name()), "events": run(c), "point": c.point,
-            "reason": c.reason, "test": c.as_test(content, &p.name)})),
-        _ => None,
-    };
-    let (proved_by, reasons) = match &r.conclusion {
-        Conclusion::Proved { by, .. } => (Some(by.name()), Vec::new()),
-        Conclusion::Undecided { reasons } => (None, reasons.clone()),
-        _ => (None, Vec::new()),
-    };
-    let premise = r.premise.as_ref().map(|pr| match pr {
-        Premise::Reachable(c) => json!({"reachable": true, "events": run(c)}),
-        Premise::Vacuous { by } => {
-            json!({"reachable": false, "vacuous": true, "code": "W0501", "proved_by": by.name()})
-        }
-        Premise::Unknown => json!({"reachable": null}),
-    });
-    let code = match r.conclusion {
-        Conclusion::Undecided { .. } => Some("E0502"),
-        _ => None,
-    };
-    json!({"kind": "property", "file": path.display().to_string(), "name": p.name, "place": p.place.to_string(),
-           "verdict": r.conclusion.word(), "passed": matches!(r.conclusion, Conclusion::Proved { .. }),
-           "code": code, "proved_by": proved_by, "undecided_because": reasons,
-           "exhaustive": verdict(&r.exhaustive), "symbolic": verdict(&r.symbolic), "random": verdict(&r.random),
-           "counterexample": cex, "premise": premise})
 }
 
 fn count(n: usize, what: &str) -> String {
