@@ -27,6 +27,13 @@ pub fn check(input: Input<'_>) -> Result<Checked, Error> {
     })
 }
 
+/// Every finding of a check as a JSON object (`situ check --format json`'s:
+/// code, severity, message, file, line, column, end, label, help, related
+/// places, witness, allowed).
+pub fn findings_json(checked: &Checked) -> Vec<serde_json::Value> {
+    checked.diagnostics.iter().map(|d| situ_compiler::render::json_object(&checked.sources, d)).collect()
+}
+
 /// Formats a source in the one canonical layout; a source with syntax
 /// errors is refused with them.
 pub fn format(text: &str) -> Result<String, Error> {

@@ -1,0 +1,469 @@
+//! `situ.Board`: `situ_api::Board` for Python. Times are seconds (float or
+//! int) on the board's clock; answers are frozen classes; callbacks given
+//! to `on_change` are called after each post or advance that changed the
+//! state, in order, and an exception in one propagates out of that call
+//! (the event stays taken).
+
+use crate::errors::{from_board, raise};
+use crate::program::Program;
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyString};
+use situ_api::{Arg, BoardError, Clock, FieldValue, Posted};
+use std::collections::BTreeMap;
+
+const NS: f64 = 1e9;
+
+fn seconds(ns: u64) -> f64 {
+    ns as f64 / NS
+}
+
+/// A change of the state at rest.
+#[pyclass(module = "situ", frozen, get_all)]
+#[derive(Clone)]
+pub struct Change {
+    /// The state before.
+    pub previous: String,
+    /// The state after.
+    pub state: String,
+    /// The board's time, in seconds.
+    pub time: f64,
+    /// The rules that fired, in order.
+    pub rules: Vec<String>,
+}
+
+#[pymethods]
+impl Change {
+    fn __repr__(&self) -> String {
+        format!("Change({} -> {} at {}s by {})", self.previous, self.state, self.time, self.rules.join(", "))
+    }
+}
+
+fn change(c: situ_api::Change) -> Change {
+    Change { previous: c.from, state: c.to, time: seconds(c.time), rules: c.rules }
+}
+
+/// What a post did with its event.
+#[pyclass(module = "situ", frozen, get_all)]
+pub struct Outcome {
+    /// The board took the event (whether or not the state changed).
+    pub accepted: bool,
+    /// Why it was not taken: `sleeping`, `out of order`, `from the future`.
+    pub key: Option<String>,
+    pub reason: Option<String>,
+    /// The change it made, if the state changed.
+    pub change: Option<Change>,
+    /// The rules did not come to rest (a cascade): why.
+    pub error: Option<String>,
+}
+
+#[pymethods]
+impl Outcome {
+    fn __repr__(&self) -> String {
+        match (&self.reason, &self.change) {
+            (Some(r), _) => format!("Outcome(not taken: {r})"),
+            (None, Some(c)) => format!("Outcome(taken, {} -> {})", c.previous, c.state),
+            (None, None) => "Outcome(taken, no change)".to_string(),
+        }
+    }
+    fn __bool__(&self) -> bool {
+        self.accepted
+    }
+}
+
+/// What a batch did.
+#[pyclass(module = "situ", frozen, get_all)]
+pub struct Batch {
+    pub accepted: u64,
+    /// Events not taken, by reason.
+    pub not_taken: BTreeMap<String, u64>,
+    /// The changes, in order.
+    pub changes: Vec<Change>,
+}
+
+/// An agent's fact (or its staleness).
+#[pyclass(module = "situ", frozen, get_all)]
+pub struct Fact {
+    pub agent: String,
+    /// The event, unless the agent is stale.
+    pub event: Option<String>,
+    /// Its stamp in seconds, unless stale.
+    pub time: Option<f64>,
+    pub fields: BTreeMap<String, Py<PyAny>>,
+    pub stale: bool,
+}
+
+#[pymethods]
+impl Fact {
+    fn __repr__(&self) -> String {
+        match &self.event {
+            Some(e) => format!("Fact({}: {e} at {}s)", self.agent, self.time.unwrap_or(0.0)),
+            None => format!("Fact({}: stale)", self.agent),
+        }
+    }
+}
+
+/// A rule that fired in the last change.
+#[pyclass(module = "situ", frozen, get_all)]
+pub struct Fired {
+    pub rule: String,
+    pub file: String,
+    pub line: u32,
+    /// The rule's first line.
+    pub text: String,
+    pub previous: String,
+    pub state: String,
+    /// The facts its patterns matched.
+    pub facts: Vec<Py<Fact>>,
+    /// The agents its `stale` tests found stale.
+    pub stale: Vec<String>,
+}
+
+/// Why the board is in its state.
+#[pyclass(module = "situ", frozen, get_all)]
+pub struct Why {
+    pub previous: String,
+    pub state: String,
+    pub time: f64,
+    pub firings: Vec<Py<Fired>>,
+}
+
+/// An agent now.
+#[pyclass(module = "situ", frozen, get_all)]
+pub struct Agent {
+    pub name: String,
+    /// `running`, `waiting` or `sleeping`.
+    pub mode: String,
+    pub function: Option<String>,
+    pub reads_from: Vec<String>,
+    pub sends_to: Vec<String>,
+    pub fsm_state: Option<String>,
+}
+
+#[pymethods]
+impl Agent {
+    fn __repr__(&self) -> String {
+        format!("Agent({} {}{})", self.name, self.mode, self.function.as_ref().map_or(String::new(), |f| format!(" {f}()")))
+    }
+}
+
+/// What the board did so far.
+#[pyclass(module = "situ", frozen, get_all)]
+pub struct Counters {
+    pub accepted: u64,
+    pub not_taken: BTreeMap<String, u64>,
+    pub changes: u64,
+}
+
+/// What a reload kept.
+#[pyclass(module = "situ", frozen, get_all)]
+pub struct Reloaded {
+    pub carried: Vec<String>,
+    pub dropped: Vec<(String, String)>,
+    pub change: Option<Change>,
+}
+
+/// A Bulletinboard inside this process.
+#[pyclass(module = "situ", unsendable)]
+pub struct Board {
+    inner: situ_api::Board,
+    callbacks: Vec<Py<PyAny>>,
+}
+
+enum Owned {
+    F64(f64),
+    I64(i64),
+    Bool(bool),
+    Symbol(String),
+}
+
+impl Owned {
+    fn arg(&self) -> Arg<'_> {
+        match self {
+            Owned::F64(x) => Arg::F64(*x),
+            Owned::I64(x) => Arg::I64(*x),
+            Owned::Bool(x) => Arg::Bool(*x),
+            Owned::Symbol(s) => Arg::Symbol(s),
+        }
+    }
+}
+
+fn value_of(event: &str, field: &str, v: &Bound<'_, PyAny>) -> Result<Owned, BoardError> {
+    let wrong = |found: String| BoardError::FieldType {
+        event: event.to_string(),
+        field: field.to_string(),
+        expected: "a number, a boolean or a symbol's name".to_string(),
+        found,
+    };
+    if v.is_instance_of::<PyBool>() {
+        return Ok(Owned::Bool(v.is_truthy().unwrap_or(false)));
+    }
+    if v.is_instance_of::<PyInt>() {
+        return v.extract::<i64>().map(Owned::I64).map_err(|_| wrong("an integer out of the i64 range".into()));
+    }
+    if v.is_instance_of::<PyFloat>() {
+        return v.extract::<f64>().map(Owned::F64).map_err(|_| wrong("a float".into()));
+    }
+    if v.is_instance_of::<PyString>() {
+        return v.extract::<String>().map(Owned::Symbol).map_err(|_| wrong("a text".into()));
+    }
+    let ty = v.get_type().name().map(|n| n.to_string()).unwrap_or_else(|_| "?".into());
+    Err(wrong(format!("a value of type {ty}")))
+}
+
+/// A time in seconds as nanoseconds: finite, not negative.
+fn nanos(at: Option<&Bound<'_, PyAny>>) -> Result<Option<u64>, BoardError> {
+    let Some(at) = at.filter(|a| !a.is_none()) else { return Ok(None) };
+    let bad = |what: String| BoardError::BadTime(what);
+    if at.is_instance_of::<PyBool>() {
+        return Err(bad("a boolean".into()));
+    }
+    if let Ok(i) = at.extract::<i64>() {
+        return u64::try_from(i).ok().and_then(|s| s.checked_mul(1_000_000_000)).map(Some).ok_or(bad(format!("{i} s")));
+    }
+    let s: f64 = at.extract().map_err(|_| bad("a value that is not a number".into()))?;
+    let ns = (s * NS).round();
+    if !(ns.is_finite() && ns >= 0.0 && ns < u64::MAX as f64) {
+        return Err(bad(format!("{s} s")));
+    }
+    Ok(Some(ns as u64))
+}
+
+fn field_value(py: Python<'_>, v: &FieldValue) -> PyResult<Py<PyAny>> {
+    Ok(match v {
+        FieldValue::F64(x) => x.into_pyobject(py)?.into_any().unbind(),
+        FieldValue::I64(x) => x.into_pyobject(py)?.into_any().unbind(),
+        FieldValue::Bool(x) => PyBool::new(py, *x).to_owned().into_any().unbind(),
+        FieldValue::Symbol(s) => s.into_pyobject(py)?.into_any().unbind(),
+    })
+}
+
+fn fact(py: Python<'_>, f: &situ_api::Fact) -> PyResult<Fact> {
+    let mut fields = BTreeMap::new();
+    for (name, v) in &f.fields {
+        fields.insert(name.clone(), field_value(py, v)?);
+    }
+    Ok(Fact {
+        agent: f.agent.clone(),
+        event: Some(f.event.clone()),
+        time: Some(seconds(f.time)),
+        fields,
+        stale: false,
+    })
+}
+
+impl Board {
+    fn post_one(
+        &mut self,
+        py: Python<'_>,
+        event: &str,
+        at: Option<&Bound<'_, PyAny>>,
+        payload: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Outcome> {
+        let id = self.inner.event(event).map_err(|e| from_board(py, e))?;
+        let name = &self.inner.content().events[id as usize].name;
+        let mut owned: Vec<(String, Owned)> = Vec::new();
+        if let Some(d) = payload {
+            for (k, v) in d.iter() {
+                let k: String = k.extract().map_err(|_| {
+                    raise(py, "BoardError", format!("`{name}`: a field's name is a text"), "unknown-field", None)
+                })?;
+                let v = value_of(name, &k, &v).map_err(|e| from_board(py, e))?;
+                owned.push((k, v));
+            }
+        }
+        let args: Vec<(&str, Arg)> = owned.iter().map(|(k, v)| (k.as_str(), v.arg())).collect();
+        let values = self.inner.payload(id, &args).map_err(|e| from_board(py, e))?;
+        let at = nanos(at).map_err(|e| from_board(py, e))?;
+        let posted = self.inner.post(id, at, &values).map_err(|e| from_board(py, e))?;
+        Ok(match posted {
+            Posted::Taken { change: c, error } => {
+                Outcome { accepted: true, key: None, reason: None, change: c.map(change), error }
+            }
+            Posted::NotTaken { key, reason } => {
+                Outcome { accepted: false, key: Some(key.to_string()), reason: Some(reason), change: None, error: None }
+            }
+        })
+    }
+
+    fn notify(&self, py: Python<'_>, c: &Change) -> PyResult<()> {
+        for cb in &self.callbacks {
+            cb.call1(py, (c.clone(),))?;
+        }
+        Ok(())
+    }
+}
+
+#[pymethods]
+impl Board {
+    /// A board on a program (`situ.load`, `situ.load_path`), with a manual
+    /// clock (`"manual"`: time is what the caller stamps) or the system's
+    /// (`"system"`: UNIX time; events from the future are refused).
+    #[new]
+    #[pyo3(signature = (program, clock = "manual", max_skew = None))]
+    fn new(py: Python<'_>, program: &Program, clock: &str, max_skew: Option<&Bound<'_, PyAny>>) -> PyResult<Board> {
+        let clock = match clock {
+            "manual" => Clock::Manual,
+            "system" => Clock::System,
+            other => {
+                return Err(raise(py, "Error", format!("a clock is \"manual\" or \"system\", not {other:?}"), "clock", None))
+            }
+        };
+        let mut inner = situ_api::Board::new(program.content.clone(), clock);
+        if let Some(ns) = nanos(max_skew).map_err(|e| from_board(py, e))? {
+            inner.set_max_skew(ns);
+        }
+        Ok(Board { inner, callbacks: Vec::new() })
+    }
+
+    /// Posts an event (`"EVENT"` or `"Agent.EVENT"`) stamped `at` seconds
+    /// (`None`: now on the board's clock), its fields by name.
+    #[pyo3(signature = (agent_event, at = None, payload = None, **fields))]
+    fn post(
+        &mut self,
+        py: Python<'_>,
+        agent_event: &str,
+        at: Option<&Bound<'_, PyAny>>,
+        payload: Option<&Bound<'_, PyDict>>,
+        fields: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Outcome> {
+        let merged;
+        let given = match (payload, fields) {
+            (Some(p), Some(f)) => {
+                merged = p.copy()?;
+                merged.update(f.as_mapping())?;
+                Some(&merged)
+            }
+            (Some(p), None) => Some(p),
+            (None, f) => f,
+        };
+        let out = self.post_one(py, agent_event, at, given)?;
+        if let Some(c) = &out.change {
+            self.notify(py, c)?;
+        }
+        Ok(out)
+    }
+
+    /// Posts a batch of `(agent_event, at, payload)` in order; stops at the
+    /// first wrong event (an error) with the ones before it taken.
+    fn post_many(&mut self, py: Python<'_>, events: &Bound<'_, PyAny>) -> PyResult<Batch> {
+        let mut batch = Batch { accepted: 0, not_taken: BTreeMap::new(), changes: Vec::new() };
+        for item in events.try_iter()? {
+            let item = item?;
+            let (name, at, payload): (String, Bound<'_, PyAny>, Option<Bound<'_, PyDict>>) = item.extract()?;
+            let out = self.post_one(py, &name, Some(&at), payload.as_ref())?;
+            match (&out.key, out.change) {
+                (Some(k), _) => *batch.not_taken.entry(k.clone()).or_default() += 1,
+                (None, change) => {
+                    batch.accepted += 1;
+                    if let Some(c) = change {
+                        self.notify(py, &c)?;
+                        batch.changes.push(c);
+                    }
+                }
+            }
+        }
+        Ok(batch)
+    }
+
+    /// Lets time pass to `to` seconds (`None`: now on the board's clock):
+    /// facts age and silent agents go stale. The change, if any.
+    #[pyo3(signature = (to = None))]
+    fn advance(&mut self, py: Python<'_>, to: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Change>> {
+        let to = nanos(to).map_err(|e| from_board(py, e))?;
+        let c = self.inner.advance(to).map(change);
+        if let Some(c) = &c {
+            self.notify(py, c)?;
+        }
+        Ok(c)
+    }
+
+    /// The state at rest.
+    #[getter]
+    fn state(&self) -> String {
+        self.inner.state().to_string()
+    }
+
+    /// The board's latest time, in seconds.
+    #[getter]
+    fn now(&self) -> f64 {
+        seconds(self.inner.now())
+    }
+
+    /// The last change, rule by rule (`None` before any rule fired).
+    fn why(&self, py: Python<'_>) -> PyResult<Option<Why>> {
+        let Some(w) = self.inner.why() else { return Ok(None) };
+        let mut firings = Vec::new();
+        for f in &w.firings {
+            let facts = f.facts.iter().map(|x| Py::new(py, fact(py, x)?)).collect::<PyResult<Vec<_>>>()?;
+            let fired = Fired {
+                rule: f.rule.clone(),
+                file: f.file.clone(),
+                line: f.line,
+                text: f.text.clone(),
+                previous: f.from.clone(),
+                state: f.to.clone(),
+                facts,
+                stale: f.stale.clone(),
+            };
+            firings.push(Py::new(py, fired)?);
+        }
+        Ok(Some(Why { previous: w.from, state: w.to, time: seconds(w.time), firings }))
+    }
+
+    /// Every agent's mode, function and links now.
+    fn agents(&self) -> Vec<Agent> {
+        self.inner
+            .agents()
+            .into_iter()
+            .map(|a| Agent {
+                name: a.name,
+                mode: a.mode.to_string(),
+                function: a.function,
+                reads_from: a.from,
+                sends_to: a.to,
+                fsm_state: a.fsm_state,
+            })
+            .collect()
+    }
+
+    /// The working memory: each agent's latest fact, or its staleness.
+    fn facts(&self, py: Python<'_>) -> PyResult<Vec<Fact>> {
+        self.inner
+            .facts()
+            .iter()
+            .map(|f| match &f.fact {
+                Some(x) => fact(py, x),
+                None => Ok(Fact { agent: f.agent.clone(), event: None, time: None, fields: BTreeMap::new(), stale: true }),
+            })
+            .collect()
+    }
+
+    /// What the board did so far.
+    fn counters(&self) -> Counters {
+        let c = self.inner.counters();
+        Counters {
+            accepted: c.accepted,
+            not_taken: c.not_taken.iter().map(|(k, v)| (k.to_string(), *v)).collect(),
+            changes: c.changes,
+        }
+    }
+
+    /// Calls `callback(change)` after every change of the state.
+    fn on_change(&mut self, callback: Py<PyAny>) {
+        self.callbacks.push(callback);
+    }
+
+    /// New rules, keeping the state and the facts that still fit.
+    fn reload(&mut self, py: Python<'_>, program: &Program) -> PyResult<Reloaded> {
+        let r = self.inner.reload(program.content.clone()).map_err(|e| from_board(py, e))?;
+        let c = r.change.map(change);
+        if let Some(c) = &c {
+            self.notify(py, c)?;
+        }
+        Ok(Reloaded { carried: r.carried, dropped: r.dropped, change: c })
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Board(state={}, now={}s)", self.inner.state(), seconds(self.inner.now()))
+    }
+}
