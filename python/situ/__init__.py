@@ -138,12 +138,16 @@ def test(
     max_states: Optional[int] = None,
     depth: Optional[int] = None,
     cases: Optional[int] = None,
+    length: Optional[int] = None,
     seed: Optional[int] = None,
 ) -> Report:
     """Runs every ``test`` block and checks every property of the files, as
     ``situ test`` does: each property proved, violated or undecided (never
     passed for "not found"). ``effort`` is IC3's work budget per property
-    (SAT propagations): the same budget gives the same verdict anywhere."""
+    (SAT propagations): the same budget gives the same verdict anywhere;
+    ``depth`` and ``max_states`` bound the exhaustive search, ``cases``,
+    ``length`` and ``seed`` the random one. Raises :class:`ReadError` when
+    a file cannot be read; rules with errors are in ``Report.findings``."""
     records, verdict = _situ.test(
         [os.fspath(p) for p in paths],
         filter=filter,
@@ -152,6 +156,7 @@ def test(
         max_states=max_states,
         depth=depth,
         cases=cases,
+        length=length,
         seed=seed,
     )
     return report_of(json.loads(records), verdict)

@@ -20,6 +20,7 @@ fn _situ(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(program::load_path, m)?)?;
     m.add_function(wrap_pyfunction!(program::load_text, m)?)?;
     m.add_function(wrap_pyfunction!(program::test, m)?)?;
+    m.add_function(wrap_pyfunction!(program::blocks, m)?)?;
     m.add_class::<program::Program>()?;
     m.add_class::<program::Bundle>()?;
     m.add_class::<board::Board>()?;

@@ -181,7 +181,7 @@ pub fn load_text(py: Python<'_>, text: &str, name: &str, deny_warnings: bool) ->
 /// Runs the tests and properties of files: the suite's JSON records and
 /// its verdict (`pass`, `fail`).
 #[pyfunction]
-#[pyo3(signature = (paths, filter = None, allow_undecided = false, effort = None, max_states = None, depth = None, cases = None, seed = None))]
+#[pyo3(signature = (paths, filter = None, allow_undecided = false, effort = None, max_states = None, depth = None, cases = None, length = None, seed = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn test(
     py: Python<'_>,
@@ -192,6 +192,7 @@ pub fn test(
     max_states: Option<usize>,
     depth: Option<usize>,
     cases: Option<u32>,
+    length: Option<usize>,
     seed: Option<u64>,
 ) -> PyResult<(String, String)> {
     let mut options = situ_api::TestOptions { filter, allow_undecided, ..Default::default() };
@@ -200,6 +201,7 @@ pub fn test(
     p.limits.max_states = max_states.unwrap_or(p.limits.max_states);
     p.limits.depth = depth.unwrap_or(p.limits.depth);
     p.search.cases = cases.unwrap_or(p.search.cases);
+    p.search.length = length.unwrap_or(p.search.length);
     p.search.seed = seed.unwrap_or(p.search.seed);
     let (records, verdict, unreadable) = py.detach(|| {
         let report = situ_api::test(&paths, &options);
@@ -230,4 +232,22 @@ fn type_name(ty: &situ_bundle::FieldType) -> String {
         situ_bundle::FieldType::Bool => "bool".into(),
         situ_bundle::FieldType::Symbols(s) => format!("{{{}}}", s.join(", ")),
     }
+}
+
+/// The `test` and `property` blocks of a file: `(kind, name, file, line)`.
+/// Rules with errors raise [`FindingsError`].
+#[pyfunction]
+pub fn blocks(py: Python<'_>, path: PathBuf) -> PyResult<Vec<(String, String, String, u32)>> {
+    let checked = checked_of(py, Some(path), None, "")?;
+    if checked.errors() > 0 {
+        let name = checked.sources.iter().next().map(|(_, f)| f.name.clone()).unwrap_or_default();
+        let e = situ_api::Error::Findings {
+            name,
+            errors: checked.errors(),
+            warnings: checked.warnings(),
+            checked: Box::new(checked),
+        };
+        return Err(from_api(py, e));
+    }
+    Ok(situ_api::blocks(&checked).into_iter().map(|b| (b.kind.to_string(), b.name, b.file, b.line)).collect())
 }
