@@ -163,7 +163,7 @@ pub struct Reloaded {
 }
 
 /// A Bulletinboard inside this process.
-#[pyclass(module = "situ", unsendable)]
+#[pyclass(module = "situ")]
 pub struct Board {
     inner: situ_api::Board,
     callbacks: Vec<Py<PyAny>>,
@@ -285,12 +285,17 @@ impl Board {
         })
     }
 
-    fn notify(&self, py: Python<'_>, c: &Change) -> PyResult<()> {
-        for cb in &self.callbacks {
-            cb.call1(py, (c.clone(),))?;
-        }
-        Ok(())
+}
+
+/// Calls the board's callbacks with a change, the board not borrowed (a
+/// callback may read the board, or post to it).
+fn notify(slf: &Bound<'_, Board>, c: &Change) -> PyResult<()> {
+    let py = slf.py();
+    let callbacks: Vec<Py<PyAny>> = slf.borrow().callbacks.iter().map(|cb| cb.clone_ref(py)).collect();
+    for cb in callbacks {
+        cb.call1(py, (c.clone(),))?;
     }
+    Ok(())
 }
 
 #[pymethods]
@@ -319,8 +324,7 @@ impl Board {
     /// (`None`: now on the board's clock), its fields by name.
     #[pyo3(signature = (agent_event, at = None, payload = None, **fields))]
     fn post(
-        &mut self,
-        py: Python<'_>,
+        slf: &Bound<'_, Self>,
         agent_event: &str,
         at: Option<&Bound<'_, PyAny>>,
         payload: Option<&Bound<'_, PyDict>>,
@@ -336,27 +340,28 @@ impl Board {
             (Some(p), None) => Some(p),
             (None, f) => f,
         };
-        let out = self.post_one(py, agent_event, at, given)?;
+        let out = slf.borrow_mut().post_one(slf.py(), agent_event, at, given)?;
         if let Some(c) = &out.change {
-            self.notify(py, c)?;
+            notify(slf, c)?;
         }
         Ok(out)
     }
 
     /// Posts a batch of `(agent_event, at, payload)` in order; stops at the
     /// first wrong event (an error) with the ones before it taken.
-    fn post_many(&mut self, py: Python<'_>, events: &Bound<'_, PyAny>) -> PyResult<Batch> {
+    fn post_many(slf: &Bound<'_, Self>, events: &Bound<'_, PyAny>) -> PyResult<Batch> {
+        let py = slf.py();
         let mut batch = Batch { accepted: 0, not_taken: BTreeMap::new(), changes: Vec::new() };
         for item in events.try_iter()? {
             let item = item?;
             let (name, at, payload): (String, Bound<'_, PyAny>, Option<Bound<'_, PyDict>>) = item.extract()?;
-            let out = self.post_one(py, &name, Some(&at), payload.as_ref())?;
+            let out = slf.borrow_mut().post_one(py, &name, Some(&at), payload.as_ref())?;
             match (&out.key, out.change) {
                 (Some(k), _) => *batch.not_taken.entry(k.clone()).or_default() += 1,
                 (None, change) => {
                     batch.accepted += 1;
                     if let Some(c) = change {
-                        self.notify(py, &c)?;
+                        notify(slf, &c)?;
                         batch.changes.push(c);
                     }
                 }
@@ -368,11 +373,11 @@ impl Board {
     /// Lets time pass to `to` seconds (`None`: now on the board's clock):
     /// facts age and silent agents go stale. The change, if any.
     #[pyo3(signature = (to = None))]
-    fn advance(&mut self, py: Python<'_>, to: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Change>> {
-        let to = nanos(to).map_err(|e| from_board(py, e))?;
-        let c = self.inner.advance(to).map(change);
+    fn advance(slf: &Bound<'_, Self>, to: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Change>> {
+        let to = nanos(to).map_err(|e| from_board(slf.py(), e))?;
+        let c = slf.borrow_mut().inner.advance(to).map(change);
         if let Some(c) = &c {
-            self.notify(py, c)?;
+            notify(slf, c)?;
         }
         Ok(c)
     }
@@ -454,11 +459,11 @@ impl Board {
     }
 
     /// New rules, keeping the state and the facts that still fit.
-    fn reload(&mut self, py: Python<'_>, program: &Program) -> PyResult<Reloaded> {
-        let r = self.inner.reload(program.content.clone()).map_err(|e| from_board(py, e))?;
+    fn reload(slf: &Bound<'_, Self>, program: &Program) -> PyResult<Reloaded> {
+        let r = slf.borrow_mut().inner.reload(program.content.clone()).map_err(|e| from_board(slf.py(), e))?;
         let c = r.change.map(change);
         if let Some(c) = &c {
-            self.notify(py, c)?;
+            notify(slf, c)?;
         }
         Ok(Reloaded { carried: r.carried, dropped: r.dropped, change: c })
     }

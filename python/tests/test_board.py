@@ -156,3 +156,15 @@ def test_reload_keeps_the_state_and_facts_and_refuses_rules_without_the_state(
 def test_a_bad_clock_is_an_error(picker: situ.Program) -> None:
     with pytest.raises(situ.Error):
         situ.Board(picker, clock="sundial")
+
+
+def test_a_callback_may_read_the_board_and_another_thread_may_post(board: situ.Board) -> None:
+    import threading
+
+    modes: list[str] = []
+    board.on_change(lambda c: modes.append({a.name: a.mode for a in board.agents()}["Arm"] + " in " + board.state))
+    board.post("BATT", at=0, charge=80.0)
+    t = threading.Thread(target=lambda: board.post("ORDER", at=0, item=1))
+    t.start()
+    t.join()
+    assert modes == ["running in PICKING"]
