@@ -51,12 +51,15 @@ from .findings import Counterexample, Finding, Place, PropertyResult, Report, St
 __version__: str = _situ.__version__
 
 PathLike = Union[str, "os.PathLike[str]"]
+#: A field's value: a float (``f64``), an int (``i64``, or an ``f64``), a
+#: bool, or a symbol's name.
+Value = Union[float, int, bool, str]
 
 __all__ = [
     "Agent", "Batch", "Board", "BoardError", "Bundle", "BundleError", "Change", "Counterexample", "Counters",
     "Error", "Fact", "Finding", "FindingsError", "Fired", "Outcome", "Place", "Program", "PropertyResult",
     "ReadError", "RecordingError", "Reloaded", "Report", "SituSyntaxError", "Step", "TestResult", "TrustError",
-    "Why", "WriteError", "build", "check", "fmt", "load", "load_path", "load_text", "test",
+    "Value", "Why", "WriteError", "build", "check", "fmt", "load", "load_path", "load_text", "test",
 ]
 
 

@@ -119,7 +119,7 @@ def test_the_fsm_follows_its_agents_events(board: situ.Board) -> None:
     ],
 )
 def test_a_wrong_event_field_or_value_is_a_board_error(
-    board: situ.Board, event: str, fields: dict[str, situ._situ._Value], code: str
+    board: situ.Board, event: str, fields: dict[str, situ.Value], code: str
 ) -> None:
     with pytest.raises(situ.BoardError) as e:
         board.post(event, at=0, payload=fields)
