@@ -25,6 +25,11 @@ fi
 echo "== cargo test --workspace --all-features"
 cargo test --workspace --all-features
 
+echo "== the Python package: pip install ./python (maturin; the dev profile, whose build the tests above made), mypy --strict, pytest"
+MATURIN_PEP517_ARGS="--profile dev" python3 -m pip install --quiet --disable-pip-version-check --force-reinstall ./python
+(cd python && python3 -m mypy --strict situ tests ../examples/python/board_node.py)
+SITU=target/debug/situ python3 -m pytest -q -p no:cacheprovider python/tests
+
 echo "== the fuzz targets, 5 s each, from their committed corpora (scripts/fuzz.sh; cargo-fuzz on stable)"
 bash scripts/fuzz.sh 5
 

@@ -206,6 +206,8 @@ pub struct Counters {
     /// Events not taken, by reason.
     pub not_taken: BTreeMap<&'static str, u64>,
     pub changes: u64,
+    /// New missions started ([`Board::reset`], or after a final state).
+    pub missions: u64,
 }
 
 /// What a reload kept.
@@ -226,11 +228,19 @@ pub struct Board {
     /// `EVENT` and `AGENT.EVENT` to the event's id.
     names: HashMap<String, u32>,
     counters: Counters,
+    /// A final state ends the mission: the next post starts a new one.
+    missions: bool,
 }
 
 impl Board {
     pub fn new(content: Arc<Content>, clock: Clock) -> Board {
-        Board { names: names(&content), local: LocalBoard::new(content), clock, counters: Counters::default() }
+        Board {
+            names: names(&content),
+            local: LocalBoard::new(content),
+            clock,
+            counters: Counters::default(),
+            missions: false,
+        }
     }
 
     pub fn content(&self) -> &Arc<Content> {
@@ -258,6 +268,21 @@ impl Board {
 
     pub fn counters(&self) -> &Counters {
         &self.counters
+    }
+
+    /// With `true`, a `final` state ends the mission (language reference
+    /// §10.12, as `situ bench` and `--random` runs do): the next post first
+    /// starts a new one ([`reset`](Self::reset)). Off by default: a final
+    /// state stays, as on a robot whose run ends there.
+    pub fn set_missions(&mut self, on: bool) {
+        self.missions = on;
+    }
+
+    /// A new mission: the initial state with no facts, every FSM in its
+    /// initial state; time and each agent's latest stamp are kept.
+    pub fn reset(&mut self) {
+        self.local.reset();
+        self.counters.missions += 1;
     }
 
     /// An event by name: `EVENT`, or `AGENT.EVENT` (which also checks
@@ -308,6 +333,9 @@ impl Board {
     pub fn post(&mut self, event: u32, at: Option<u64>, payload: &[Value]) -> Result<Posted, BoardError> {
         let now = self.tick_clock();
         let time = at.unwrap_or(now);
+        if self.missions && self.local.is_final() {
+            self.reset();
+        }
         match self.local.post(event, time, payload) {
             Ok(taken) => {
                 self.counters.accepted += 1;

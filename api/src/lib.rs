@@ -29,11 +29,13 @@ pub use board::{
     AgentNow, Arg, Board, BoardError, Change, Clock, Counters, Fact, FactNow, FieldValue, Fired, Posted, Reloaded, Why,
 };
 pub use error::Error;
-pub use program::{build, check, findings_json, format, is_source, load, load_path, BuildOptions, Built, Input, Program};
+pub use program::{
+    build, check, findings_json, format, is_source, load, load_path, BuildOptions, Built, Input, Program,
+};
 pub use runs::{replay, run_script, Drive, Recording, Replayed};
 pub use situ_compiler::bundle::{Content, Encoding, Loaded, Trust};
 pub use situ_compiler::{Checked, Diagnostic, Severity};
 pub use situ_runtime::replay::ReplayReport;
 pub use situ_runtime::script::report::ScriptReport;
 pub use situ_verify::suite::FileOutcome;
-pub use suite::{test, test_records, SuiteReport, TestOptions, Verdict};
+pub use suite::{blocks, test, test_records, Block, SuiteReport, TestOptions, Verdict};

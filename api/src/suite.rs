@@ -21,6 +21,39 @@ pub fn test(files: &[PathBuf], options: &TestOptions) -> SuiteReport {
     situ_verify::suite::run(files, &FsLoader, options)
 }
 
+/// A `test` or `property` block of a file, where it is written.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Block {
+    /// `test` or `property`.
+    pub kind: &'static str,
+    pub name: String,
+    pub file: String,
+    pub line: u32,
+}
+
+/// The `test` and `property` blocks of checked rules (those of included
+/// files too, each with its own file), in the order they are written; none
+/// for rules with errors.
+pub fn blocks(checked: &situ_compiler::Checked) -> Vec<Block> {
+    if checked.errors() > 0 {
+        return Vec::new();
+    }
+    let spec = situ_compiler::spec::lower(checked);
+    let tests = spec.tests.iter().map(|t| Block {
+        kind: "test",
+        name: t.name.clone(),
+        file: t.place.file.clone(),
+        line: t.place.line,
+    });
+    let props = spec.properties.iter().map(|p| Block {
+        kind: "property",
+        name: p.name.clone(),
+        file: p.place.file.clone(),
+        line: p.place.line,
+    });
+    tests.chain(props).collect()
+}
+
 /// A suite's report as JSON records, the data model of `situ test --format
 /// json` and of the bindings: for each file in order, the findings of a
 /// file with errors (`situ check --format json`'s objects), or one object

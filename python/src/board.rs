@@ -76,8 +76,8 @@ pub struct Batch {
     pub accepted: u64,
     /// Events not taken, by reason.
     pub not_taken: BTreeMap<String, u64>,
-    /// The changes, in order.
-    pub changes: Vec<Change>,
+    /// The changes, in order, each with the index of its event in the batch.
+    pub changes: Vec<(usize, Change)>,
 }
 
 /// An agent's fact (or its staleness).
@@ -142,7 +142,12 @@ pub struct Agent {
 #[pymethods]
 impl Agent {
     fn __repr__(&self) -> String {
-        format!("Agent({} {}{})", self.name, self.mode, self.function.as_ref().map_or(String::new(), |f| format!(" {f}()")))
+        format!(
+            "Agent({} {}{})",
+            self.name,
+            self.mode,
+            self.function.as_ref().map_or(String::new(), |f| format!(" {f}()"))
+        )
     }
 }
 
@@ -152,6 +157,7 @@ pub struct Counters {
     pub accepted: u64,
     pub not_taken: BTreeMap<String, u64>,
     pub changes: u64,
+    pub missions: u64,
 }
 
 /// What a reload kept.
@@ -242,13 +248,7 @@ fn fact(py: Python<'_>, f: &situ_api::Fact) -> PyResult<Fact> {
     for (name, v) in &f.fields {
         fields.insert(name.clone(), field_value(py, v)?);
     }
-    Ok(Fact {
-        agent: f.agent.clone(),
-        event: Some(f.event.clone()),
-        time: Some(seconds(f.time)),
-        fields,
-        stale: false,
-    })
+    Ok(Fact { agent: f.agent.clone(), event: Some(f.event.clone()), time: Some(seconds(f.time)), fields, stale: false })
 }
 
 impl Board {
@@ -284,7 +284,6 @@ impl Board {
             }
         })
     }
-
 }
 
 /// Calls the board's callbacks with a change, the board not borrowed (a
@@ -304,16 +303,29 @@ impl Board {
     /// clock (`"manual"`: time is what the caller stamps) or the system's
     /// (`"system"`: UNIX time; events from the future are refused).
     #[new]
-    #[pyo3(signature = (program, clock = "manual", max_skew = None))]
-    fn new(py: Python<'_>, program: &Program, clock: &str, max_skew: Option<&Bound<'_, PyAny>>) -> PyResult<Board> {
+    #[pyo3(signature = (program, clock = "manual", max_skew = None, missions = false))]
+    fn new(
+        py: Python<'_>,
+        program: &Program,
+        clock: &str,
+        max_skew: Option<&Bound<'_, PyAny>>,
+        missions: bool,
+    ) -> PyResult<Board> {
         let clock = match clock {
             "manual" => Clock::Manual,
             "system" => Clock::System,
             other => {
-                return Err(raise(py, "Error", format!("a clock is \"manual\" or \"system\", not {other:?}"), "clock", None))
+                return Err(raise(
+                    py,
+                    "Error",
+                    format!("a clock is \"manual\" or \"system\", not {other:?}"),
+                    "clock",
+                    None,
+                ))
             }
         };
         let mut inner = situ_api::Board::new(program.content.clone(), clock);
+        inner.set_missions(missions);
         if let Some(ns) = nanos(max_skew).map_err(|e| from_board(py, e))? {
             inner.set_max_skew(ns);
         }
@@ -352,7 +364,7 @@ impl Board {
     fn post_many(slf: &Bound<'_, Self>, events: &Bound<'_, PyAny>) -> PyResult<Batch> {
         let py = slf.py();
         let mut batch = Batch { accepted: 0, not_taken: BTreeMap::new(), changes: Vec::new() };
-        for item in events.try_iter()? {
+        for (index, item) in events.try_iter()?.enumerate() {
             let item = item?;
             let (name, at, payload): (String, Bound<'_, PyAny>, Option<Bound<'_, PyDict>>) = item.extract()?;
             let out = slf.borrow_mut().post_one(py, &name, Some(&at), payload.as_ref())?;
@@ -362,7 +374,7 @@ impl Board {
                     batch.accepted += 1;
                     if let Some(c) = change {
                         notify(slf, &c)?;
-                        batch.changes.push(c);
+                        batch.changes.push((index, c));
                     }
                 }
             }
@@ -438,7 +450,9 @@ impl Board {
             .iter()
             .map(|f| match &f.fact {
                 Some(x) => fact(py, x),
-                None => Ok(Fact { agent: f.agent.clone(), event: None, time: None, fields: BTreeMap::new(), stale: true }),
+                None => {
+                    Ok(Fact { agent: f.agent.clone(), event: None, time: None, fields: BTreeMap::new(), stale: true })
+                }
             })
             .collect()
     }
@@ -450,7 +464,13 @@ impl Board {
             accepted: c.accepted,
             not_taken: c.not_taken.iter().map(|(k, v)| (k.to_string(), *v)).collect(),
             changes: c.changes,
+            missions: c.missions,
         }
+    }
+
+    /// A new mission: the initial state with no facts; time is kept.
+    fn reset(&mut self) {
+        self.inner.reset();
     }
 
     /// Calls `callback(change)` after every change of the state.

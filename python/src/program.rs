@@ -27,6 +27,11 @@ impl Program {
     fn states(&self) -> Vec<String> {
         self.content.states.iter().map(|s| s.name.clone()).collect()
     }
+    /// The `final` states: a mission ends there.
+    #[getter]
+    fn final_states(&self) -> Vec<String> {
+        self.content.states.iter().filter(|s| s.is_final).map(|s| s.name.clone()).collect()
+    }
     #[getter]
     fn initial(&self) -> String {
         self.content.states[self.content.initial as usize].name.clone()

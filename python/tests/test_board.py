@@ -78,7 +78,8 @@ def test_on_change_sees_every_change_in_order_and_post_many_batches(board: situ.
         ]
     )
     assert (batch.accepted, batch.not_taken) == (4, {"out of order": 1})
-    assert [(c.previous, c.state) for c in batch.changes] == seen
+    assert [(c.previous, c.state) for _, c in batch.changes] == seen
+    assert [i for i, _ in batch.changes] == [1, 3, 4]
     assert seen == [("IDLE", "PICKING"), ("PICKING", "CARRYING"), ("CARRYING", "FAULT")]
 
 
@@ -168,3 +169,26 @@ def test_a_callback_may_read_the_board_and_another_thread_may_post(board: situ.B
     t.start()
     t.join()
     assert modes == ["running in PICKING"]
+
+
+def test_with_missions_a_final_state_starts_a_new_mission(picker: situ.Program) -> None:
+    b = situ.Board(picker, missions=True)
+    b.post("BATT", at=0, charge=80.0)
+    b.post("ORDER", at=0, item=1)
+    b.post("OBST", at=0.1, distance=0.1, side="right")
+    assert b.state == "FAULT" and "FAULT" in picker.final_states
+    b.post("BATT", at=0.2, charge=80.0)
+    assert b.state == "IDLE" and b.counters().missions == 1
+    # Without, FAULT stays.
+    plain = situ.Board(picker)
+    steps: list[tuple[str, float, dict[str, situ.Value]]] = [
+        ("BATT", 0, {"charge": 80.0}),
+        ("ORDER", 0, {"item": 1}),
+        ("OBST", 0.1, {"distance": 0.1, "side": "right"}),
+    ]
+    for e, at, p in steps:
+        plain.post(e, at=at, payload=p)
+    plain.post("BATT", at=0.2, charge=80.0)
+    assert plain.state == "FAULT"
+    plain.reset()
+    assert plain.state == "IDLE" and plain.facts() == []

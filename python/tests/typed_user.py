@@ -38,7 +38,7 @@ def main(rules: Path, public_key: Optional[Path] = None, secret_key: Optional[Pa
     if not out.accepted:
         print(out.key, out.reason)
     batch: situ.Batch = board.post_many([(first, 0.1, payload)])
-    print(batch.accepted, batch.not_taken, [c.state for c in batch.changes])
+    print(batch.accepted, batch.not_taken, [c.state for _, c in batch.changes])
     change: Optional[situ.Change] = board.advance(1.0)
     why: Optional[situ.Why] = board.why()
     if why is not None:

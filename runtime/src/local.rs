@@ -194,6 +194,20 @@ impl LocalBoard {
         }
     }
 
+    /// A new mission (language reference §10.12): the initial state with
+    /// no facts, the FSMs in their initial states; time and each agent's
+    /// latest stamp are kept.
+    pub fn reset(&mut self) {
+        self.board.reset();
+        self.org.reset();
+        self.last = None;
+    }
+
+    /// Whether the state at rest is `final` (the mission is over).
+    pub fn is_final(&self) -> bool {
+        self.content.states.get(self.board.state() as usize).is_some_and(|s| s.is_final)
+    }
+
     /// Takes new rules, keeping the state, the facts that still fit and
     /// every FSM's state (by name); on failure the old rules stay.
     pub fn reload(&mut self, new: Arc<Content>) -> Result<SwapReport, SwapError> {
