@@ -175,42 +175,25 @@ pub struct Board {
     callbacks: Vec<Py<PyAny>>,
 }
 
-enum Owned {
-    F64(f64),
-    I64(i64),
-    Bool(bool),
-    Symbol(String),
-}
-
-impl Owned {
-    fn arg(&self) -> Arg<'_> {
-        match self {
-            Owned::F64(x) => Arg::F64(*x),
-            Owned::I64(x) => Arg::I64(*x),
-            Owned::Bool(x) => Arg::Bool(*x),
-            Owned::Symbol(s) => Arg::Symbol(s),
-        }
-    }
-}
-
-fn value_of(event: &str, field: &str, v: &Bound<'_, PyAny>) -> Result<Owned, BoardError> {
+/// A field's value as given, borrowed from the Python object.
+fn arg_of<'a>(event: &str, field: &str, v: &'a Bound<'_, PyAny>) -> Result<Arg<'a>, BoardError> {
     let wrong = |found: String| BoardError::FieldType {
         event: event.to_string(),
         field: field.to_string(),
         expected: "a number, a boolean or a symbol's name".to_string(),
         found,
     };
+    if let Ok(f) = v.cast::<PyFloat>() {
+        return Ok(Arg::F64(f.value()));
+    }
     if v.is_instance_of::<PyBool>() {
-        return Ok(Owned::Bool(v.is_truthy().unwrap_or(false)));
+        return Ok(Arg::Bool(v.is_truthy().unwrap_or(false)));
     }
     if v.is_instance_of::<PyInt>() {
-        return v.extract::<i64>().map(Owned::I64).map_err(|_| wrong("an integer out of the i64 range".into()));
+        return v.extract::<i64>().map(Arg::I64).map_err(|_| wrong("an integer out of the i64 range".into()));
     }
-    if v.is_instance_of::<PyFloat>() {
-        return v.extract::<f64>().map(Owned::F64).map_err(|_| wrong("a float".into()));
-    }
-    if v.is_instance_of::<PyString>() {
-        return v.extract::<String>().map(Owned::Symbol).map_err(|_| wrong("a text".into()));
+    if let Ok(s) = v.cast::<PyString>() {
+        return s.to_str().map(Arg::Symbol).map_err(|_| wrong("a text that is not UTF-8".into()));
     }
     let ty = v.get_type().name().map(|n| n.to_string()).unwrap_or_else(|_| "?".into());
     Err(wrong(format!("a value of type {ty}")))
@@ -252,37 +235,45 @@ fn fact(py: Python<'_>, f: &situ_api::Fact) -> PyResult<Fact> {
 }
 
 impl Board {
-    fn post_one(
+    /// One event, by name, with its fields from a dict: what the library
+    /// did with it, or why the call is wrong.
+    fn post_raw(
         &mut self,
         py: Python<'_>,
         event: &str,
         at: Option<&Bound<'_, PyAny>>,
         payload: Option<&Bound<'_, PyDict>>,
-    ) -> PyResult<Outcome> {
+    ) -> PyResult<Posted> {
         let id = self.inner.event(event).map_err(|e| from_board(py, e))?;
         let name = &self.inner.content().events[id as usize].name;
-        let mut owned: Vec<(String, Owned)> = Vec::new();
-        if let Some(d) = payload {
-            for (k, v) in d.iter() {
-                let k: String = k.extract().map_err(|_| {
-                    raise(py, "BoardError", format!("`{name}`: a field's name is a text"), "unknown-field", None)
-                })?;
-                let v = value_of(name, &k, &v).map_err(|e| from_board(py, e))?;
-                owned.push((k, v));
-            }
+        let items: Vec<(Bound<'_, PyAny>, Bound<'_, PyAny>)> = payload.map(|d| d.iter().collect()).unwrap_or_default();
+        let mut args: Vec<(&str, Arg)> = Vec::with_capacity(items.len());
+        for (k, v) in &items {
+            let Ok(k) = k.cast::<PyString>().map_err(|_| ()).and_then(|k| k.to_str().map_err(|_| ())) else {
+                return Err(raise(
+                    py,
+                    "BoardError",
+                    format!("`{name}`: a field's name is a text"),
+                    "unknown-field",
+                    None,
+                ));
+            };
+            args.push((k, arg_of(name, k, v).map_err(|e| from_board(py, e))?));
         }
-        let args: Vec<(&str, Arg)> = owned.iter().map(|(k, v)| (k.as_str(), v.arg())).collect();
         let values = self.inner.payload(id, &args).map_err(|e| from_board(py, e))?;
         let at = nanos(at).map_err(|e| from_board(py, e))?;
-        let posted = self.inner.post(id, at, &values).map_err(|e| from_board(py, e))?;
-        Ok(match posted {
-            Posted::Taken { change: c, error } => {
-                Outcome { accepted: true, key: None, reason: None, change: c.map(change), error }
-            }
-            Posted::NotTaken { key, reason } => {
-                Outcome { accepted: false, key: Some(key.to_string()), reason: Some(reason), change: None, error: None }
-            }
-        })
+        self.inner.post(id, at, &values).map_err(|e| from_board(py, e))
+    }
+}
+
+fn outcome(posted: Posted) -> Outcome {
+    match posted {
+        Posted::Taken { change: c, error } => {
+            Outcome { accepted: true, key: None, reason: None, change: c.map(change), error }
+        }
+        Posted::NotTaken { key, reason } => {
+            Outcome { accepted: false, key: Some(key.to_string()), reason: Some(reason), change: None, error: None }
+        }
     }
 }
 
@@ -352,7 +343,7 @@ impl Board {
             (Some(p), None) => Some(p),
             (None, f) => f,
         };
-        let out = slf.borrow_mut().post_one(slf.py(), agent_event, at, given)?;
+        let out = outcome(slf.borrow_mut().post_raw(slf.py(), agent_event, at, given)?);
         if let Some(c) = &out.change {
             notify(slf, c)?;
         }
@@ -366,13 +357,15 @@ impl Board {
         let mut batch = Batch { accepted: 0, not_taken: BTreeMap::new(), changes: Vec::new() };
         for (index, item) in events.try_iter()?.enumerate() {
             let item = item?;
-            let (name, at, payload): (String, Bound<'_, PyAny>, Option<Bound<'_, PyDict>>) = item.extract()?;
-            let out = slf.borrow_mut().post_one(py, &name, Some(&at), payload.as_ref())?;
-            match (&out.key, out.change) {
-                (Some(k), _) => *batch.not_taken.entry(k.clone()).or_default() += 1,
-                (None, change) => {
+            let (name, at, payload): (Bound<'_, PyString>, Bound<'_, PyAny>, Option<Bound<'_, PyDict>>) =
+                item.extract()?;
+            let posted = slf.borrow_mut().post_raw(py, name.to_str()?, Some(&at), payload.as_ref())?;
+            match posted {
+                Posted::NotTaken { key, .. } => *batch.not_taken.entry(key.to_string()).or_default() += 1,
+                Posted::Taken { change: c, .. } => {
                     batch.accepted += 1;
-                    if let Some(c) = change {
+                    if let Some(c) = c {
+                        let c = change(c);
                         notify(slf, &c)?;
                         batch.changes.push((index, c));
                     }
