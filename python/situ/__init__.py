@@ -133,6 +133,20 @@ def load_text(source: str, *, name: str = "<source>", deny_warnings: bool = Fals
     return _situ.load_text(source, name=name, deny_warnings=deny_warnings)
 
 
+def _program_of(rules: object, trust: Optional[Sequence[PathLike]]) -> Program:
+    """What `Board(rules)` runs: a program from a bundle, its bytes, a path
+    to a source or a bundle, or a source text."""
+    if isinstance(rules, (Bundle, bytes, bytearray, memoryview)):
+        return load(rules if isinstance(rules, Bundle) else bytes(rules), trust=trust)
+    if isinstance(rules, str) and _is_source(rules):
+        if trust is not None:
+            raise TrustError("a source text carries no signature: give a signed bundle under a trust policy", "trust")
+        return load_text(rules)
+    if isinstance(rules, (str, os.PathLike)):
+        return load_path(rules, trust=trust)
+    raise Error(f"a board runs a Program, a Bundle, bytes, a path or a source text, not {type(rules).__name__}", "usage")
+
+
 def test(
     *paths: PathLike,
     filter: Optional[str] = None,

@@ -1,6 +1,7 @@
 # The extension module: situ-api through PyO3 (python/src/). Public names are
 # re-exported by `situ`; see its docstrings and docs/python.md.
-from typing import Any, Callable, Iterable, Optional, Union
+import os
+from typing import Any, Callable, Iterable, Optional, Sequence, Union
 
 __version__: str
 
@@ -178,7 +179,12 @@ class Board:
     """A Bulletinboard in this process (``clock``: ``"manual"`` or ``"system"``)."""
 
     def __init__(
-        self, program: Program, clock: str = "manual", max_skew: Optional[_Seconds] = None, missions: bool = False
+        self,
+        rules: Union[Program, Bundle, bytes, str, "os.PathLike[str]"],
+        clock: str = "manual",
+        max_skew: Optional[_Seconds] = None,
+        missions: bool = False,
+        trust: Optional[Sequence[Union[str, "os.PathLike[str]"]]] = None,
     ) -> None: ...
     def reset(self) -> None: ...
     def post(

@@ -290,17 +290,20 @@ fn notify(slf: &Bound<'_, Board>, c: &Change) -> PyResult<()> {
 
 #[pymethods]
 impl Board {
-    /// A board on a program (`situ.load`, `situ.load_path`), with a manual
-    /// clock (`"manual"`: time is what the caller stamps) or the system's
-    /// (`"system"`: UNIX time; events from the future are refused).
+    /// A board on rules: a `Program` (`situ.load`, `situ.load_path`), a
+    /// `Bundle` or its bytes (verified under `trust`), a path to a source or
+    /// a bundle, or a source text; with a manual clock (`"manual"`: time is
+    /// what the caller stamps) or the system's (`"system"`: UNIX time;
+    /// events from the future are refused).
     #[new]
-    #[pyo3(signature = (program, clock = "manual", max_skew = None, missions = false))]
+    #[pyo3(signature = (rules, clock = "manual", max_skew = None, missions = false, trust = None))]
     fn new(
         py: Python<'_>,
-        program: &Program,
+        rules: &Bound<'_, PyAny>,
         clock: &str,
         max_skew: Option<&Bound<'_, PyAny>>,
         missions: bool,
+        trust: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Board> {
         let clock = match clock {
             "manual" => Clock::Manual,
@@ -315,6 +318,12 @@ impl Board {
                 ))
             }
         };
+        let program: Bound<'_, Program> = match rules.cast::<Program>() {
+            Ok(p) => p.clone(),
+            // Anything else is loaded as `situ.load`/`load_path`/`load_text` would.
+            Err(_) => py.import("situ")?.getattr("_program_of")?.call1((rules, trust))?.cast_into::<Program>()?,
+        };
+        let program = program.get();
         let mut inner = situ_api::Board::new(program.content.clone(), clock);
         inner.set_missions(missions);
         if let Some(ns) = nanos(max_skew).map_err(|e| from_board(py, e))? {

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import time
+from pathlib import Path
 
 import pytest
 
@@ -192,3 +193,20 @@ def test_with_missions_a_final_state_starts_a_new_mission(picker: situ.Program) 
     assert plain.state == "FAULT"
     plain.reset()
     assert plain.state == "IDLE" and plain.facts() == []
+
+
+def test_a_board_runs_a_program_a_bundle_bytes_a_path_or_a_source(picker_text: str, tmp_path: Path) -> None:
+    from conftest import PICKER
+
+    bundle = situ.build(picker_text)
+    f = tmp_path / "picker.bundle"
+    bundle.save(str(f))
+    for rules in (situ.load_text(picker_text), bundle, bundle.data, PICKER, str(PICKER), f, picker_text):
+        b = situ.Board(rules)
+        b.post("BATT", at=0, charge=80.0)
+        b.post("ORDER", at=0, item=1)
+        assert b.state == "PICKING", rules
+    with pytest.raises(situ.Error):
+        situ.Board(42)  # type: ignore[arg-type]
+    with pytest.raises(situ.TrustError):
+        situ.Board(picker_text, trust=[str(tmp_path / "k.pub")])
