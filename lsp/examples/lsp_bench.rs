@@ -70,7 +70,9 @@ impl Client {
             situ_lsp::serve(In { rx: server_in, buf: Vec::new(), pos: 0 }, Out { tx: server_out, buf: Vec::new() })
         });
         let mut c = Client { tx: to_server, rx: from_server, id: 0 };
-        c.request("initialize", json!({ "capabilities": {} }));
+        // Without the verdicts of properties and tests (run on open and save):
+        // these figures are the compiler's diagnostics as one types.
+        c.request("initialize", json!({ "capabilities": {}, "initializationOptions": { "verdicts": false } }));
         c.notify("initialized", json!({}));
         c
     }
