@@ -32,12 +32,13 @@ enum Event {
 /// input; the process's exit code (0 after a `shutdown`, 1 otherwise).
 ///
 /// Four threads: one reads frames, one runs the static checks (the longest
-/// part of a check) on copies of the documents, one the properties and
+/// part of a check) on copies of the documents, one runs the properties and
 /// tests ([`verdicts`]) when a document is opened or saved, and this one
-/// answers. An
-/// edit is checked here without the static checks (names, types: fast) and
-/// published at once when that finds errors; otherwise the diagnostics wait
-/// for the whole check, whose result is dropped if an edit came since.
+/// answers. An edit is checked here without the static checks (names,
+/// types: fast) and published at once when that finds errors; otherwise the
+/// diagnostics wait for the whole check, whose result is dropped if an edit
+/// came since. The verdicts of a run join the diagnostics of its files when
+/// it ends, unless an edit came since.
 pub fn serve(input: impl Read + Send + 'static, output: impl Write) -> i32 {
     let (tx, rx) = mpsc::channel();
     let frames = tx.clone();
@@ -217,13 +218,10 @@ impl<W: Write> Server<W> {
             }
             (Lifecycle::Running, "workspace/executeCommand") => {
                 self.publish(false);
-                match protocol::execute(&self.world, &req.params) {
-                    Ok(edit) => {
-                        self.ask("workspace/applyEdit", edit);
-                        Ok(Value::Null)
-                    }
-                    Err(e) => Err(e),
-                }
+                protocol::execute(&self.world, &req.params).map(|edit| {
+                    self.ask("workspace/applyEdit", edit);
+                    Value::Null
+                })
             }
             (Lifecycle::Running, method) => {
                 self.publish(false);

@@ -27,7 +27,7 @@ use situ_verify::explore::Limits;
 use situ_verify::ic3::Stop;
 use situ_verify::property::{self, Conclusion, Engines, Premise, Report};
 use situ_verify::random::Search;
-use situ_verify::suite::{self, FileReport};
+use situ_verify::suite::{self, FileReport, PropertyResult};
 use situ_verify::Verdict;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -225,11 +225,12 @@ pub fn code_actions(world: &World, path: &Path, range: Range) -> Vec<CodeAction>
         .collect()
 }
 
-/// The span of a property or a test.
+/// The place of a property or a test: its name (where `situ test` puts its
+/// findings).
 fn verdict_item(item: &ast::Item) -> Option<Span> {
     match item {
-        ast::Item::Test(t) => Some(t.span),
-        ast::Item::Property(p) => Some(p.span),
+        ast::Item::Test(t) => Some(t.name.span),
+        ast::Item::Property(p) => Some(p.name.span),
         _ => None,
     }
 }
@@ -242,7 +243,9 @@ fn outcome(a: &Analysis, r: &FileReport, docs: &BTreeMap<PathBuf, Doc>) -> Outco
         // The editor's budget is not `situ test`'s: undecided here is a warning.
         f.error &= d.code != codes::UNDECIDED_PROPERTY;
         if d.code == codes::VIOLATED_PROPERTY {
-            let run = r.properties.iter().find(|p| p.spec.origin.span == d.primary.span);
+            let origin =
+                |p: &&PropertyResult| (p.spec.origin.file, p.spec.origin.span) == (d.primary.file, d.primary.span);
+            let run = r.properties.iter().find(origin);
             if let Some(Conclusion::Violated { by, how, counterexample }) = run.map(|p| &p.report.conclusion) {
                 let text = format!("the run ({}, {how}):\n{}", by.name(), counterexample.describe(&r.content));
                 f.related.insert(0, (a.location(d.primary.file, d.primary.span), text));

@@ -40,6 +40,7 @@ fn each_verdict_is_a_lens_and_a_finding_with_the_codes_of_sarif() {
     let running = titles(&w, &path);
     assert_eq!(running.len(), 5, "{running:?}");
     assert!(running.iter().all(|(_, t)| t == "running…"), "{running:?}");
+    let names: Vec<Range> = lenses(&w, &path).iter().map(|l| l.range).collect();
     let outcome = runs[0].run();
     let current = w.generation(&path);
     assert!(w.verdicts.accept(&path, runs[0].generation, current, outcome));
@@ -59,6 +60,8 @@ fn each_verdict_is_a_lens_and_a_finding_with_the_codes_of_sarif() {
         )
     );
     assert_eq!(got[4].0, at("test \"one step"));
+    let done: Vec<Range> = lenses(&w, &path).iter().map(|l| l.range).collect();
+    assert_eq!(names, done, "at the same places, the names, running or done");
     assert!(got[4].1.starts_with("failed: "), "{got:?}");
 
     let uri = path_to_uri(&path);
