@@ -3,6 +3,9 @@
 //! on the repository's rule files (insta snapshots, URIs relative to the
 //! repository).
 
+#[path = "lsp/verdicts.rs"]
+mod verdicts;
+
 use serde_json::{json, Value};
 use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
@@ -65,10 +68,18 @@ impl Client {
         Client { child, stdin, rx, next_id: 0, notifications: Vec::new() }
     }
 
-    /// Started and initialized.
+    /// Started and initialized, without the verdicts of properties and tests
+    /// (their own tests are in `lsp/verdicts.rs`): the publications these
+    /// tests wait for are the compiler's.
     fn ready() -> Client {
+        Client::ready_with(json!({ "verdicts": false }), json!({}))
+    }
+
+    /// Started and initialized with these options and client capabilities.
+    fn ready_with(options: Value, capabilities: Value) -> Client {
         let mut c = Client::start();
-        let init = c.request("initialize", json!({ "processId": null, "rootUri": null, "capabilities": {} }));
+        let params = json!({ "processId": null, "rootUri": null, "capabilities": capabilities, "initializationOptions": options });
+        let init = c.request("initialize", params);
         assert!(init["result"]["capabilities"]["hoverProvider"] == true, "{init}");
         c.notify("initialized", json!({}));
         c

@@ -9,13 +9,19 @@ const { LanguageClient, TransportKind } = require("vscode-languageclient/node");
 let client;
 
 function activate(context) {
-  const command = vscode.workspace.getConfiguration("situ").get("server.path") || "situ";
+  const config = vscode.workspace.getConfiguration("situ");
+  const command = config.get("server.path") || "situ";
   const server = { command, args: ["lsp"], transport: TransportKind.stdio };
   client = new LanguageClient(
     "situ",
     "situ language server",
     { run: server, debug: server },
-    { documentSelector: [{ scheme: "file", language: "situ" }, { scheme: "untitled", language: "situ" }] },
+    {
+      documentSelector: [{ scheme: "file", language: "situ" }, { scheme: "untitled", language: "situ" }],
+      // The verdicts' budget (docs/editors.md); changes are sent as `settings.situ`.
+      initializationOptions: { verdicts: config.get("verdicts") },
+      synchronize: { configurationSection: "situ" },
+    },
   );
   context.subscriptions.push(client);
   return client.start();

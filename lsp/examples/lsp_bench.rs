@@ -11,6 +11,11 @@
 //! - the same on a generated file of 10,000 rules;
 //! - completion on `outdoor.situ`;
 //! - the process's resident memory over 1,000 edits.
+//!
+//! With the argument `verdicts` (`cargo run --release -p situ-lsp --example
+//! lsp_bench verdicts`), instead: how long the verdicts of properties and
+//! tests take at the editor's budget on `rules/outdoor.situ` and the
+//! mower, from the open to their code lenses.
 
 use serde_json::{json, Value};
 use std::io::{Read, Write};
@@ -64,13 +69,19 @@ struct Client {
 
 impl Client {
     fn start() -> Client {
+        // Without the verdicts of properties and tests (run on open and save):
+        // these figures are the compiler's diagnostics as one types.
+        Client::start_with(json!({}), json!({ "verdicts": false }))
+    }
+
+    fn start_with(capabilities: Value, options: Value) -> Client {
         let (to_server, server_in) = channel();
         let (server_out, from_server) = channel();
         std::thread::spawn(move || {
             situ_lsp::serve(In { rx: server_in, buf: Vec::new(), pos: 0 }, Out { tx: server_out, buf: Vec::new() })
         });
         let mut c = Client { tx: to_server, rx: from_server, id: 0 };
-        c.request("initialize", json!({ "capabilities": {} }));
+        c.request("initialize", json!({ "capabilities": capabilities, "initializationOptions": options }));
         c.notify("initialized", json!({}));
         c
     }
@@ -199,7 +210,45 @@ fn generated(rules: usize) -> String {
     s
 }
 
+/// The verdicts of a file at the editor's budget: from the open to the
+/// second `workspace/codeLens/refresh` (the first says that they run).
+fn verdicts(rel: &str) {
+    let path = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/..")).join(rel);
+    let path = path.canonicalize().unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    let uri = format!("file://{}", path.display());
+    let refresh = json!({ "workspace": { "codeLens": { "refreshSupport": true } } });
+    let mut c = Client::start_with(refresh, json!({}));
+    let t = Instant::now();
+    c.open(&uri, &text);
+    let mut refreshes = 0;
+    while refreshes < 2 {
+        if c.next()["method"] == "workspace/codeLens/refresh" {
+            refreshes += 1;
+        }
+    }
+    let elapsed = t.elapsed();
+    let lenses = c.request("textDocument/codeLens", json!({ "textDocument": { "uri": uri } }));
+    let mut words = std::collections::BTreeMap::new();
+    for l in lenses["result"].as_array().unwrap() {
+        let title = l["command"]["title"].as_str().unwrap();
+        *words.entry(title.split([':', ' ']).next().unwrap().to_string()).or_insert(0) += 1;
+    }
+    let words: Vec<String> = words.iter().map(|(w, n)| format!("{n} {w}")).collect();
+    println!(
+        "{:<58} {:>8.2} ms ({})",
+        format!("{rel}: open to verdicts"),
+        elapsed.as_secs_f64() * 1e3,
+        words.join(", ")
+    );
+}
+
 fn main() {
+    if std::env::args().nth(1).as_deref() == Some("verdicts") {
+        verdicts("rules/outdoor.situ");
+        verdicts("examples/mower/mower.situ");
+        return;
+    }
     let outdoor = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../rules/outdoor.situ")).unwrap();
     let c = Client::start();
     let uri = "file:///bench/outdoor.situ";

@@ -62,8 +62,9 @@ pub fn finding(a: &Analysis, d: &Diagnostic) -> Finding {
     }
 }
 
-/// The findings of every covered file, by URI, with the version of the open
-/// document they were computed on; `None` for a file whose analysis waits
+/// The findings of every covered file (the compiler's, then the verdicts'
+/// of [`crate::verdicts`]), by URI, with the version of the open document
+/// they were computed on; `None` for a file whose analysis waits
 /// for its static checks (what was published stays until they end).
 pub type Published = BTreeMap<String, Option<(Option<i32>, Vec<Finding>)>>;
 
@@ -75,9 +76,12 @@ pub fn all(world: &World) -> Published {
             out.insert(a.uri(file), None);
             continue;
         }
-        let found: Vec<Finding> = of_file(a, file).map(|d| finding(a, d)).collect();
+        let uri = a.uri(file);
+        let mut found: Vec<Finding> = of_file(a, file).map(|d| finding(a, d)).collect();
+        // The verdicts of the properties and tests, while they are of these documents.
+        found.extend(crate::verdicts::findings(world, a, &uri).iter().cloned());
         let version = world.docs.get(&path).map(|d| d.version);
-        out.insert(a.uri(file), Some((version, found)));
+        out.insert(uri, Some((version, found)));
     }
     out
 }

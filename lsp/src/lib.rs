@@ -14,8 +14,12 @@
 //!   typed inputs, the features' answers become results, failures become
 //!   JSON-RPC errors;
 //! - the features ([`nav`], [`complete`], [`actions`], [`tokens`],
-//!   [`diagnostics`]) take an analysis and a place and return data in the
-//!   protocol's terms ([`data`]), with no JSON.
+//!   [`diagnostics`], [`verdicts`]) take an analysis and a place and return
+//!   data in the protocol's terms ([`data`]), with no JSON.
+//!
+//! The verdicts of properties and tests ([`verdicts`]) run `situ test`'s
+//! policy (`situ_verify::suite`) when a document is opened or saved, on a
+//! worker thread and a budget of work suited to an editor.
 
 pub mod actions;
 pub mod complete;
@@ -28,6 +32,7 @@ pub mod server;
 pub mod text;
 pub mod tokens;
 pub mod transport;
+pub mod verdicts;
 pub mod world;
 
 pub use server::serve;

@@ -11,6 +11,7 @@ use crate::diagnostics::Finding;
 use crate::nav::{self, Highlight, Hover, RenamePlace, Symbol, WorkspaceSymbol};
 use crate::text::{uri_to_path, LineIndex};
 use crate::tokens::{self, Fold, SemanticToken, TOKEN_MODIFIERS, TOKEN_TYPES};
+use crate::verdicts::{self, Lens, Settings};
 use crate::world::{Analysis, Doc, World};
 use lsp_server::ErrorCode;
 use lsp_types::Position;
@@ -105,7 +106,7 @@ pub fn capabilities() -> Value {
     json!({
         "capabilities": {
             "positionEncoding": "utf-16",
-            "textDocumentSync": { "openClose": true, "change": 2 },
+            "textDocumentSync": { "openClose": true, "change": 2, "save": { "includeText": false } },
             "hoverProvider": true,
             "definitionProvider": true,
             "referencesProvider": true,
@@ -120,6 +121,8 @@ pub fn capabilities() -> Value {
             "semanticTokensProvider": { "legend": { "tokenTypes": TOKEN_TYPES, "tokenModifiers": TOKEN_MODIFIERS }, "full": true },
             "foldingRangeProvider": true,
             "inlayHintProvider": true,
+            "codeLensProvider": { "resolveProvider": false },
+            "executeCommandProvider": { "commands": [verdicts::INSERT_COMMAND] },
         },
         "serverInfo": { "name": "situ", "version": env!("CARGO_PKG_VERSION") },
     })
@@ -233,8 +236,11 @@ pub fn request(world: &World, method: &str, params: &Value) -> Answer {
         "textDocument/codeAction" => {
             let (a, file) = analysis(world, params)?;
             let span = required_range(a, file, params)?;
-            Ok(list(&actions::code_actions(a, file, span), code_action))
+            let mut all = actions::code_actions(a, file, span);
+            all.extend(verdicts::code_actions(world, &doc_path(params)?, a.range(file, span)));
+            Ok(list(&all, code_action))
         }
+        "textDocument/codeLens" => Ok(list(&verdicts::lenses(world, &doc_path(params)?), code_lens)),
         "textDocument/inlayHint" => {
             let (a, file) = analysis(world, params)?;
             Ok(list(&actions::inlay_hints(a, file, range(a, file, params)), inlay_hint))
@@ -269,6 +275,9 @@ pub enum SyncError {
     BadRange(String),
     #[error("change {index} of `{}` has an impossible range {}:{}-{}:{}; the change was not applied", path.display(), range.start.line, range.start.character, range.end.line, range.end.character)]
     ImpossibleRange { index: usize, path: PathBuf, range: lsp_types::Range },
+    /// A setting that is not what it must be (the settings stay as they were).
+    #[error("{0}")]
+    Settings(String),
     /// The handler of the notification failed (a bug of situ, reported).
     #[error("`{0}` failed")]
     Failed(String),
@@ -285,7 +294,17 @@ pub fn sync(world: &mut World, method: &str, p: &Value) -> Result<(), SyncError>
             let text = text.ok_or(SyncError::Incomplete("didOpen without a text"))?;
             let version = p.pointer("/textDocument/version").and_then(Value::as_i64).unwrap_or(0) as i32;
             let path = uri_path(uri).map_err(|e| SyncError::Uri(e.message))?;
-            world.open(path, Doc::new(uri.to_string(), text.to_string(), version));
+            world.open(path.clone(), Doc::new(uri.to_string(), text.to_string(), version));
+            world.verdicts.want(path);
+        }
+        "textDocument/didSave" => {
+            let path = doc_path(p).map_err(|e| SyncError::Uri(e.message))?;
+            world.verdicts.want(path);
+        }
+        "workspace/didChangeConfiguration" => {
+            if let Some(v) = p.pointer("/settings/situ/verdicts") {
+                world.verdicts.settings = settings(v).map_err(SyncError::Settings)?;
+            }
         }
         "textDocument/didChange" => did_change(world, p)?,
         "textDocument/didClose" => {
@@ -298,7 +317,7 @@ pub fn sync(world: &mut World, method: &str, p: &Value) -> Result<(), SyncError>
                 world.touch(&r);
             }
         }
-        _ => {} // `initialized`, `didSave`, `$/cancelRequest`, `$/setTrace`, and anything else
+        _ => {} // `initialized`, `$/cancelRequest`, `$/setTrace`, and anything else
     }
     Ok(())
 }
@@ -331,6 +350,88 @@ fn did_change(world: &mut World, p: &Value) -> Result<(), SyncError> {
     doc.text = text;
     world.touch(&path);
     Ok(())
+}
+
+// ---------------------------------------------------------------- settings
+
+/// The verdicts' settings: `false` (none run), `true`, or an object whose
+/// fields (each optional) are `enabled`, `effort` (IC3's SAT propagations
+/// per property), `depth` and `maxStates` (the exploration), `randomRuns`
+/// and `randomLength` (the random search), `timeoutSeconds` (the
+/// wall-clock guard on IC3). The rest stay [`verdicts::EDITOR_OPTIONS`]'s.
+pub fn settings(v: &Value) -> Result<Settings, String> {
+    let mut s = Settings::default();
+    let fields = match v {
+        Value::Bool(b) => {
+            s.enabled = *b;
+            return Ok(s);
+        }
+        Value::Object(fields) => fields,
+        _ => return Err(format!("the setting `verdicts` is `{v}`: it must be true, false or an object")),
+    };
+    let o = &mut s.options;
+    for (key, value) in fields {
+        let number = || {
+            value
+                .as_u64()
+                .ok_or_else(|| format!("the setting `verdicts.{key}` is `{value}`: it must be a whole number"))
+        };
+        match key.as_str() {
+            "enabled" => {
+                s.enabled = value.as_bool().ok_or_else(|| format!("the setting `verdicts.enabled` is `{value}`: it must be true or false"))?
+            }
+            "effort" => o.effort = number()?,
+            "depth" => o.limits.depth = number()? as usize,
+            "maxStates" => o.limits.max_states = number()? as usize,
+            "randomRuns" => o.search.cases = u32::try_from(number()?).unwrap_or(u32::MAX),
+            "randomLength" => o.search.length = number()? as usize,
+            "timeoutSeconds" => o.timeout = Some(std::time::Duration::from_secs(number()?)),
+            _ => return Err(format!("unknown setting `verdicts.{key}`: the settings are enabled, effort, depth, maxStates, randomRuns, randomLength and timeoutSeconds")),
+        }
+    }
+    Ok(s)
+}
+
+/// From `initialize`'s params: the verdicts' settings
+/// (`initializationOptions.verdicts`; the default when absent), and whether
+/// the client asks to be told to refresh its code lenses.
+pub fn initialization(params: &Value) -> (Result<Settings, String>, bool) {
+    let s = params.pointer("/initializationOptions/verdicts").map_or(Ok(Settings::default()), settings);
+    let refresh = params.pointer("/capabilities/workspace/codeLens/refreshSupport").and_then(Value::as_bool);
+    (s, refresh == Some(true))
+}
+
+/// `workspace/executeCommand` of [`verdicts::INSERT_COMMAND`]: the params of
+/// the `workspace/applyEdit` to ask of the client, if the document is still
+/// the version the counterexample was found on.
+pub fn execute(world: &World, params: &Value) -> Result<Value, RpcError> {
+    let command = params.get("command").and_then(Value::as_str).ok_or_else(|| invalid_params("no command"))?;
+    if command != verdicts::INSERT_COMMAND {
+        return Err(invalid_params(format!("unknown command `{command}`")));
+    }
+    let arg = params.pointer("/arguments/0").ok_or_else(|| invalid_params("no arguments"))?;
+    let uri = arg.get("uri").and_then(Value::as_str).ok_or_else(|| invalid_params("no uri"))?;
+    let edit: lsp_types::TextEdit = arg
+        .get("edit")
+        .cloned()
+        .and_then(|e| serde_json::from_value(e).ok())
+        .ok_or_else(|| invalid_params("no edit"))?;
+    let version = arg.get("version").and_then(Value::as_i64).map(|v| v as i32);
+    let now = world.docs.get(&uri_path(uri)?).map(|d| d.version);
+    if now != version {
+        return Err(refused(
+            "the document changed since this counterexample was found: save it to check the properties again",
+        ));
+    }
+    let edit = TextEdit { range: edit.range, new_text: edit.new_text };
+    Ok(
+        json!({ "label": "append the counterexample as a test", "edit": workspace_edit(&[(uri.to_string(), vec![edit])].into()) }),
+    )
+}
+
+/// A request of the server to the client.
+pub fn server_request(id: &str, method: &str, params: Value) -> Value {
+    json!({ "jsonrpc": "2.0", "id": id, "method": method, "params": params })
 }
 
 // ---------------------------------------------------------------- results
@@ -427,6 +528,20 @@ fn code_action(c: &CodeAction) -> Value {
         "isPreferred": c.preferred,
         "edit": workspace_edit(&c.edit),
     })
+}
+
+/// A lens: its title, and the command that appends a counterexample (an
+/// empty command otherwise: a title only).
+fn code_lens(l: &Lens) -> Value {
+    let command = match &l.insert {
+        Some(i) => json!({
+            "title": l.title,
+            "command": verdicts::INSERT_COMMAND,
+            "arguments": [{ "uri": i.uri, "version": i.version, "edit": text_edit(&i.edit) }],
+        }),
+        None => json!({ "title": l.title, "command": "" }),
+    };
+    json!({ "range": l.range, "command": command })
 }
 
 fn inlay_hint(h: &InlayHint) -> Value {
@@ -590,6 +705,36 @@ mod tests {
         assert!(out["items"][0].get("insertTextFormat").is_none());
         assert_eq!(out["items"][1]["insertTextFormat"], 2);
         assert!(out["items"][1].get("detail").is_none());
+    }
+
+    #[test]
+    fn verdict_settings_and_their_errors() {
+        let s = settings(&json!(false)).unwrap();
+        assert!(!s.enabled);
+        let s = settings(&json!({ "effort": 7, "depth": 3, "maxStates": 9, "randomRuns": 2, "randomLength": 4, "timeoutSeconds": 5 }))
+            .unwrap();
+        assert!(s.enabled);
+        let o = s.options;
+        assert_eq!((o.effort, o.limits.depth, o.limits.max_states, o.search.cases, o.search.length), (7, 3, 9, 2, 4));
+        assert_eq!(o.timeout, Some(std::time::Duration::from_secs(5)));
+        assert_eq!(o.search.seed, verdicts::EDITOR_OPTIONS.search.seed, "the rest is the editor's");
+        let bad = settings(&json!({ "effort": -1 })).unwrap_err();
+        assert_eq!(bad, "the setting `verdicts.effort` is `-1`: it must be a whole number");
+        assert!(settings(&json!({ "efort": 1 })).unwrap_err().starts_with("unknown setting `verdicts.efort`"));
+        assert!(settings(&json!("on")).is_err());
+        let (s, refresh) = initialization(&json!({ "capabilities": {} }));
+        assert!(s.unwrap().enabled && !refresh);
+        let (s, refresh) = initialization(
+            &json!({ "initializationOptions": { "verdicts": { "enabled": false } }, "capabilities": { "workspace": { "codeLens": { "refreshSupport": true } } } }),
+        );
+        assert!(!s.unwrap().enabled && refresh);
+    }
+
+    #[test]
+    fn a_lens_with_and_without_its_command() {
+        let range = Range { start: at(0, 0), end: at(0, 1) };
+        let title = code_lens(&Lens { range, title: "passed".into(), insert: None });
+        assert_eq!(title, json!({ "range": range, "command": { "title": "passed", "command": "" } }));
     }
 
     #[test]

@@ -11,6 +11,7 @@
 use crate::diagnostics::{self, Finding};
 use crate::protocol::{self, Answer};
 use crate::transport::{self, Incoming};
+use crate::verdicts::{self, Outcome, Run};
 use crate::world::{Analysis, Job, World};
 use lsp_server::{Message, Notification, Request};
 use serde_json::Value;
@@ -23,19 +24,25 @@ enum Event {
     Frame(Incoming),
     /// A whole check (static checks included) is done.
     Checked(Job, Option<Box<Analysis>>),
+    /// The verdicts of a root are in (`None`: the run failed).
+    Verdicts(Run, Option<Outcome>),
 }
 
 /// Serves one client on `input` and `output` until `exit` or the end of the
 /// input; the process's exit code (0 after a `shutdown`, 1 otherwise).
 ///
-/// Three threads: one reads frames, one runs the static checks (the longest
-/// part of a check) on copies of the documents, and this one answers. An
-/// edit is checked here without the static checks (names, types: fast) and
-/// published at once when that finds errors; otherwise the diagnostics wait
-/// for the whole check, whose result is dropped if an edit came since.
+/// Four threads: one reads frames, one runs the static checks (the longest
+/// part of a check) on copies of the documents, one runs the properties and
+/// tests ([`verdicts`]) when a document is opened or saved, and this one
+/// answers. An edit is checked here without the static checks (names,
+/// types: fast) and published at once when that finds errors; otherwise the
+/// diagnostics wait for the whole check, whose result is dropped if an edit
+/// came since. The verdicts of a run join the diagnostics of its files when
+/// it ends, unless an edit came since.
 pub fn serve(input: impl Read + Send + 'static, output: impl Write) -> i32 {
     let (tx, rx) = mpsc::channel();
     let frames = tx.clone();
+    let verdicts_tx = tx.clone();
     std::thread::spawn(move || {
         let mut r = BufReader::new(input);
         while let Ok(Some(frame)) = transport::read(&mut r) {
@@ -61,8 +68,33 @@ pub fn serve(input: impl Read + Send + 'static, output: impl Write) -> i32 {
             }
         }
     });
-    let mut server =
-        Server { out: output, world: World::default(), state: Lifecycle::Starting, published: BTreeMap::new(), jobs };
+    let (runs, to_run) = mpsc::channel::<Run>();
+    std::thread::spawn(move || {
+        while let Ok(first) = to_run.recv() {
+            // A newer run of a root supersedes the older ones still waiting.
+            let mut latest = BTreeMap::new();
+            latest.insert(first.root.clone(), first);
+            while let Ok(run) = to_run.try_recv() {
+                latest.insert(run.root.clone(), run);
+            }
+            for (_, run) in latest {
+                let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run.run())).ok();
+                if verdicts_tx.send(Event::Verdicts(run, outcome)).is_err() {
+                    return;
+                }
+            }
+        }
+    });
+    let mut server = Server {
+        out: output,
+        world: World::default(),
+        state: Lifecycle::Starting,
+        published: BTreeMap::new(),
+        jobs,
+        runs,
+        refresh_lenses: false,
+        asked: 0,
+    };
     while let Ok(first) = rx.recv() {
         if let Some(code) = server.event(first) {
             return code;
@@ -91,6 +123,11 @@ struct Server<W: Write> {
     /// What was last published, by URI.
     published: BTreeMap<String, Vec<Finding>>,
     jobs: mpsc::Sender<Job>,
+    runs: mpsc::Sender<Run>,
+    /// The client refreshes its code lenses when asked.
+    refresh_lenses: bool,
+    /// Requests sent to the client so far (their ids).
+    asked: u64,
 }
 
 impl<W: Write> Server<W> {
@@ -116,6 +153,21 @@ impl<W: Write> Server<W> {
                 }
                 None
             }
+            Event::Verdicts(run, outcome) => {
+                let current = self.world.generation(&run.root);
+                let Some(outcome) = outcome else {
+                    self.world.verdicts.forget(&run.root);
+                    let message =
+                        format!("the properties of `{}` could not be checked (an error of situ)", run.root.display());
+                    self.complain(message);
+                    return None;
+                };
+                if self.world.verdicts.accept(&run.root, run.generation, current, outcome) {
+                    self.publish(true);
+                    self.refresh_lenses();
+                }
+                None
+            }
         }
     }
 
@@ -130,11 +182,31 @@ impl<W: Write> Server<W> {
         None
     }
 
+    /// Asks the client to show the code lenses again, if it can.
+    fn refresh_lenses(&mut self) {
+        if self.refresh_lenses {
+            self.ask("workspace/codeLens/refresh", Value::Null);
+        }
+    }
+
+    /// Sends a request to the client (its answer is not awaited).
+    fn ask(&mut self, method: &str, params: Value) {
+        self.asked += 1;
+        let id = format!("situ/{}", self.asked);
+        self.send(protocol::server_request(&id, method, params));
+    }
+
     fn request(&mut self, req: Request) {
         let id = serde_json::to_value(&req.id).unwrap_or(Value::Null);
         let answer: Answer = match (self.state, req.method.as_str()) {
             (Lifecycle::Starting, "initialize") => {
                 self.state = Lifecycle::Running;
+                let (settings, refresh) = protocol::initialization(&req.params);
+                self.refresh_lenses = refresh;
+                match settings {
+                    Ok(s) => self.world.verdicts.settings = s,
+                    Err(e) => self.complain(format!("{e}; the verdicts run on the editor's default budget")),
+                }
                 Ok(protocol::capabilities())
             }
             (Lifecycle::Starting, _) => Err(protocol::not_initialized()),
@@ -143,6 +215,13 @@ impl<W: Write> Server<W> {
             (Lifecycle::Running, "shutdown") => {
                 self.state = Lifecycle::ShutDown;
                 Ok(Value::Null)
+            }
+            (Lifecycle::Running, "workspace/executeCommand") => {
+                self.publish(false);
+                protocol::execute(&self.world, &req.params).map(|edit| {
+                    self.ask("workspace/applyEdit", edit);
+                    Value::Null
+                })
             }
             (Lifecycle::Running, method) => {
                 self.publish(false);
@@ -174,14 +253,21 @@ impl<W: Write> Server<W> {
 
     /// Checks what is stale (`force`: or an analysis came) and publishes what changed.
     fn publish(&mut self, force: bool) {
-        match self.world.refresh() {
-            Some(jobs) => {
-                for job in jobs {
-                    let _ = self.jobs.send(job);
-                }
-            }
-            None if !force => return,
-            None => {}
+        let refreshed = self.world.refresh();
+        let stale = refreshed.is_some();
+        for job in refreshed.into_iter().flatten() {
+            let _ = self.jobs.send(job);
+        }
+        // The documents opened or saved: their properties and tests run.
+        let runs = verdicts::start(&mut self.world);
+        if !runs.is_empty() {
+            self.refresh_lenses();
+        }
+        for run in runs {
+            let _ = self.runs.send(run);
+        }
+        if !stale && !force {
+            return;
         }
         let skipped: Vec<String> = self
             .world

@@ -172,6 +172,8 @@ pub struct World {
     /// Per root, the generation of its documents: it grows at every change.
     generations: BTreeMap<PathBuf, u64>,
     next_generation: u64,
+    /// The verdicts of the properties and tests, run on open and save.
+    pub verdicts: crate::verdicts::Board,
 }
 
 impl World {
@@ -192,6 +194,7 @@ impl World {
     }
 
     pub fn close(&mut self, path: &Path) {
+        self.verdicts.forget(path);
         self.docs.remove(path);
         self.analyses.remove(path);
         self.dirty.remove(path);
@@ -227,6 +230,11 @@ impl World {
             }
         }
         Some(jobs)
+    }
+
+    /// The generation of the documents of `root` (it grows at every change).
+    pub fn generation(&self, root: &Path) -> u64 {
+        self.generations.get(root).copied().unwrap_or(0)
     }
 
     /// A whole check is done: kept if no change came since its job.
