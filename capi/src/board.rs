@@ -322,9 +322,11 @@ fn write_reason(out: &mut situ_posted, reason: &str) {
     while !reason.is_char_boundary(end) {
         end -= 1;
     }
-    for (dst, &b) in out.reason.iter_mut().zip(&reason.as_bytes()[..end]) {
-        *dst = if b == 0 { b' ' as c_char } else { b as c_char };
-    }
+    // One copy (a `c_char` is a byte); a NUL inside, which no reason has,
+    // would only cut the text short.
+    let bytes = &reason.as_bytes()[..end];
+    let dst = &mut out.reason[..end];
+    dst.copy_from_slice(unsafe { &*(bytes as *const [u8] as *const [c_char]) });
     out.reason[end] = 0;
 }
 
@@ -466,4 +468,38 @@ pub unsafe extern "C" fn situ_board_reload(
         notify(callback, reloaded.change.as_ref());
         Ok(())
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn posted() -> situ_posted {
+        situ_posted {
+            taken: false,
+            changed: false,
+            cascade: false,
+            not_taken: situ_not_taken::SITU_TAKEN,
+            reason: [1; SITU_REASON_LEN],
+        }
+    }
+
+    fn text(p: &situ_posted) -> String {
+        let bytes: Vec<u8> = p.reason.iter().take_while(|&&c| c != 0).map(|&c| c as u8).collect();
+        String::from_utf8(bytes).expect("a whole UTF-8 text")
+    }
+
+    #[test]
+    fn a_reason_is_copied_whole_when_it_fits_and_cut_at_a_character_when_not() {
+        let mut p = posted();
+        write_reason(&mut p, "`Arm` sleeps in CHARGING");
+        assert_eq!(text(&p), "`Arm` sleeps in CHARGING");
+        write_reason(&mut p, "");
+        assert_eq!(text(&p), "");
+        // 'é' is two bytes: 200 of them do not fit in 255, and the cut
+        // falls between two characters.
+        let long = "é".repeat(200);
+        write_reason(&mut p, &long);
+        assert_eq!(text(&p), "é".repeat(127));
+    }
 }

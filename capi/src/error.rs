@@ -191,3 +191,52 @@ pub extern "C" fn situ_status_name(status: i32) -> *const c_char {
     };
     name.as_ptr().cast()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::ffi::CStr;
+
+    fn last() -> (situ_status, String) {
+        let message = unsafe { CStr::from_ptr(situ_last_error()) }.to_string_lossy().into_owned();
+        (situ_last_status(), message)
+    }
+
+    #[test]
+    fn a_panic_is_caught_and_answered_with_its_status_and_message() {
+        let status = call(|| panic!("a bug in the engine"));
+        assert_eq!(status, SITU_ERR_PANIC);
+        let (code, message) = last();
+        assert_eq!(code, SITU_ERR_PANIC);
+        assert!(message.contains("a bug in the engine"), "{message}");
+        // The next success clears it.
+        assert_eq!(call(|| Ok(())), SITU_OK);
+        assert_eq!(last(), (SITU_OK, String::new()));
+    }
+
+    #[test]
+    fn a_failure_records_its_status_and_message_on_its_thread_only() {
+        assert_eq!(call(|| Err(Failure::new(SITU_ERR_KEY, "no key"))), SITU_ERR_KEY);
+        let other = std::thread::spawn(last).join().unwrap();
+        assert_eq!(other, (SITU_OK, String::new()));
+        assert_eq!(last(), (SITU_ERR_KEY, "no key".to_string()));
+    }
+
+    #[test]
+    fn every_status_has_the_name_of_its_board_error_code() {
+        let names = [
+            (SITU_ERR_UNKNOWN_EVENT, "unknown-event"),
+            (SITU_ERR_NOT_ITS_AGENT, "not-its-agent"),
+            (SITU_ERR_UNKNOWN_FIELD, "unknown-field"),
+            (SITU_ERR_MISSING_FIELDS, "missing-fields"),
+            (SITU_ERR_FIELD_TWICE, "field-twice"),
+            (SITU_ERR_FIELD_TYPE, "field-type"),
+            (SITU_ERR_BAD_TIME, "bad-time"),
+            (SITU_ERR_RELOAD, "reload"),
+        ];
+        for (status, name) in names {
+            let got = unsafe { CStr::from_ptr(situ_status_name(status as i32)) }.to_str().unwrap();
+            assert_eq!(got, name);
+        }
+    }
+}
