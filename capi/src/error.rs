@@ -121,17 +121,21 @@ fn record(status: situ_status, message: &str) {
     LAST.with(|l| *l.borrow_mut() = (status, message));
 }
 
-/// Runs an entry point: clears the last error, catches a panic, records
-/// the error of a failure, and returns the status.
+/// Runs an entry point: catches a panic, records the error of a failure
+/// or clears the last one on success (at the end, so that a failed call
+/// made by a callback inside this one is not what the caller reads after
+/// this one succeeded), and returns the status.
 pub(crate) fn call(f: impl FnOnce() -> Result<(), Failure>) -> situ_status {
-    LAST.with(|l| {
-        let mut l = l.borrow_mut();
-        if l.0 != SITU_OK {
-            *l = (SITU_OK, CString::default());
-        }
-    });
     match catch_unwind(AssertUnwindSafe(f)) {
-        Ok(Ok(())) => SITU_OK,
+        Ok(Ok(())) => {
+            LAST.with(|l| {
+                let mut l = l.borrow_mut();
+                if l.0 != SITU_OK {
+                    *l = (SITU_OK, CString::default());
+                }
+            });
+            SITU_OK
+        }
         Ok(Err(failure)) => {
             record(failure.status, &failure.message);
             failure.status

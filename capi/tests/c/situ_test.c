@@ -92,6 +92,14 @@ static void on_change(const situ_change *c, void *user) {
         snprintf(s->state_in_callback, sizeof s->state_in_callback, "%s", state);
 }
 
+/* A callback whose own call fails: the post that ran it still succeeds,
+ * and the last error is then that success's. */
+static void fail_inside(const situ_change *c, void *user) {
+    (void)c;
+    uint32_t id;
+    if (situ_board_event((situ_board *)user, "NOPE", &id) != SITU_ERR_UNKNOWN_EVENT) abort();
+}
+
 /* A callback that frees the board it was called by. */
 static void free_on_change(const situ_change *c, void *user) {
     (void)c;
@@ -403,6 +411,12 @@ static void test_reload(const char *dir, situ_program *picker) {
 
 static void test_handles(situ_program *picker) {
     situ_board *b = NULL;
+    OK(situ_board_new(picker, SITU_CLOCK_MANUAL, &b));
+    OK(situ_board_on_change(b, fail_inside, b));
+    situ_arg low[] = {{"charge", situ_f64(5.0)}};
+    situ_posted charging = post(b, "BATT", low, 1, 0); /* checks SITU_OK and an empty last error */
+    CHECK(charging.changed);
+    OK(situ_board_free(b));
     OK(situ_board_new(picker, SITU_CLOCK_MANUAL, &b));
     /* A callback that frees its own board: the post returns normally. */
     OK(situ_board_on_change(b, free_on_change, b));
