@@ -55,7 +55,12 @@ fn built() -> &'static Built {
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).expect("a folder under target/tmp");
         let prefix = dir.join("prefix");
-        run(Command::new("bash").arg(root().join("capi/install.sh")).arg(&prefix));
+        // The libraries this test run built (target/PROFILE/deps, where
+        // the test runs from), with its features: a nested cargo build of
+        // other features would rebuild the dependencies.
+        let exe = std::env::current_exe().expect("the test's path");
+        let libs = exe.parent().expect("target/PROFILE/deps");
+        run(Command::new("bash").arg(root().join("capi/install.sh")).arg(&prefix).env("SITU_LIB_DIR", libs));
         for file in ["include/situ.h", "lib/libsitu.so", "lib/libsitu.a", "lib/cmake/situ/situConfig.cmake"] {
             assert!(prefix.join(file).is_file(), "capi/install.sh did not lay out {file}");
         }
