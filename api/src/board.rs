@@ -327,6 +327,30 @@ impl Board {
         Ok(values.into_iter().flatten().collect())
     }
 
+    /// An event's payload from values in field order, without names (the
+    /// bindings' fast path), each typed as [`payload`](Self::payload)
+    /// types it; written into `into`, which is cleared first so that a
+    /// caller reuses one buffer. A value past the last field is an unknown
+    /// field `#N`; an event id the rules do not have, an unknown event `#ID`.
+    pub fn payload_in_order(&self, event: u32, args: &[Arg], into: &mut Vec<Value>) -> Result<(), BoardError> {
+        into.clear();
+        let Some(def) = self.content().events.get(event as usize) else {
+            return Err(BoardError::UnknownEvent { name: format!("#{event}"), suggestion: None });
+        };
+        if let Some(extra) = args.len().checked_sub(def.fields.len()).filter(|&n| n > 0) {
+            let field = format!("#{}", args.len() - extra);
+            return Err(BoardError::UnknownField { event: def.name.clone(), field, suggestion: None });
+        }
+        if args.len() < def.fields.len() {
+            let missing = def.fields[args.len()..].iter().map(|f| f.name.clone()).collect();
+            return Err(BoardError::MissingFields { event: def.name.clone(), missing });
+        }
+        for (f, arg) in def.fields.iter().zip(args) {
+            into.push(convert(&def.name, &f.name, &f.ty, arg)?);
+        }
+        Ok(())
+    }
+
     /// Posts an event (its id from [`event`](Self::event), its payload
     /// from [`payload`](Self::payload)) stamped `at` (ns; `None`: now, by
     /// the board's [`Clock`]).
