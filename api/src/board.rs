@@ -136,9 +136,29 @@ pub enum Posted {
         /// state where they stopped, and this says why.
         error: Option<String>,
     },
-    /// Not taken; nothing changed. `key` is the count's word (`sleeping`,
-    /// `out of order`, `from the future`, `payload`).
-    NotTaken { key: &'static str, reason: String },
+    /// Not taken; nothing changed.
+    NotTaken(Refusal),
+}
+
+/// Why an event was not taken, kept as data: its text is made only when
+/// asked for ([`Refusal::reason`]), so that a stream with many refusals
+/// costs no formatting.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Refusal {
+    /// The count's word: `sleeping`, `out of order`, `from the future`,
+    /// `payload`.
+    pub key: &'static str,
+    why: NotTaken,
+    /// The state when it was refused.
+    state: u32,
+}
+
+impl Refusal {
+    /// The reason in the rules' terms (`content`: the board's rules).
+    pub fn reason(&self, content: &Content) -> String {
+        let state = content.states.get(self.state as usize).map_or("?", |s| s.name.as_str());
+        self.why.describe(content, state)
+    }
 }
 
 /// An agent's fact, in the rules' terms.
@@ -363,7 +383,7 @@ impl Board {
         match self.local.post(event, time, payload) {
             Ok(taken) => {
                 self.counters.accepted += 1;
-                let change = taken.change.filter(StateChange::changed).map(|c| self.change(&c));
+                let change = self.local.last_change().filter(|_| taken.changed).map(|c| self.change(c));
                 self.counters.changes += change.is_some() as u64;
                 Ok(Posted::Taken { change, error: taken.error.map(|e| e.describe(self.content())) })
             }
@@ -372,7 +392,7 @@ impl Board {
                     return Err(BoardError::UnknownEvent { name: format!("#{event}"), suggestion: None });
                 }
                 *self.counters.not_taken.entry(why.key()).or_default() += 1;
-                Ok(Posted::NotTaken { key: why.key(), reason: why.describe(self.content(), self.state()) })
+                Ok(Posted::NotTaken(Refusal { key: why.key(), why, state: self.local.state() }))
             }
         }
     }
@@ -383,7 +403,7 @@ impl Board {
     pub fn advance(&mut self, to: Option<u64>) -> Option<Change> {
         let now = self.tick_clock();
         let taken = self.local.advance(to.unwrap_or(now));
-        let change = taken.change.filter(StateChange::changed).map(|c| self.change(&c));
+        let change = self.local.last_change().filter(|_| taken.changed).map(|c| self.change(c));
         self.counters.changes += change.is_some() as u64;
         change
     }

@@ -57,13 +57,15 @@ fn late_and_sleeping_agents_events_are_not_taken_and_counted() {
     post(&mut b, "BATT", 100 * MS, &[("charge", Arg::F64(50.0))]);
     // Stamped before the battery's latest accepted event.
     let late = post(&mut b, "BATT", 50 * MS, &[("charge", Arg::F64(5.0))]);
-    assert!(matches!(late, Posted::NotTaken { key: "out of order", .. }), "{late:?}");
+    assert!(matches!(&late, Posted::NotTaken(r) if r.key == "out of order"), "{late:?}");
     assert_eq!(b.state(), "IDLE");
     // Low battery: charging, where the arm sleeps and never reports.
     post(&mut b, "BATT", 200 * MS, &[("charge", Arg::F64(10.0))]);
     assert_eq!(b.state(), "CHARGING");
     let asleep = post(&mut b, "PICKED", 300 * MS, &[]);
-    let Posted::NotTaken { key: "sleeping", reason } = asleep else { panic!("{asleep:?}") };
+    let Posted::NotTaken(refusal) = &asleep else { panic!("{asleep:?}") };
+    assert_eq!(refusal.key, "sleeping");
+    let reason = refusal.reason(b.content());
     assert!(reason.contains("`Arm` sleeps in CHARGING"), "{reason}");
     assert_eq!(b.counters().not_taken.get("sleeping"), Some(&1));
     assert_eq!(b.counters().not_taken.get("out of order"), Some(&1));
@@ -74,7 +76,7 @@ fn with_the_system_clock_an_event_from_the_future_is_refused() {
     let mut b = picker(Clock::System);
     let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap().as_nanos() as u64;
     let future = post(&mut b, "BATT", now + 3_600_000 * MS, &[("charge", Arg::F64(50.0))]);
-    assert!(matches!(future, Posted::NotTaken { key: "from the future", .. }), "{future:?}");
+    assert!(matches!(&future, Posted::NotTaken(r) if r.key == "from the future"), "{future:?}");
     let id = b.event("BATT").unwrap();
     let payload = b.payload(id, &[("charge", Arg::F64(50.0))]).unwrap();
     assert!(matches!(b.post(id, None, &payload).unwrap(), Posted::Taken { .. }));

@@ -279,6 +279,11 @@ pub unsafe extern "C" fn situ_board_post_values(
 /// Writes what a post did, unlocks the board and calls the callback.
 unsafe fn finish(g: MutexGuard<'_, BoardCell>, posted: Posted, out: *mut situ_posted) -> Result<(), Failure> {
     let callback = g.callback;
+    // A refusal's text is made only for a caller that reads it.
+    let reason = match &posted {
+        Posted::NotTaken(r) if !out.is_null() => r.reason(g.board.content()),
+        _ => String::new(),
+    };
     drop(g);
     let change = match posted {
         Posted::Taken { change, error } => {
@@ -291,12 +296,12 @@ unsafe fn finish(g: MutexGuard<'_, BoardCell>, posted: Posted, out: *mut situ_po
             }
             change
         }
-        Posted::NotTaken { key, reason } => {
+        Posted::NotTaken(r) => {
             if let Some(out) = out.as_mut() {
                 out.taken = false;
                 out.changed = false;
                 out.cascade = false;
-                out.not_taken = not_taken(key);
+                out.not_taken = not_taken(r.key);
                 write_reason(out, &reason);
             }
             None

@@ -266,14 +266,18 @@ impl Board {
     }
 }
 
-fn outcome(posted: Posted) -> Outcome {
+fn outcome(posted: Posted, content: &situ_api::Content) -> Outcome {
     match posted {
         Posted::Taken { change: c, error } => {
             Outcome { accepted: true, key: None, reason: None, change: c.map(change), error }
         }
-        Posted::NotTaken { key, reason } => {
-            Outcome { accepted: false, key: Some(key.to_string()), reason: Some(reason), change: None, error: None }
-        }
+        Posted::NotTaken(r) => Outcome {
+            accepted: false,
+            key: Some(r.key.to_string()),
+            reason: Some(r.reason(content)),
+            change: None,
+            error: None,
+        },
     }
 }
 
@@ -352,7 +356,11 @@ impl Board {
             (Some(p), None) => Some(p),
             (None, f) => f,
         };
-        let out = outcome(slf.borrow_mut().post_raw(slf.py(), agent_event, at, given)?);
+        let out = {
+            let mut b = slf.borrow_mut();
+            let posted = b.post_raw(slf.py(), agent_event, at, given)?;
+            outcome(posted, b.inner.content())
+        };
         if let Some(c) = &out.change {
             notify(slf, c)?;
         }
@@ -370,7 +378,7 @@ impl Board {
                 item.extract()?;
             let posted = slf.borrow_mut().post_raw(py, name.to_str()?, Some(&at), payload.as_ref())?;
             match posted {
-                Posted::NotTaken { key, .. } => *batch.not_taken.entry(key.to_string()).or_default() += 1,
+                Posted::NotTaken(r) => *batch.not_taken.entry(r.key.to_string()).or_default() += 1,
                 Posted::Taken { change: c, .. } => {
                     batch.accepted += 1;
                     if let Some(c) = c {

@@ -56,9 +56,8 @@ impl NotTaken {
 /// What a taken event did.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Taken {
-    /// The rules fired (a change of the state at rest, or firings that
-    /// came back to the same state).
-    pub change: Option<StateChange>,
+    /// The state at rest changed: [`LocalBoard::last_change`] says how.
+    pub changed: bool,
     /// The rules did not come to rest (a cascade): the board is in the
     /// state where they stopped.
     pub error: Option<PostError>,
@@ -80,8 +79,11 @@ pub struct LocalBoard {
 
 impl LocalBoard {
     pub fn new(content: Arc<Content>) -> LocalBoard {
+        let mut board = Bulletinboard::new(content.clone());
+        // The last change is kept here; the board need keep no history.
+        board.set_history_capacity(0);
         LocalBoard {
-            board: Bulletinboard::new(content.clone()),
+            board,
             org: Organisation::new(content.clone()),
             content,
             now: 0,
@@ -176,20 +178,18 @@ impl LocalBoard {
 
     fn after(&mut self, result: Result<Option<StateChange>, PostError>) -> Taken {
         match result {
-            Ok(Some(change)) => {
-                if change.changed() {
-                    self.org.on_state(change.to);
-                    self.last = Some(change.clone());
-                }
-                Taken { change: Some(change), error: None }
+            Ok(Some(change)) if change.changed() => {
+                self.org.on_state(change.to);
+                self.last = Some(change);
+                Taken { changed: true, error: None }
             }
-            Ok(None) => Taken::default(),
+            Ok(_) => Taken::default(),
             Err(e) => {
                 let state = self.board.state();
                 if self.org.state() != state {
                     self.org.on_state(state);
                 }
-                Taken { change: None, error: Some(e) }
+                Taken { changed: false, error: Some(e) }
             }
         }
     }

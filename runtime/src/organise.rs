@@ -87,11 +87,15 @@ impl Organisation {
 
     fn step_fsms(&mut self, fires: impl Fn(&Trigger) -> bool, only: Option<u32>) -> Vec<FsmMove> {
         let mut moves = Vec::new();
-        for (i, a) in self.content.agents.iter().enumerate() {
-            if only.is_some_and(|o| o as usize != i) {
-                continue;
-            }
-            let Behaviour::Fsm(f) = &a.behaviour else { continue };
+        let agents = &self.content.agents;
+        // One agent's event looks at that agent's FSM only (every event
+        // of a running stack passes here).
+        let range = match only {
+            Some(o) => (o as usize).min(agents.len())..(o as usize + 1).min(agents.len()),
+            None => 0..agents.len(),
+        };
+        for i in range {
+            let Behaviour::Fsm(f) = &agents[i].behaviour else { continue };
             let at = self.fsm[i];
             if let Some(t) = f.transitions.iter().find(|t| t.from == at && fires(&t.trigger)) {
                 self.fsm[i] = t.to;

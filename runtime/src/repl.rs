@@ -228,8 +228,8 @@ impl Session {
         if let Some(e) = taken.error {
             return format!("error: {} (now in {})", e.describe(&self.content), self.state());
         }
-        match taken.change {
-            Some(change) if change.changed() => format!(
+        match self.local.last_change().filter(|_| taken.changed) {
+            Some(change) => format!(
                 "{} -> {} ({})",
                 self.content.states[change.from as usize].name,
                 self.content.states[change.to as usize].name,
