@@ -8,7 +8,8 @@
 //! an event stamped before its agent's latest accepted one is refused (out
 //! of order), one stamped more than the skew bound ahead of the board's
 //! clock is refused (from the future; only with [`Clock::System`]), one of
-//! an agent that sleeps in the current situation is dropped. NaN and the
+//! an agent that sleeps in the current situation is dropped (or taken:
+//! [`Board::set_take_sleeping`]). NaN and the
 //! infinities are accepted and match as §10.3 says. None of these is an
 //! error: [`Board::post`] returns [`Posted::NotTaken`] with the reason,
 //! and the board counts it. An event name, field or value that the rules
@@ -296,6 +297,15 @@ impl Board {
     /// state stays, as on a robot whose run ends there.
     pub fn set_missions(&mut self, on: bool) {
         self.missions = on;
+    }
+
+    /// With `true`, events of agents that sleep in the current situation
+    /// are taken, as a Bulletinboard of a distributed deployment takes
+    /// them from agents that are not situ's (a sensor that reports whatever
+    /// its mode); by default they are dropped and counted (`sleeping`), as
+    /// in a run of situ's agents, where a sleeping agent is not stepped.
+    pub fn set_take_sleeping(&mut self, take: bool) {
+        self.local.set_take_sleeping(take);
     }
 
     /// A new mission: the initial state with no facts, every FSM in its

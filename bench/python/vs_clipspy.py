@@ -12,7 +12,9 @@ own engine reaches. Then, in this one Python process:
   event's fact, expires stale agents and runs the rules to rest, after a
   new mission when the last one ended (`step`, below);
 - **situ** `Board.post` is called once per event (`situ.Board(program,
-  missions=True)`: a final state ends the mission, as in `situ bench`);
+  missions=True, sleeping="take")`: a final state ends the mission and
+  every event is taken whatever its agent's mode, as in `situ bench` and
+  CLIPS);
 - **situ** `Board.post_many` takes the whole stream in one call.
 
 Each engine's state sequence (`INDEX STATE` at every change) must equal
@@ -97,7 +99,7 @@ def run_clips(lines: list[list[str]], states_out: Path) -> dict[str, Any]:
 
 
 def run_post(program: situ.Program, events: list[tuple[str, float, dict[str, situ.Value]]], states_out: Path) -> dict[str, Any]:
-    board = situ.Board(program, missions=True)
+    board = situ.Board(program, missions=True, sleeping="take")
     changes: list[str] = []
     post = board.post
     start = time.perf_counter()
@@ -113,7 +115,7 @@ def run_post(program: situ.Program, events: list[tuple[str, float, dict[str, sit
 def run_post_many(
     program: situ.Program, events: list[tuple[str, float, dict[str, situ.Value]]], states_out: Path
 ) -> dict[str, Any]:
-    board = situ.Board(program, missions=True)
+    board = situ.Board(program, missions=True, sleeping="take")
     start = time.perf_counter()
     batch = board.post_many(events)
     seconds = time.perf_counter() - start

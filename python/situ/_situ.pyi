@@ -185,6 +185,7 @@ class Board:
         max_skew: Optional[_Seconds] = None,
         missions: bool = False,
         trust: Optional[Sequence[Union[str, "os.PathLike[str]"]]] = None,
+        sleeping: str = "drop",
     ) -> None: ...
     def reset(self) -> None: ...
     def post(

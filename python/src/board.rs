@@ -203,16 +203,21 @@ fn arg_of<'a>(event: &str, field: &str, v: &'a Bound<'_, PyAny>) -> Result<Arg<'
 fn nanos(at: Option<&Bound<'_, PyAny>>) -> Result<Option<u64>, BoardError> {
     let Some(at) = at.filter(|a| !a.is_none()) else { return Ok(None) };
     let bad = |what: String| BoardError::BadTime(what);
-    if at.is_instance_of::<PyBool>() {
+    // A float first: the common case, and a failed integer extraction
+    // would cost an exception.
+    let seconds = if let Ok(f) = at.cast::<PyFloat>() {
+        f.value()
+    } else if at.is_instance_of::<PyBool>() {
         return Err(bad("a boolean".into()));
-    }
-    if let Ok(i) = at.extract::<i64>() {
+    } else if at.is_instance_of::<PyInt>() {
+        let i: i64 = at.extract().map_err(|_| bad("an integer out of range".into()))?;
         return u64::try_from(i).ok().and_then(|s| s.checked_mul(1_000_000_000)).map(Some).ok_or(bad(format!("{i} s")));
-    }
-    let s: f64 = at.extract().map_err(|_| bad("a value that is not a number".into()))?;
-    let ns = (s * NS).round();
+    } else {
+        return Err(bad("a value that is not a number".into()));
+    };
+    let ns = (seconds * NS).round();
     if !(ns.is_finite() && ns >= 0.0 && ns < u64::MAX as f64) {
-        return Err(bad(format!("{s} s")));
+        return Err(bad(format!("{seconds} s")));
     }
     Ok(Some(ns as u64))
 }
@@ -300,7 +305,7 @@ impl Board {
     /// what the caller stamps) or the system's (`"system"`: UNIX time;
     /// events from the future are refused).
     #[new]
-    #[pyo3(signature = (rules, clock = "manual", max_skew = None, missions = false, trust = None))]
+    #[pyo3(signature = (rules, clock = "manual", max_skew = None, missions = false, trust = None, sleeping = "drop"))]
     fn new(
         py: Python<'_>,
         rules: &Bound<'_, PyAny>,
@@ -308,7 +313,16 @@ impl Board {
         max_skew: Option<&Bound<'_, PyAny>>,
         missions: bool,
         trust: Option<&Bound<'_, PyAny>>,
+        sleeping: &str,
     ) -> PyResult<Board> {
+        let take_sleeping = match sleeping {
+            "drop" => false,
+            "take" => true,
+            other => {
+                let msg = format!("a sleeping agent's events are \"drop\" or \"take\", not {other:?}");
+                return Err(raise(py, "Error", msg, "sleeping", None));
+            }
+        };
         let clock = match clock {
             "manual" => Clock::Manual,
             "system" => Clock::System,
@@ -330,6 +344,7 @@ impl Board {
         let program = program.get();
         let mut inner = situ_api::Board::new(program.content.clone(), clock);
         inner.set_missions(missions);
+        inner.set_take_sleeping(take_sleeping);
         if let Some(ns) = nanos(max_skew).map_err(|e| from_board(py, e))? {
             inner.set_max_skew(ns);
         }

@@ -210,3 +210,12 @@ def test_a_board_runs_a_program_a_bundle_bytes_a_path_or_a_source(picker_text: s
         situ.Board(42)  # type: ignore[arg-type]
     with pytest.raises(situ.TrustError):
         situ.Board(picker_text, trust=[str(tmp_path / "k.pub")])
+
+
+def test_a_board_whose_agents_are_not_situs_takes_a_sleeping_agents_events(picker: situ.Program) -> None:
+    b = situ.Board(picker, sleeping="take")
+    b.post("BATT", at=0.2, charge=10.0)
+    assert b.state == "CHARGING"
+    assert b.post("PICKED", at=0.3).accepted
+    with pytest.raises(situ.Error):
+        situ.Board(picker, sleeping="snooze")

@@ -7,7 +7,8 @@
 //! reports on the agents' behalf (language reference §10.4, §10.7):
 //! - an event of an agent that sleeps in the current situation is
 //!   **dropped** ([`NotTaken::Sleeping`]): a sleeping agent is not
-//!   stepped, so a run never reports it;
+//!   stepped, so a run of situ's agents never reports it (a caller whose
+//!   agents are not situ's takes them: [`LocalBoard::set_take_sleeping`]);
 //! - an event the engine's acceptance rule refuses (payload, out of
 //!   order, from the future: [`Engine::admit`](crate::rete::Engine::admit))
 //!   is **refused** ([`NotTaken::Refused`]).
@@ -75,6 +76,10 @@ pub struct LocalBoard {
     /// stamped more than the skew bound ahead of it is from the future.
     clock: Option<u64>,
     last: Option<StateChange>,
+    /// Takes a sleeping agent's events, as a Bulletinboard whose agents are
+    /// elsewhere (not situ's: a sensor that reports whatever its mode)
+    /// does; by default they are dropped, as in a run of situ's agents.
+    take_sleeping: bool,
 }
 
 impl LocalBoard {
@@ -89,7 +94,15 @@ impl LocalBoard {
             now: 0,
             clock: None,
             last: None,
+            take_sleeping: false,
         }
+    }
+
+    /// With `true`, a sleeping agent's events are taken (the agents are not
+    /// situ's and report whatever their mode, as a Bulletinboard of a
+    /// distributed deployment takes them); by default they are dropped.
+    pub fn set_take_sleeping(&mut self, take: bool) {
+        self.take_sleeping = take;
     }
 
     pub fn content(&self) -> &Arc<Content> {
@@ -140,7 +153,7 @@ impl LocalBoard {
         let Some(def) = self.content.events.get(event as usize) else {
             return Some(NotTaken::Refused(PostError::UnknownEvent { event }));
         };
-        if self.org.mode(def.agent) == Mode::Sleeping {
+        if !self.take_sleeping && self.org.mode(def.agent) == Mode::Sleeping {
             return Some(NotTaken::Sleeping { agent: def.agent, event });
         }
         if let Some(clock) = self.clock {
