@@ -45,24 +45,15 @@ fn load(text: &str) -> Option<(Arc<bundle::Content>, Vec<PropertySpec>)> {
     (checked.errors() == 0).then(|| (Arc::new(bundle::build(&checked)), spec::lower(&checked).properties))
 }
 
-/// `situ test`'s default budgets for the exploration and its deepening,
-/// without IC3 and the random search (which do not change the exhaustive
-/// verdict): the exploration's verdict as `situ test` reports it.
+/// `situ test`'s default budgets (without the random search, which does
+/// not change the exhaustive verdict): the exhaustive verdict of each
+/// property as `situ test` reports it.
 fn exhaustive_verdicts(path: &Path) -> Vec<(String, Verdict)> {
     let (content, props) = load_file(path);
     let refs: Vec<&PropertySpec> = props.iter().collect();
-    let d = property::DEFAULT_OPTIONS;
-    let graph = Graph::build(&content, &refs, d.limits);
-    let alphabet = Arc::new(Alphabet::new(&content, &refs));
-    let model = Model::build(&content, &alphabet, &refs).expect("a circuit");
-    let budget = ic3::Limits { frames: d.limits.depth, work: d.effort / bmc::SHARE, deadline: None };
-    refs.iter()
-        .enumerate()
-        .map(|(i, p)| {
-            let v = bmc::deepen(&content, &alphabet, Some(&model), i, p, graph.check(i, p), budget);
-            (p.name.clone(), v)
-        })
-        .collect()
+    let opts = Options { engines: Engines::Exhaustive, ..property::DEFAULT_OPTIONS };
+    let (_, reports) = property::check_all(&content, &refs, &opts);
+    refs.iter().zip(reports).map(|(p, r)| (p.name.clone(), r.exhaustive.expect("explored"))).collect()
 }
 
 #[test]
@@ -293,4 +284,42 @@ fn a_counterexample_deeper_than_the_exploration_replays_and_is_shrunk() {
         other => panic!("{other:?}"),
     }
     assert!(reports[0].symbolic.is_none(), "IC3 is not needed once the search broke it");
+}
+
+/// Ten agents of two events each, every one read by a rule: the exploration
+/// alone runs out of states after 2 or 3 events.
+fn wide() -> String {
+    let mut s = String::from("states { Idle initial Busy Rest final Done final }\n");
+    for k in 0..10 {
+        s.push_str(&format!("agent A{k} sensor {{ event P{k} {{ v: f64 }} event Q{k} }}\n"));
+        s.push_str(&format!("rule up{k} salience {} {{ when state == Idle and P{k}(v > 1.0) then Busy }}\n", 2 * k));
+        s.push_str(&format!("rule down{k} salience {} {{ when state == Busy and Q{k} then Rest }}\n", 2 * k + 1));
+    }
+    s.push_str("rule end salience 30 { when state == Busy and P0(v > 1.0) and Q9 and P5(v > 1.0) then Done }\n");
+    s.push_str(
+        "property \"busy ends at rest or done\" { always (state == Busy -> next state in {Busy, Rest, Done}) }\n",
+    );
+    s.push_str("property \"done stays done\" { always (state == Done -> next state == Done) }\n");
+    s
+}
+
+#[test]
+fn a_wide_file_is_reported_to_the_depth_asked_for() {
+    let (content, props) = load(&wide()).expect("the wide file");
+    let refs: Vec<&PropertySpec> = props.iter().collect();
+    let opts = Options { engines: Engines::Exhaustive, ..property::DEFAULT_OPTIONS };
+    let (session, reports) = property::check_all(&content, &refs, &opts);
+    let explored = session.graph.as_ref().map_or(0, |g| g.complete_depth);
+    assert!(explored < 8, "the exploration alone reaches {explored} events");
+    for r in &reports {
+        match &r.exhaustive {
+            Some(Verdict::Bounded { depth, note, .. }) => {
+                assert_eq!(*depth, opts.limits.depth, "{note}");
+                assert!(note.contains("with any gaps"), "{note}");
+            }
+            other => panic!("{other:?}"),
+        }
+        // Deeper is still not a proof: IC3 proves these, and says so.
+        assert!(matches!(r.conclusion, Conclusion::Proved { by: Checker::Symbolic, .. }), "{:?}", r.conclusion);
+    }
 }
