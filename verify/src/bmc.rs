@@ -34,6 +34,14 @@
 //!
 //! The budget is work, not time: SAT propagations, checked between depths,
 //! so that the same file and options reach the same depth on any machine.
+//!
+//! **Why not fewer interleavings.** Sleep sets (trying two commuting events
+//! in one order only) keep every reachable abstract state, so they do not
+//! lower the count that the state budget bounds; persistent sets would,
+//! but where every event can move the state (which every property reads),
+//! few events are invisible, and a bounded claim after such a reduction
+//! needs runs permuted and lengthened, which is harder to make honest than
+//! one SAT query per depth.
 
 use super::abstraction::Alphabet;
 use super::aig::{Aig, Lit};
