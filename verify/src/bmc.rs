@@ -3,7 +3,7 @@
 //! influence.
 //!
 //! The exploration ([`explore`](super::explore)) posts every letter after
-//! every gap at every node: on a file as wide as a drone's (10 agents, 36
+//! every gap at every node: on a file as wide as a drone's (11 agents, 31
 //! letters, 5 gaps) its state budget runs out after 2 or 3 events, because
 //! the abstract states of independent agents multiply. A SAT solver does not
 //! enumerate them: the circuit is unrolled one copy per event, and the
