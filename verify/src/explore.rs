@@ -20,6 +20,9 @@
 //! abstraction samples something (time gaps, linked values: it says which);
 //! otherwise **bounded**: no counterexample among the runs that stay within
 //! the nodes expanded (every run of up to `depth` events, at least).
+//!
+//! A bounded answer short of the depth asked for is made deeper by the
+//! caller on the circuit ([`bmc::deepen`](super::bmc::deepen)).
 
 use super::abstraction::Alphabet;
 use super::monitor::{Monitor, MonitorState};

@@ -11,6 +11,8 @@
 //! - [`explore`] explores a finite abstraction of the system breadth first
 //!   ([`abstraction`]): it proves a property, or finds its shortest
 //!   counterexample, or says up to which depth it found none.
+//! - [`bmc`] unrolls the circuit of [`model`] where the exploration stopped
+//!   short (a wide file), so that its bound reaches `--depth` events.
 //!
 //! [`property`] runs them on each property and concludes: proved, violated
 //! or undecided; [`suite`] is `situ test` as one call: the tests and the
@@ -23,6 +25,7 @@
 
 pub mod abstraction;
 pub mod aig;
+pub mod bmc;
 pub mod explore;
 pub mod findings;
 pub mod ic3;

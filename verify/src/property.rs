@@ -24,6 +24,7 @@
 //! reaches makes the property **vacuous** (W0501): true, but of nothing.
 
 use super::abstraction::Alphabet;
+use super::bmc;
 use super::explore::{Graph, Limits};
 use super::ic3;
 use super::liveness;
@@ -219,6 +220,14 @@ pub fn check_all(content: &Arc<Content>, props: &[&PropertySpec], opts: &Options
     (session, reports)
 }
 
+/// The exploration's verdict, deepened on the circuit ([`bmc::deepen`]) to
+/// `--depth` events on a share of IC3's budget ([`bmc::SHARE`]).
+fn deeper(content: &Arc<Content>, s: &Session, i: usize, p: &PropertySpec, v: Verdict, opts: &Options) -> Verdict {
+    let model = s.model.as_ref().and_then(|m| m.as_ref().ok());
+    let budget = ic3::Limits { frames: opts.limits.depth, work: opts.effort / bmc::SHARE, ..limits(opts) };
+    bmc::deepen(content, &s.alphabet, model, i, p, v, budget)
+}
+
 fn limits(opts: &Options) -> ic3::Limits {
     ic3::Limits { frames: prove::MAX_FRAMES, work: opts.effort, deadline: opts.timeout.map(|t| Instant::now() + t) }
 }
@@ -227,7 +236,7 @@ fn limits(opts: &Options) -> ic3::Limits {
 fn check_one(content: &Arc<Content>, s: &Session, i: usize, p: &PropertySpec, opts: &Options) -> Report {
     let monitor = Monitor::new(p);
     let liveness = monitor.is_liveness() && !monitor.never;
-    let exhaustive = s.graph.as_ref().map(|g| g.check(i, p));
+    let exhaustive = s.graph.as_ref().map(|g| deeper(content, s, i, p, g.check(i, p), opts));
     let settled = exhaustive.as_ref().is_some_and(|v| v.failed() || matches!(v, Verdict::Proved { .. }));
     let mut ic3_time = None;
     let (symbolic, symbolic_note) = match &s.model {
@@ -295,8 +304,11 @@ fn conclude(r: &Report, liveness: bool) -> Conclusion {
     if let Some(c) = failed(&r.random) {
         return Conclusion::Violated { by: Checker::Random, how: "shrunk", counterexample: c };
     }
-    if let Some(Verdict::Disagree { events }) = r.symbolic {
-        return Conclusion::Disagree { events };
+    // The circuit's run does not replay (IC3's, or the deepened exploration's).
+    if let Some(Verdict::Disagree { events }) =
+        [&r.symbolic, &r.exhaustive].into_iter().flatten().find(|v| matches!(v, Verdict::Disagree { .. }))
+    {
+        return Conclusion::Disagree { events: *events };
     }
     if let Some(v @ Verdict::Proved { .. }) = &r.exhaustive {
         return Conclusion::Proved { by: Checker::Exhaustive, what: v.summary() };
@@ -331,7 +343,7 @@ fn conclude(r: &Report, liveness: bool) -> Conclusion {
 /// Whether the premise of a property can hold: `never P` checked by the
 /// exploration, then by the random search, then by IC3.
 fn premise(content: &Arc<Content>, s: &Session, j: usize, never_p: &PropertySpec, opts: &Options) -> Premise {
-    let exhaustive = s.graph.as_ref().map(|g| g.check(j, never_p));
+    let exhaustive = s.graph.as_ref().map(|g| deeper(content, s, j, never_p, g.check(j, never_p), opts));
     match &exhaustive {
         Some(Verdict::Failed(c)) => return Premise::Reachable(c.clone()),
         Some(Verdict::Proved { .. }) => return Premise::Vacuous { by: Checker::Exhaustive },
