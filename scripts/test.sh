@@ -30,6 +30,8 @@ echo "== the Python package: pip install ./python (maturin; the dev profile, who
 MATURIN_PEP517_ARGS="--profile dev" python3 -m pip install --quiet --disable-pip-version-check --force-reinstall ./python
 (cd python && python3 -m mypy --strict situ tests ../examples/python/board_node.py)
 SITU=target/debug/situ python3 -m pytest -q -p no:cacheprovider python/tests
+echo "== the Python package and clipspy reach situ bench's states (bench/python/vs_clipspy.py; the speeds: docs/performance.md, release)"
+python3 bench/python/vs_clipspy.py --situ target/debug/situ --events 20000
 
 echo "== the fuzz targets, 5 s each, from their committed corpora (scripts/fuzz.sh; cargo-fuzz on stable)"
 bash scripts/fuzz.sh 5

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import pytest
 
+import situ
+
 from test_report import VIOLATED, ladder
 
 MOWER_TEST = 'test "low battery sends it home" {'
@@ -91,3 +93,18 @@ def test_rules_with_errors_are_one_failing_item(pytester: pytest.Pytester) -> No
     r = pytester.runpytest()
     r.assert_outcomes(failed=1)
     r.stdout.fnmatch_lines(["*E0104*NOPE*"])
+
+
+def test_the_drones_blocks_are_collected_with_their_lines(pytester: pytest.Pytester) -> None:
+    from conftest import ROOT
+
+    drone = (ROOT / "tests" / "explore" / "inspection-drone.situ").read_text()
+    mower = (ROOT / "examples" / "mower" / "mower.situ").read_text()
+    pytester.makefile(".situ", drone=drone, mower=mower)
+    r = pytester.runpytest("--collect-only", "-q")
+    names = [line for line in r.outlines if "::" in line]
+    expected = [b for b in situ._situ.blocks(str(pytester.path / "drone.situ"))]
+    assert len(expected) >= 5
+    for kind, name, _, _ in expected:
+        assert f"drone.situ::{name}" in names, (kind, name, names)
+    assert "mower.situ::low battery sends it home" in names
