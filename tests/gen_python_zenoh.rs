@@ -26,9 +26,19 @@ const AGENTS: [&str; 2] = ["Mission", "Flight"];
 /// until the final state (`--deploy D [--process P]` on the command line).
 const USER: &str = r#"
 import sys
+import threading
 
 import flight_agent as flight
 import mission_agent as mission
+
+lock = threading.Lock()
+
+
+def say(line: str) -> None:
+    """One whole line at a time: the agents run in threads of their own."""
+    with lock:
+        sys.stdout.write(line + "\n")
+        sys.stdout.flush()
 
 
 class Planner(mission.Handlers):
@@ -36,17 +46,17 @@ class Planner(mission.Handlers):
         self.ready = self.flying = self.done = False
 
     def on_status(self, state: str, seq: int) -> None:
-        print(f"Mission status {state} {seq}", flush=True)
+        say(f"Mission status {state} {seq}")
         self.flying = self.flying or state == "FLYING"
 
     def on_safe_mode(self, entered: bool) -> None:
-        print(f"Mission safe mode {entered}", flush=True)
+        say(f"Mission safe mode {entered}")
 
     def without_function(self, step: mission.Step) -> None:
         if not self.ready:
             self.ready = True
             step.report(mission.mpready(waypoints=4))
-            print(f"Mission reported MPREADY, safe mode {step.safe_mode}", flush=True)
+            say(f"Mission reported MPREADY, safe mode {step.safe_mode}")
         if self.flying and not self.done:
             self.done = True
             step.report(mission.mpdone())
@@ -56,16 +66,16 @@ class Controller(flight.Handlers):
     armed = False
 
     def on_status(self, state: str, seq: int) -> None:
-        print(f"Flight status {state} {seq}", flush=True)
+        say(f"Flight status {state} {seq}")
 
     def on_safe_mode(self, entered: bool) -> None:
-        print(f"Flight safe mode {entered}", flush=True)
+        say(f"Flight safe mode {entered}")
 
     def hold(self, step: flight.Step) -> None:
         if not self.armed:
             self.armed = True
             step.report(flight.fcarmed(armed=True))
-            print(f"Flight reported FCARMED, safe mode {step.safe_mode}", flush=True)
+            say(f"Flight reported FCARMED, safe mode {step.safe_mode}")
 
     def fly(self, step: flight.Step) -> None:
         pass
@@ -73,7 +83,7 @@ class Controller(flight.Handlers):
 
 runners = mission.run_all([Planner(), Controller()], duration=40.0)
 for r in runners:
-    print(f"{r.agent}: finished {r.finished}, seen {r.states_seen}, {r.counters}", flush=True)
+    say(f"{r.agent}: finished {r.finished}, seen {r.states_seen}, {r.counters}")
 sys.exit(0 if all(r.finished for r in runners) else 1)
 "#;
 
@@ -135,6 +145,9 @@ impl Watched {
 
     /// Waits (at most 40 s) for a line that contains `what`.
     fn wait_for(&mut self, what: &str) {
+        if self.seen.iter().any(|l| l.contains(what)) {
+            return;
+        }
         while let Ok(line) = self.lines.recv_timeout(Duration::from_secs(40)) {
             self.seen.push(line);
             if self.seen.last().is_some_and(|l| l.contains(what)) {
@@ -178,15 +191,17 @@ fn check(board: (bool, String), python: (bool, String)) {
     let all = format!("--- board\n{board_out}\n--- python\n{python_out}");
     assert!(!python_out.contains("No module named"), "pip install -r examples/python/requirements.txt\n{all}");
     assert!(board_ok && python_ok, "{all}");
-    for state in ["PLANNED", "FLYING", "DONE"] {
+    // PLANNED may be passed through, not at rest: both events came at once.
+    for state in ["FLYING", "DONE"] {
         assert!(board_out.contains(&format!("board: state {state}")), "{state}\n{all}");
     }
     for agent in AGENTS {
         // Safe mode from the start, left with the first status, which
-        // on_status gets (the initial state, that no change announces).
+        // on_status gets (GROUND, the initial state that no change
+        // announces, or a later one if the other agent's event came first).
         let first = |what: &str| python_out.find(&format!("{agent} {what}"));
-        let (safe, status, left) = (first("safe mode True"), first("status GROUND"), first("safe mode False"));
-        assert!(safe.is_some() && safe < status && status.is_some() && left.is_some(), "{agent}\n{all}");
+        let (safe, status, left) = (first("safe mode True"), first("status "), first("safe mode False"));
+        assert!(safe.is_some() && safe < status && status < left, "{agent}\n{all}");
         assert!(python_out.contains(&format!("{agent}: finished True")), "{agent}\n{all}");
         assert!(python_out.contains(&format!("{agent} status DONE")), "{agent}\n{all}");
     }

@@ -178,7 +178,7 @@ class Runner:
         self._heard = False
         self._last_status = _time.monotonic()
         self._statuses: list[tuple[str, int, bool]] = []
-        self._safe_told: bool | None = None
+        self._safe_told: bool | None = None  # what on_safe_mode was told
         self._held: _deque[tuple[Event, bool]] = _deque()
         self._inputs: list[Datum] = []
         self._outputs: list[tuple[str | None, Json, bool]] = []
@@ -365,6 +365,11 @@ class Runner:
         (`on_board_restart`, `on_status` for every new status, `on_safe_mode`
         on entering and leaving safe mode), then sends the held events once
         the Bulletinboard is there."""
+        if self._safe_told is None:
+            # The runner starts in safe mode, whether or not a status came
+            # before this first call.
+            self._safe_told = True
+            self.handlers.on_safe_mode(True)
         with self._lock:
             statuses, self._statuses = self._statuses, []
             safe = self.safe_mode()
