@@ -420,7 +420,10 @@ connect = ["tcp/127.0.0.1:7447"]
             (GOOD.replace("agents = [", "agent = ["), "unknown field `agent`"),
             (format!("{GOOD}\n[tls]\nca = \"ca.pem\"\n"), "use `tls/` endpoints"),
             (GOOD.replace("robot = \"amr\"", "robot = \"amr\"\nmax_skew_ms = 3600000"), "at most 10000"),
-            (format!("{GOOD}[[process]]\nname = \"x\"\nexternal = true\n"), "process `x`: `external = true` but it runs no agents"),
+            (
+                format!("{GOOD}[[process]]\nname = \"x\"\nexternal = true\n"),
+                "process `x`: `external = true` but it runs no agents",
+            ),
         ];
         for (text, want) in cases {
             let e = Deployment::parse(&text, &agents()).unwrap_err().to_string();
