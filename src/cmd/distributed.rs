@@ -317,11 +317,15 @@ fn open_deployment_warning(deploy: &Path, robot: &str) -> String {
     )
 }
 
+/// What `situ up` starts (each process's name, and whether it only routes)
+/// and what it leaves to others (the external processes, as said).
+type Started = (Vec<(String, bool)>, Vec<String>);
+
 /// The processes of the deployment that `situ up` starts on this host (not
 /// `external`), each with whether it only routes; and what the external
 /// ones are, to say that they are expected to join.
 #[cfg(feature = "zenoh")]
-fn local_processes(deploy: &Path, agents: &[String]) -> Result<(Vec<(String, bool)>, Vec<String>), String> {
+fn local_processes(deploy: &Path, agents: &[String]) -> Result<Started, String> {
     let d = situ_bus_zenoh::deploy::Deployment::load(deploy, agents).map_err(|e| e.to_string())?;
     let started = d.processes.iter().filter(|p| p.is_local() && !p.external);
     let external = d.processes.iter().filter(|p| p.external).map(|p| {
@@ -332,7 +336,7 @@ fn local_processes(deploy: &Path, agents: &[String]) -> Result<(Vec<(String, boo
 }
 
 #[cfg(not(feature = "zenoh"))]
-fn local_processes(_deploy: &Path, _agents: &[String]) -> Result<(Vec<(String, bool)>, Vec<String>), String> {
+fn local_processes(_deploy: &Path, _agents: &[String]) -> Result<Started, String> {
     Err(NO_ZENOH.into())
 }
 
