@@ -17,6 +17,7 @@ const FILES: &[(&str, &[&str])] = &[
     ("examples/fig5/fig5.situ", &["RFCCD", "LADAR", "Fusion", "LPL", "Drive"]),
     ("examples/mower/mower.situ", &["Bumper", "Rain", "Battery", "GPS", "Blades", "Drive"]),
     ("tests/gen/robot.situ", &["Sonar", "Planner", "Motor", "Operator"]),
+    ("tests/gen/launch.situ", &["Mission", "Flight"]),
 ];
 
 fn root() -> PathBuf {
@@ -227,6 +228,90 @@ print("python logic ok")
     let o = python(&["check.py"], tmp.path());
     assert!(o.status.success(), "{}", text(&o));
     assert!(stdout(&o).contains("python logic ok"), "{}", text(&o));
+}
+
+/// The running cycle's behaviour without a network (a session that records,
+/// statuses fed by hand), as the Rust agent runtime behaves and as issue 30
+/// asked: safe mode from the start until the first status, with the reports
+/// of that time held and sent in order once the Bulletinboard is there (the
+/// oldest dropped and counted past `HELD_CAPACITY`); `on_status` for every
+/// new status, the first included; the safe-mode and restart hooks; the end
+/// at a final state.
+#[test]
+fn the_python_runner_holds_events_until_the_board_and_ends_at_a_final_state() {
+    let tmp = tempfile::tempdir().unwrap();
+    for agent in ["Mission", "Flight"] {
+        let o = situ_at_root(&["gen", "agent", agent, "tests/gen/launch.situ", "--lang", "python", "-o", "-"]);
+        assert_eq!(code(&o), 0, "{}", text(&o));
+        std::fs::write(tmp.path().join(format!("{}_agent.py", agent.to_lowercase())), stdout(&o)).unwrap();
+    }
+    let script = r#"
+import json, time
+import mission_agent as mission, flight_agent as flight
+
+class Payload:
+    def __init__(self, text): self.text = text
+    def to_string(self): return self.text
+
+class Sample:
+    def __init__(self, obj): self.payload = Payload(json.dumps(obj))
+
+class Session:
+    def __init__(self): self.puts = []
+    def declare_subscriber(self, key, callback): return key
+    def put(self, key, value): self.puts.append((key, json.loads(value)))
+
+def status(runner, state, seq):
+    runner._on_status(Sample({"v": 1, "state": state, "time_ns": time.time_ns(), "seq": seq}))
+
+log = []
+class Fc(flight.Handlers):
+    def on_status(self, state, seq): log.append(("status", state, seq))
+    def on_safe_mode(self, entered): log.append(("safe", entered))
+    def on_board_restart(self): log.append(("restart",))
+    def hold(self, step):
+        log.append(("hold", step.mode.value, step.safe_mode))
+        step.report(flight.fcarmed(True))
+    def fly(self, step): log.append(("fly", step.mode.value))
+
+s = Session()
+r = flight.Runner(Fc(), s, "t")
+# Safe mode from the start: waiting, the report held, nothing on the wire.
+assert r.safe_mode() and r.step_once()
+assert log == [("safe", True), ("hold", "waiting", True)], log
+assert s.puts == [] and r.counters["held"] == 1 and r.held() == 1, (s.puts, r.counters)
+# The first status, whose state is the initial one: on_status, safe mode
+# ends, the held event goes out.
+status(r, "GROUND", 1); r.follow()
+assert log[2:] == [("status", "GROUND", 1), ("safe", False)], log
+assert [(k, m["event"]) for k, m in s.puts] == [("situ/t/event/Flight", "FCARMED")], s.puts
+assert r.held() == 0
+# A repetition is not a new status; a change is.
+status(r, "GROUND", 1); status(r, "PLANNED", 2); r.follow()
+assert log[4:] == [("status", "PLANNED", 2)], log
+# A restarted board: seq goes back.
+status(r, "GROUND", 1); r.follow()
+assert log[5:] == [("restart",), ("status", "GROUND", 1)], log
+assert r.counters["restarts"] == 1
+# Silence: safe mode again, and reports are held again, in order.
+r._last_status -= 1.0; r.follow()
+assert log[7:] == [("safe", True)], log
+n = len(s.puts)
+for _ in range(flight.HELD_CAPACITY + 3):
+    r.report(flight.fcarmed(False))
+assert len(s.puts) == n and r.counters["held_dropped"] == 3 and r.held() == flight.HELD_CAPACITY
+status(r, "FLYING", 2); r.follow()
+assert len(s.puts) == n + flight.HELD_CAPACITY and r.held() == 0
+assert not r.finished
+status(r, "DONE", 3); r.follow()
+assert r.finished and r.states_seen == ["GROUND", "PLANNED", "GROUND", "FLYING", "DONE"], r.states_seen
+r.loop(duration=5.0)  # returns at once: a final state
+print("python runtime ok")
+"#;
+    std::fs::write(tmp.path().join("logic.py"), script).unwrap();
+    let o = python(&["logic.py"], tmp.path());
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(stdout(&o).contains("python runtime ok"), "{}", text(&o));
 }
 
 #[test]

@@ -22,6 +22,7 @@
 //! agents = ["RFCCD", "LADAR"]
 //! connect = ["tcp/127.0.0.1:7447"]
 //! # mode = "peer"                    # or "client" (through a router), "router"
+//! # external = true                  # started by someone else: `situ up` leaves it out
 //! ```
 //!
 //! Peers by default, multicast scouting off, explicit endpoints only. A
@@ -120,6 +121,11 @@ pub struct Process {
     /// or this host's name.
     #[serde(default)]
     pub host: Option<String>,
+    /// Started by someone else (a generated Python agent, a node of the
+    /// robot's own): `situ up` does not start it, and says it expects it to
+    /// join.
+    #[serde(default)]
+    pub external: bool,
 }
 
 impl Process {
@@ -233,6 +239,12 @@ impl Deployment {
             }
             if d.tls.is_some() && (p.cert.is_none() || p.key.is_none()) {
                 return Err(DeployError(format!("process `{}` needs `cert` and `key` with `[tls]`", p.name)));
+            }
+            if p.external && p.agents.is_empty() && !p.board {
+                return Err(DeployError(format!(
+                    "process `{}`: `external = true` but it runs no agents and hosts no Bulletinboard: nothing would join",
+                    p.name
+                )));
             }
             if p.mode == Mode::Client && p.connect.is_empty() {
                 return Err(DeployError(format!(
@@ -408,6 +420,10 @@ connect = ["tcp/127.0.0.1:7447"]
             (GOOD.replace("agents = [", "agent = ["), "unknown field `agent`"),
             (format!("{GOOD}\n[tls]\nca = \"ca.pem\"\n"), "use `tls/` endpoints"),
             (GOOD.replace("robot = \"amr\"", "robot = \"amr\"\nmax_skew_ms = 3600000"), "at most 10000"),
+            (
+                format!("{GOOD}[[process]]\nname = \"x\"\nexternal = true\n"),
+                "process `x`: `external = true` but it runs no agents",
+            ),
         ];
         for (text, want) in cases {
             let e = Deployment::parse(&text, &agents()).unwrap_err().to_string();

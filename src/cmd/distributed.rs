@@ -317,16 +317,26 @@ fn open_deployment_warning(deploy: &Path, robot: &str) -> String {
     )
 }
 
-/// The processes of the deployment that run on this host, each with
-/// whether it only routes.
+/// What `situ up` starts (each process's name, and whether it only routes)
+/// and what it leaves to others (the external processes, as said).
+type Started = (Vec<(String, bool)>, Vec<String>);
+
+/// The processes of the deployment that `situ up` starts on this host (not
+/// `external`), each with whether it only routes; and what the external
+/// ones are, to say that they are expected to join.
 #[cfg(feature = "zenoh")]
-fn local_processes(deploy: &Path, agents: &[String]) -> Result<Vec<(String, bool)>, String> {
+fn local_processes(deploy: &Path, agents: &[String]) -> Result<Started, String> {
     let d = situ_bus_zenoh::deploy::Deployment::load(deploy, agents).map_err(|e| e.to_string())?;
-    Ok(d.processes.iter().filter(|p| p.is_local()).map(|p| (p.name.clone(), p.routes_only())).collect())
+    let started = d.processes.iter().filter(|p| p.is_local() && !p.external);
+    let external = d.processes.iter().filter(|p| p.external).map(|p| {
+        let what = if p.board { "the Bulletinboard".to_string() } else { p.agents.join(", ") };
+        format!("`{}` ({what})", p.name)
+    });
+    Ok((started.map(|p| (p.name.clone(), p.routes_only())).collect(), external.collect()))
 }
 
 #[cfg(not(feature = "zenoh"))]
-fn local_processes(_deploy: &Path, _agents: &[String]) -> Result<Vec<(String, bool)>, String> {
+fn local_processes(_deploy: &Path, _agents: &[String]) -> Result<Started, String> {
     Err(NO_ZENOH.into())
 }
 
@@ -361,13 +371,16 @@ pub fn up(args: &UpArgs) -> u8 {
         Err(code) => return code,
     };
     let names: Vec<String> = program.content.agents.iter().map(|a| a.name.clone()).collect();
-    let processes = match local_processes(deploy, &names) {
+    let (processes, external) = match local_processes(deploy, &names) {
         Ok(p) => p,
         Err(e) => {
             eprintln!("error: {e}");
             return USAGE;
         }
     };
+    if !external.is_empty() {
+        eprintln!("up: not started here (external), expected to join: {}", external.join(", "));
+    }
     let stop = stop_flag();
     let exe = match std::env::current_exe() {
         Ok(e) => e,

@@ -4,11 +4,14 @@
 //! The module holds the agent's data (states, table or FSM, the links out of
 //! it per state, the FSMs of the readers whose FSM state decides a link),
 //! an enum per symbol field, a function per event, a `Handlers` class with a
-//! method per function, and a run loop (`Runner`, `run`) that follows the
-//! Bulletinboard's status as the Rust runtime does (§10.6-10.7): the mode,
-//! function and receivers of the moment, safe mode after 600 ms without a
-//! status, data dropped while asleep, the FSM stepped by status changes and
-//! by the agent's own reports.
+//! method per function, and a run loop (`Runner`, `run`, `run_all` for
+//! several agents in one process) that follows the Bulletinboard's status as
+//! the Rust runtime does (§10.6-10.7): the mode, function and receivers of
+//! the moment, safe mode from the start until the first status and after
+//! 600 ms without one (the events reported then held until a status comes),
+//! data dropped while asleep, the FSM stepped by status changes and by the
+//! agent's own reports, the end at a final state; and the Zenoh session of
+//! a deployment file's process as `bus-zenoh/src/deploy.rs` makes it.
 //!
 //! The output passes `mypy --strict` and is stable under `black` (default
 //! settings): one item per line with trailing commas wherever a line could
@@ -52,12 +55,19 @@ pub(crate) fn generate(content: &Content, me: u32, header: &Header<'_>) -> Strin
     out.push_str(
         "from __future__ import annotations\n\n\
          import enum as _enum\n\
+         import importlib as _importlib\n\
          import json as _json\n\
          import math as _math\n\
+         import os as _os\n\
+         import sys as _sys\n\
          import threading as _threading\n\
          import time as _time\n\
+         from collections import deque as _deque\n\
          from dataclasses import dataclass as _dataclass\n\
+         from typing import Any as _Any\n\
          from typing import Callable as _Callable\n\
+         from typing import Protocol as _Protocol\n\
+         from typing import Sequence as _Sequence\n\
          from typing import TypeAlias as _TypeAlias\n\
          from typing import Union as _Union\n\n\
          import zenoh as _zenoh\n\n",
@@ -70,6 +80,8 @@ pub(crate) fn generate(content: &Content, me: u32, header: &Header<'_>) -> Strin
     let states: Vec<String> = content.states.iter().map(|s| quote(&s.name)).collect();
     out.push_str(&tuple_stmt("STATES: tuple[str, ...] = ", &states, 0, ""));
     let _ = writeln!(out, "INITIAL_STATE = {}", quote(&content.states[content.initial as usize].name));
+    let finals: Vec<String> = content.states.iter().filter(|s| s.is_final).map(|s| quote(&s.name)).collect();
+    out.push_str(&tuple_stmt("FINAL_STATES: tuple[str, ...] = ", &finals, 0, ""));
     match def.rate_hz {
         Some(r) => {
             let _ = writeln!(out, "RATE_HZ: float | None = {}", float(r));
@@ -236,7 +248,11 @@ pub(crate) fn generate(content: &Content, me: u32, header: &Header<'_>) -> Strin
     out.push_str("class Handlers:\n");
     let _ = writeln!(out, "    \"\"\"Your code for {}: override the method of each function.\"\"\"\n", def.name);
     out.push_str("    def on_status(self, state: str, seq: int) -> None:\n");
-    out.push_str("        \"\"\"Called, before the next step, when the state at rest changes.\"\"\"\n\n");
+    out.push_str("        \"\"\"Called for every new status (the first, each change, a restart).\"\"\"\n\n");
+    out.push_str("    def on_safe_mode(self, entered: bool) -> None:\n");
+    out.push_str("        \"\"\"Called on entering safe mode (True: at start) and on leaving it.\"\"\"\n\n");
+    out.push_str("    def on_board_restart(self) -> None:\n");
+    out.push_str("        \"\"\"Called when the Bulletinboard restarted (its `seq` went back).\"\"\"\n\n");
     out.push_str("    def without_function(self, step: Step) -> None:\n");
     out.push_str("        \"\"\"A step with no function (a `wait` without one, or no table or FSM).\"\"\"\n");
     let methods = unique(def.functions.iter().map(|f| ident(snake(&f.name))).collect());
@@ -249,6 +265,9 @@ pub(crate) fn generate(content: &Content, me: u32, header: &Header<'_>) -> Strin
         let _ = writeln!(out, "        \"\"\"{}\"\"\"", docstring_text(&doc));
         let _ = writeln!(out, "        raise NotImplementedError({})", quote(&format!("{}.{}", def.name, f.name)));
     }
+    out.push_str("\n    def _situ_agent(self) -> str:\n        return AGENT\n");
+    out.push_str("\n    def _situ_runner(self, session: _zenoh.Session, robot: str) -> Runner:\n");
+    out.push_str("        return Runner(self, session, robot)\n");
     out.push_str("\n\ndef _dispatch(handlers: Handlers, step: Step) -> None:\n");
     for (i, (f, m)) in def.functions.iter().zip(&methods).enumerate() {
         let kw = if i == 0 { "if" } else { "elif" };
