@@ -247,7 +247,7 @@ pub struct Board {
     local: LocalBoard,
     clock: Clock,
     /// `EVENT` and `AGENT.EVENT` to the event's id.
-    names: HashMap<String, u32>,
+    names: Names,
     counters: Counters,
     /// A final state ends the mission: the next post starts a new one.
     missions: bool,
@@ -337,24 +337,24 @@ impl Board {
     /// An event's payload from values given by field name: every field
     /// once, each of its type (an integer is taken for an `f64` field).
     pub fn payload(&self, event: u32, args: &[(&str, Arg)]) -> Result<Vec<Value>, BoardError> {
-        let def = &self.content().events[event as usize];
-        let mut values: Vec<Option<Value>> = vec![None; def.fields.len()];
+        let mut values = Vec::new();
+        let mut fields = self.fields(event, &mut values);
         for (name, arg) in args {
-            let Some(i) = def.fields.iter().position(|f| f.name == *name) else {
-                let suggestion = suggest(name, def.fields.iter().map(|f| f.name.as_str())).map(str::to_string);
-                return Err(BoardError::UnknownField { event: def.name.clone(), field: name.to_string(), suggestion });
-            };
-            if values[i].is_some() {
-                return Err(BoardError::FieldTwice { event: def.name.clone(), field: name.to_string() });
-            }
-            values[i] = Some(convert(&def.name, &def.fields[i].name, &def.fields[i].ty, arg)?);
+            fields.set(name, *arg)?;
         }
-        let missing: Vec<String> =
-            def.fields.iter().zip(&values).filter(|(_, v)| v.is_none()).map(|(f, _)| f.name.clone()).collect();
-        if !missing.is_empty() {
-            return Err(BoardError::MissingFields { event: def.name.clone(), missing });
-        }
-        Ok(values.into_iter().flatten().collect())
+        fields.finish()?;
+        Ok(values)
+    }
+
+    /// An event's payload built field by field into `into` (cleared
+    /// first, so that a caller reuses one buffer): the bindings' path,
+    /// which gives each value as it reads it. [`Fields::finish`] says
+    /// which fields are missing.
+    pub fn fields<'a>(&'a self, event: u32, into: &'a mut Vec<Value>) -> Fields<'a> {
+        let def = &self.content().events[event as usize];
+        into.clear();
+        into.resize(def.fields.len(), Value::Bool(false));
+        Fields { def, values: into, seen: 0 }
     }
 
     /// An event's payload from values in field order, without names (the
@@ -521,8 +521,63 @@ impl Board {
     }
 }
 
-fn names(c: &Content) -> HashMap<String, u32> {
-    let mut m = HashMap::with_capacity(c.events.len() * 2);
+/// An event's payload being built by field name ([`Board::fields`]).
+pub struct Fields<'a> {
+    def: &'a situ_bundle::EventDef,
+    values: &'a mut Vec<Value>,
+    /// Which fields are given, a bit each.
+    seen: u128,
+}
+
+impl Fields<'_> {
+    /// The bit of field `i` (a bundle has at most 64 fields per event:
+    /// its codec refuses more).
+    fn bit(i: usize) -> u128 {
+        1u128.checked_shl(i as u32).unwrap_or(0)
+    }
+
+    fn given(&self, i: usize) -> bool {
+        self.seen & Self::bit(i) != 0
+    }
+
+    fn mark(&mut self, i: usize) {
+        self.seen |= Self::bit(i);
+    }
+
+    /// The value of the field `name`: a field the event does not have,
+    /// one given twice and a value of the wrong type are errors.
+    pub fn set(&mut self, name: &str, arg: Arg) -> Result<(), BoardError> {
+        let def = self.def;
+        let Some(i) = def.fields.iter().position(|f| f.name == name) else {
+            let suggestion = suggest(name, def.fields.iter().map(|f| f.name.as_str())).map(str::to_string);
+            return Err(BoardError::UnknownField { event: def.name.clone(), field: name.to_string(), suggestion });
+        };
+        if self.given(i) {
+            return Err(BoardError::FieldTwice { event: def.name.clone(), field: name.to_string() });
+        }
+        self.values[i] = convert(&def.name, &def.fields[i].name, &def.fields[i].ty, &arg)?;
+        self.mark(i);
+        Ok(())
+    }
+
+    /// Every field was given, or the missing ones are named.
+    pub fn finish(self) -> Result<(), BoardError> {
+        let n = self.def.fields.len();
+        let missing: Vec<String> =
+            (0..n).filter(|&i| !self.given(i)).map(|i| self.def.fields[i].name.clone()).collect();
+        if missing.is_empty() {
+            Ok(())
+        } else {
+            Err(BoardError::MissingFields { event: self.def.name.clone(), missing })
+        }
+    }
+}
+
+/// Names to ids, hashed fast (the names are the rules', not an attacker's).
+type Names = HashMap<String, u32, foldhash::fast::FixedState>;
+
+fn names(c: &Content) -> Names {
+    let mut m = Names::with_capacity_and_hasher(c.events.len() * 2, foldhash::fast::FixedState::default());
     for (i, e) in c.events.iter().enumerate() {
         m.insert(e.name.clone(), i as u32);
         m.insert(format!("{}.{}", c.agents[e.agent as usize].name, e.name), i as u32);

@@ -26,8 +26,8 @@ mod runs;
 mod suite;
 
 pub use board::{
-    AgentNow, Arg, Board, BoardError, Change, Clock, Counters, Fact, FactNow, FieldValue, Fired, Posted, Refusal,
-    Reloaded, Why,
+    AgentNow, Arg, Board, BoardError, Change, Clock, Counters, Fact, FactNow, FieldValue, Fields, Fired, Posted,
+    Refusal, Reloaded, Why,
 };
 pub use error::Error;
 pub use program::{

@@ -163,3 +163,22 @@ fn a_reload_keeps_the_state_and_the_facts_that_still_fit() {
     assert_eq!(b.state(), "CHARGING");
     assert!(b.event("BATT").is_ok());
 }
+
+#[test]
+fn an_event_of_the_most_fields_is_built_field_by_field() {
+    let fields: Vec<String> = (0..64).map(|i| format!("v{i}: f64")).collect();
+    let text = format!("states {{ A initial }}\nagent X sensor {{ event BIG {{ {} }} }}\n", fields.join(", "));
+    let b = board_of(&text, Clock::Manual);
+    let big = b.event("BIG").unwrap();
+    let names: Vec<String> = (0..64).map(|i| format!("v{i}")).collect();
+    let all: Vec<(&str, Arg)> = names.iter().map(|n| (n.as_str(), Arg::F64(1.0))).collect();
+    assert_eq!(b.payload(big, &all).unwrap().len(), 64);
+    let e = b.payload(big, &all[..63]).unwrap_err();
+    assert!(matches!(&e, BoardError::MissingFields { missing, .. } if missing == &["v63".to_string()]), "{e}");
+    let mut twice = all.clone();
+    twice.push(("v63", Arg::F64(2.0)));
+    assert_eq!(b.payload(big, &twice).unwrap_err().code(), "field-twice");
+    let mut early = all.clone();
+    early.push(("v3", Arg::F64(2.0)));
+    assert_eq!(b.payload(big, &early).unwrap_err().code(), "field-twice");
+}

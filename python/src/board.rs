@@ -173,6 +173,8 @@ pub struct Reloaded {
 pub struct Board {
     inner: situ_api::Board,
     callbacks: Vec<Py<PyAny>>,
+    /// The payload being built, reused from post to post.
+    buf: Vec<situ_bundle::Value>,
 }
 
 /// A field's value as given, borrowed from the Python object.
@@ -251,23 +253,20 @@ impl Board {
     ) -> PyResult<Posted> {
         let id = self.inner.event(event).map_err(|e| from_board(py, e))?;
         let name = &self.inner.content().events[id as usize].name;
-        let items: Vec<(Bound<'_, PyAny>, Bound<'_, PyAny>)> = payload.map(|d| d.iter().collect()).unwrap_or_default();
-        let mut args: Vec<(&str, Arg)> = Vec::with_capacity(items.len());
-        for (k, v) in &items {
-            let Ok(k) = k.cast::<PyString>().map_err(|_| ()).and_then(|k| k.to_str().map_err(|_| ())) else {
-                return Err(raise(
-                    py,
-                    "BoardError",
-                    format!("`{name}`: a field's name is a text"),
-                    "unknown-field",
-                    None,
-                ));
-            };
-            args.push((k, arg_of(name, k, v).map_err(|e| from_board(py, e))?));
+        let mut fields = self.inner.fields(id, &mut self.buf);
+        if let Some(d) = payload {
+            for (k, v) in d.iter() {
+                let Ok(k) = k.cast::<PyString>().map_err(|_| ()).and_then(|k| k.to_str().map_err(|_| ())) else {
+                    let msg = format!("`{name}`: a field's name is a text");
+                    return Err(raise(py, "BoardError", msg, "unknown-field", None));
+                };
+                let arg = arg_of(name, k, &v).map_err(|e| from_board(py, e))?;
+                fields.set(k, arg).map_err(|e| from_board(py, e))?;
+            }
         }
-        let values = self.inner.payload(id, &args).map_err(|e| from_board(py, e))?;
+        fields.finish().map_err(|e| from_board(py, e))?;
         let at = nanos(at).map_err(|e| from_board(py, e))?;
-        self.inner.post(id, at, &values).map_err(|e| from_board(py, e))
+        self.inner.post(id, at, &self.buf).map_err(|e| from_board(py, e))
     }
 }
 
@@ -348,7 +347,7 @@ impl Board {
         if let Some(ns) = nanos(max_skew).map_err(|e| from_board(py, e))? {
             inner.set_max_skew(ns);
         }
-        Ok(Board { inner, callbacks: Vec::new() })
+        Ok(Board { inner, callbacks: Vec::new(), buf: Vec::new() })
     }
 
     /// Posts an event (`"EVENT"` or `"Agent.EVENT"`) stamped `at` seconds
@@ -387,6 +386,8 @@ impl Board {
     fn post_many(slf: &Bound<'_, Self>, events: &Bound<'_, PyAny>) -> PyResult<Batch> {
         let py = slf.py();
         let mut batch = Batch { accepted: 0, not_taken: BTreeMap::new(), changes: Vec::new() };
+        // The board is borrowed for each event only: the iterable and the
+        // callbacks may read it.
         for (index, item) in events.try_iter()?.enumerate() {
             let item = item?;
             let (name, at, payload): (Bound<'_, PyString>, Bound<'_, PyAny>, Option<Bound<'_, PyDict>>) =
