@@ -112,6 +112,20 @@ def run_post(program: situ.Program, events: list[tuple[str, float, dict[str, sit
     return {"engine": "situ Board.post", "events": len(events), "seconds": seconds, "events_per_sec": len(events) / seconds}
 
 
+def run_post_many_ids(
+    program: situ.Program, events: list[tuple[str, float, dict[str, situ.Value]]], states_out: Path
+) -> dict[str, Any]:
+    board = situ.Board(program, missions=True, sleeping="take")
+    ids = {name: board.event_id(name) for name in {e[0] for e in events}}
+    order = {name: [f for f, _ in program.fields(name)] for name in ids}
+    fast = [(ids[n], at, tuple(p[f] for f in order[n])) for n, at, p in events]
+    start = time.perf_counter()
+    batch = board.post_many_ids(fast)
+    seconds = time.perf_counter() - start
+    states_out.write_text("".join(f"{i} {c.state}\n" for i, c in batch.changes))
+    return {"engine": "situ Board.post_many (ids)", "events": len(events), "seconds": seconds, "events_per_sec": len(events) / seconds}
+
+
 def run_post_many(
     program: situ.Program, events: list[tuple[str, float, dict[str, situ.Value]]], states_out: Path
 ) -> dict[str, Any]:
@@ -146,9 +160,10 @@ def main() -> int:
             run_clips(lines, work / "clipspy.states"),
             run_post(program, events, work / "post.states"),
             run_post_many(program, events, work / "post_many.states"),
+            run_post_many_ids(program, events, work / "post_many_ids.states"),
         ]
         want = reference.read_text()
-        for r, f in zip(results, ["clipspy", "post", "post_many"]):
+        for r, f in zip(results, ["clipspy", "post", "post_many", "post_many_ids"]):
             got = (work / f"{f}.states").read_text()
             if got != want:
                 a, b = want.splitlines(), got.splitlines()
@@ -160,10 +175,11 @@ def main() -> int:
             print(json.dumps(r))
         print(json.dumps({"engine": "situ bench (Rust)", "events": engine["events"], "events_per_sec": engine["events_per_sec"]}))
         print(f"== the {len(results)} engines agree with situ bench: {len(want.splitlines())} state changes", file=sys.stderr)
-        clips_rate, post_rate, many_rate = (r["events_per_sec"] for r in results)
+        clips_rate, post_rate, many_rate, ids_rate = (r["events_per_sec"] for r in results)
         print(f"post/clipspy ratio: {post_rate / clips_rate:.1f}")
         print(f"post_many/clipspy ratio: {many_rate / clips_rate:.1f}")
         print(f"situ bench/post_many ratio: {engine['events_per_sec'] / many_rate:.2f}")
+        print(f"situ bench/post_many (ids) ratio: {engine['events_per_sec'] / ids_rate:.2f}")
     return 0
 
 

@@ -7,7 +7,7 @@
 use crate::errors::{from_board, raise};
 use crate::program::Program;
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyString};
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyString, PyTuple};
 use situ_api::{Arg, BoardError, Clock, FieldValue, Posted};
 use std::collections::BTreeMap;
 
@@ -268,6 +268,31 @@ impl Board {
         let at = nanos(at).map_err(|e| from_board(py, e))?;
         self.inner.post(id, at, &self.buf).map_err(|e| from_board(py, e))
     }
+
+    /// One event by id (`Board.event_id`) with its values in field order
+    /// (a tuple): the batch's fast path, no name looked up.
+    fn post_values(
+        &mut self,
+        py: Python<'_>,
+        id: u32,
+        at: Option<&Bound<'_, PyAny>>,
+        values: &Bound<'_, PyTuple>,
+    ) -> PyResult<Posted> {
+        let content = self.inner.content().clone();
+        let Some(def) = content.events.get(id as usize) else {
+            let e = BoardError::UnknownEvent { name: format!("#{id}"), suggestion: None };
+            return Err(from_board(py, e));
+        };
+        let items: Vec<Bound<'_, PyAny>> = values.iter().collect();
+        let mut args = Vec::with_capacity(items.len());
+        for (i, v) in items.iter().enumerate() {
+            let field = def.fields.get(i).map_or("?", |f| f.name.as_str());
+            args.push(arg_of(&def.name, field, v).map_err(|e| from_board(py, e))?);
+        }
+        self.inner.payload_in_order(id, &args, &mut self.buf).map_err(|e| from_board(py, e))?;
+        let at = nanos(at).map_err(|e| from_board(py, e))?;
+        self.inner.post(id, at, &self.buf).map_err(|e| from_board(py, e))
+    }
 }
 
 fn outcome(posted: Posted, content: &situ_api::Content) -> Outcome {
@@ -390,9 +415,18 @@ impl Board {
         // callbacks may read it.
         for (index, item) in events.try_iter()?.enumerate() {
             let item = item?;
-            let (name, at, payload): (Bound<'_, PyString>, Bound<'_, PyAny>, Option<Bound<'_, PyDict>>) =
-                item.extract()?;
-            let posted = slf.borrow_mut().post_raw(py, name.to_str()?, Some(&at), payload.as_ref())?;
+            let (event, at, payload): (Bound<'_, PyAny>, Bound<'_, PyAny>, Bound<'_, PyAny>) = item.extract()?;
+            let posted = if event.is_instance_of::<PyInt>() {
+                // The fast path: an id and the values in field order.
+                let id: u32 = event.extract()?;
+                let empty = PyTuple::empty(py);
+                let values = if payload.is_none() { &empty } else { payload.cast::<PyTuple>()? };
+                slf.borrow_mut().post_values(py, id, Some(&at), values)?
+            } else {
+                let name = event.cast::<PyString>()?;
+                let payload = if payload.is_none() { None } else { Some(payload.cast::<PyDict>()?) };
+                slf.borrow_mut().post_raw(py, name.to_str()?, Some(&at), payload)?
+            };
             match posted {
                 Posted::NotTaken(r) => *batch.not_taken.entry(r.key.to_string()).or_default() += 1,
                 Posted::Taken { change: c, .. } => {
@@ -406,6 +440,18 @@ impl Board {
             }
         }
         Ok(batch)
+    }
+
+    /// `post_many` of `(event id, at, (values in field order))`: no name
+    /// is looked up (ids from `event_id`). `post_many` takes these too.
+    fn post_many_ids(slf: &Bound<'_, Self>, events: &Bound<'_, PyAny>) -> PyResult<Batch> {
+        Self::post_many(slf, events)
+    }
+
+    /// The id of an event (`"EVENT"` or `"Agent.EVENT"`), for `post_many`'s
+    /// fast path: `(id, at, (values in field order))`.
+    fn event_id(&self, py: Python<'_>, agent_event: &str) -> PyResult<u32> {
+        self.inner.event(agent_event).map_err(|e| from_board(py, e))
     }
 
     /// Lets time pass to `to` seconds (`None`: now on the board's clock):

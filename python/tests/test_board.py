@@ -219,3 +219,19 @@ def test_a_board_whose_agents_are_not_situs_takes_a_sleeping_agents_events(picke
     assert b.post("PICKED", at=0.3).accepted
     with pytest.raises(situ.Error):
         situ.Board(picker, sleeping="snooze")
+
+
+def test_post_many_takes_ids_and_values_in_field_order(picker: situ.Program) -> None:
+    named = situ.Board(picker)
+    fast = situ.Board(picker)
+    batt, order, obst = (fast.event_id(e) for e in ("BATT", "Scanner.ORDER", "OBST"))
+    a = named.post_many([("BATT", 0.0, {"charge": 80.0}), ("ORDER", 0.1, {"item": 2}), ("OBST", 0.2, {"distance": 0.1, "side": "left"})])
+    b = fast.post_many_ids([(batt, 0.0, (80.0,)), (order, 0.1, (2,)), (obst, 0.2, (0.1, "left"))])
+    assert [(i, c.state) for i, c in a.changes] == [(i, c.state) for i, c in b.changes] == [(1, "PICKING"), (2, "FAULT")]
+    for bad, code in [((obst, 0.3, (0.1,)), "missing-fields"), ((obst, 0.3, (0.1, "up")), "field-type"),
+                      ((batt, 0.3, (1.0, 2.0)), "unknown-field"), ((99, 0.3, ()), "unknown-event")]:
+        with pytest.raises(situ.BoardError) as e:
+            fast.post_many_ids([bad])
+        assert e.value.code == code, (bad, str(e.value))
+    with pytest.raises(situ.BoardError):
+        fast.event_id("NOPE")
