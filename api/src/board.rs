@@ -282,6 +282,16 @@ impl Board {
         self.local.state_name()
     }
 
+    /// The state at rest, as its index in the rules' states.
+    pub fn state_id(&self) -> u32 {
+        self.local.state()
+    }
+
+    /// Whether the state at rest is `final`.
+    pub fn is_final(&self) -> bool {
+        self.local.is_final()
+    }
+
     /// The board's latest time (ns).
     pub fn now(&self) -> u64 {
         self.local.now()

@@ -380,9 +380,7 @@ pub unsafe extern "C" fn situ_board_state(board: *const situ_board, out: *mut *c
         let cell = self::board(board)?;
         let out = place(out, "the place for the state")?;
         let g = lock(&cell)?;
-        let name = g.board.state();
-        let i = g.board.content().states.iter().position(|s| s.name == name).unwrap_or(0);
-        *out = g.states[i].as_ptr();
+        *out = g.states[g.board.state_id() as usize].as_ptr();
         Ok(())
     })
 }
@@ -395,8 +393,7 @@ pub unsafe extern "C" fn situ_board_is_final(board: *const situ_board, out: *mut
         let cell = self::board(board)?;
         let out = place(out, "the place for the answer")?;
         let g = lock(&cell)?;
-        let name = g.board.state();
-        *out = g.board.content().states.iter().any(|s| s.name == name && s.is_final);
+        *out = g.board.is_final();
         Ok(())
     })
 }
