@@ -277,6 +277,8 @@ impl Bus for ZenohBus {
                 state: self.content.states[msg.state as usize].name.clone(),
                 time_ns: msg.time,
                 seq: msg.seq,
+                epoch: 0,
+                board: None,
             };
             let key = wire::status_key(&self.placement.robot);
             self.put(

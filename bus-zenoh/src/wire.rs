@@ -50,6 +50,13 @@ pub struct StatusWire {
     pub state: String,
     pub time_ns: u64,
     pub seq: u64,
+    /// The leading board's epoch (absent: 0): an agent follows only the
+    /// highest epoch it has seen.
+    #[serde(default)]
+    pub epoch: u64,
+    /// The leading board's name (absent: not said).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub board: Option<String>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -195,6 +202,16 @@ mod tests {
         assert_eq!((agent, event, back.urgent), (0, 0, true));
         assert!(matches!(payload[0], Value::F64(x) if x.is_nan()));
         assert_eq!(payload[1], Value::Symbol(1));
+    }
+
+    #[test]
+    fn a_status_without_an_epoch_is_epoch_0_and_the_fields_round_trip() {
+        let old: StatusWire = serde_json::from_str(r#"{"v":1,"state":"RS","time_ns":5,"seq":2}"#).unwrap();
+        assert_eq!((old.epoch, old.board.as_deref()), (0, None));
+        assert_eq!(serde_json::to_string(&old).unwrap(), r#"{"v":1,"state":"RS","time_ns":5,"seq":2,"epoch":0}"#);
+        let new = StatusWire { epoch: 7, board: Some("b".into()), ..old };
+        let text = serde_json::to_string(&new).unwrap();
+        assert_eq!(serde_json::from_str::<StatusWire>(&text).unwrap(), new);
     }
 
     #[test]

@@ -233,19 +233,41 @@ impl Drop for Journal {
 }
 
 /// A journal opened before a run, for the run to take: it applies what
-/// was recovered ([`recover`]) and writes to it from then on.
-#[derive(Debug, Clone)]
-pub struct Opened(Arc<Mutex<Option<(Journal, Recovered)>>>);
+/// was recovered ([`recover`]), says so ([`Opened::telling`]) and writes to
+/// it from then on.
+#[derive(Clone)]
+pub struct Opened {
+    slot: Arc<Mutex<Option<(Journal, Recovered)>>>,
+    tell: Arc<dyn Fn(&str) + Send + Sync>,
+}
+
+impl std::fmt::Debug for Opened {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Opened").field("slot", &self.slot).finish_non_exhaustive()
+    }
+}
 
 impl Opened {
     /// Opens the journal at `path` for `content` ([`Journal::open`]).
     pub fn open(path: &Path, content: &Content) -> Result<Opened, JournalError> {
-        Ok(Opened(Arc::new(Mutex::new(Some(Journal::open(path, content)?)))))
+        let slot = Arc::new(Mutex::new(Some(Journal::open(path, content)?)));
+        Ok(Opened { slot, tell: Arc::new(|_| ()) })
+    }
+
+    /// Who is told what was recovered (besides the recording): the
+    /// command's standard error.
+    pub fn telling(self, tell: impl Fn(&str) + Send + Sync + 'static) -> Opened {
+        Opened { tell: Arc::new(tell), ..self }
+    }
+
+    /// Says what was recovered.
+    pub fn tell(&self, text: &str) {
+        (self.tell)(text)
     }
 
     /// The journal and what it held (once).
     pub fn take(&self) -> Option<(Journal, Recovered)> {
-        self.0.lock().unwrap_or_else(|p| p.into_inner()).take()
+        self.slot.lock().unwrap_or_else(|p| p.into_inner()).take()
     }
 }
 
@@ -271,8 +293,16 @@ pub fn recover(board: &mut BoardRunner, shared: &Shared, journal: &Journal, reco
 }
 
 /// "recovered N entries from the journal P: state X, facts of A, B; M
-/// bytes of a torn tail dropped".
+/// bytes of a torn tail dropped" (or that it holds none).
 fn describe(board: &BoardRunner, journal: &Journal, recovered: &Recovered) -> String {
+    if recovered.entries.is_empty() {
+        let mut text =
+            format!("the journal {} holds no entry: the board starts from its initial state", journal.path().display());
+        if recovered.dropped > 0 {
+            text += &format!(" ({} bytes of a torn write dropped)", recovered.dropped);
+        }
+        return text;
+    }
     let content = board.board.content();
     let engine = board.board.engine();
     let facts: Vec<&str> = (0..content.agents.len() as u32)

@@ -271,7 +271,8 @@ fn resume_from_journal(
     shared: &Shared,
     now: u64,
 ) -> Option<Arc<Mutex<Option<crate::journal::JournalError>>>> {
-    let (journal, recovered) = config.journal.as_ref()?.take()?;
+    let opened = config.journal.as_ref()?;
+    let (journal, recovered) = opened.take()?;
     let say = |level, text: &str| shared.record(|s| s.diagnostic(now, level, text));
     if !config.board || config.standby.is_some() {
         say(crate::record::Level::Warning, "the journal is kept by a single board: it is not used here");
@@ -279,6 +280,7 @@ fn resume_from_journal(
     }
     let text = crate::journal::recover(board, shared, &journal, &recovered);
     say(crate::record::Level::Info, &text);
+    opened.tell(&text);
     let failures = journal.failures();
     board.set_log_out(Some(Box::new(journal)));
     Some(failures)
