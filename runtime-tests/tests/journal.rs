@@ -176,6 +176,7 @@ fn a_real_time_run_with_a_journal_starts_from_it_and_says_so() {
     // at the first heartbeat, and the rule of a blind robot fires from RO.
     assert_eq!(changes.first().copied(), Some(c.state_id("EM").unwrap()), "from {state}");
     assert_eq!(summary.final_state, "EM");
+    assert_eq!(summary.path, ["RO", "EM"], "the run started where the journal left it");
     drop(m);
     // The run wrote its own entries after the recovered ones: the
     // heartbeat that made LADAR stale, at the wall clock.

@@ -4,6 +4,9 @@
 //! `write(2)` per flush, and prints the time per event for flushes of 1
 //! and of 16 events, without and with an `fdatasync` per flush (a change
 //! broadcast after each), then the time to open (recover) the file.
+//! With a second argument N, only N events in flushes of 1 without a sync
+//! (for `valgrind --tool=callgrind`: the difference of two Ns' counts is the
+//! cost of the events).
 
 use situ_bundle::Value;
 use situ_runtime::bus::EventMsg;
@@ -24,7 +27,11 @@ fn event(i: u64) -> Entry {
 fn main() {
     let dir = std::env::args().nth(1).map(std::path::PathBuf::from).unwrap_or_else(std::env::temp_dir);
     let path = dir.join(format!("journal_bench.{}", std::process::id()));
-    for (batch, sync, n) in [(1, false, 200_000u64), (16, false, 200_000), (1, true, 2_000), (16, true, 16_000)] {
+    let runs = match std::env::args().nth(2).and_then(|n| n.parse().ok()) {
+        Some(n) => vec![(1, false, n)],
+        None => vec![(1, false, 200_000u64), (16, false, 200_000), (1, true, 2_000), (16, true, 16_000)],
+    };
+    for (batch, sync, n) in runs {
         let _ = std::fs::remove_file(&path);
         let (mut j, _) = Journal::open_for(&path, SHA).expect("open");
         let mut entries = Vec::with_capacity(batch);

@@ -128,8 +128,8 @@ pub fn run_on(
     let steps = &AtomicU64::new(0);
     let mut board = BoardRunner::new(content.clone());
     board.set_max_skew(config.max_skew.as_nanos().min(u64::MAX as u128) as u64);
-    let mut summary = Summary::new(&content).starting_at(epoch);
     let journal_failures = resume_from_journal(&config, &mut board, &shared, epoch);
+    let mut summary = Summary::new(&content).starting_at(epoch).starting_in(board.board.state());
     if config.board {
         board.start(&shared, epoch);
     }
