@@ -62,6 +62,8 @@ pub enum JournalError {
         #[source]
         source: std::io::Error,
     },
+    #[error("the journal {path} is not a regular file (a directory, a FIFO or a device)")]
+    NotAFile { path: PathBuf },
     #[error("{path} is not a situ journal (its first bytes are not `SITUJRNL` with a valid header)")]
     NotAJournal { path: PathBuf },
     #[error("the journal {path} has format version {found}; this situ reads version {expected}")]
@@ -117,6 +119,10 @@ impl Journal {
     pub fn open_for(path: &Path, sha256: &str) -> Result<(Journal, Recovered), JournalError> {
         let io = |source| JournalError::Io { path: path.to_path_buf(), source };
         let mut file = OpenOptions::new().read(true).write(true).create(true).truncate(false).open(path).map_err(io)?;
+        // A FIFO or a device would be read forever.
+        if !file.metadata().map_err(io)?.is_file() {
+            return Err(JournalError::NotAFile { path: path.to_path_buf() });
+        }
         let mut bytes = Vec::new();
         file.read_to_end(&mut bytes).map_err(io)?;
         let header = header(sha256);

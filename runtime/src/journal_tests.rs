@@ -209,3 +209,17 @@ fn the_checksum_is_crc32_ieee() {
     assert_eq!(crc32(b"123456789"), 0xCBF4_3926);
     assert_eq!(crc32(b""), 0);
 }
+
+#[test]
+fn what_is_not_a_regular_file_is_refused_not_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let err = Journal::open_for(dir.path(), A).unwrap_err();
+    assert!(matches!(err, JournalError::Io { .. } | JournalError::NotAFile { .. }), "{err}");
+    let fifo = dir.path().join("fifo");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status().unwrap();
+    assert!(made.success());
+    let err = Journal::open_for(&fifo, A).unwrap_err();
+    assert!(matches!(err, JournalError::NotAFile { .. }), "{err}");
+    let err = Journal::open_for(Path::new("/dev/null"), A).unwrap_err();
+    assert!(matches!(err, JournalError::NotAFile { .. }), "{err}");
+}
