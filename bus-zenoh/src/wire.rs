@@ -50,11 +50,11 @@ pub struct StatusWire {
     pub state: String,
     pub time_ns: u64,
     pub seq: u64,
-    /// The leading board's epoch (absent: 0): an agent follows only the
-    /// highest epoch it has seen.
+    /// The epoch of the board that sends it (absent: 0). An agent follows
+    /// only the highest epoch it has seen: a lower one is an old leader's.
     #[serde(default)]
     pub epoch: u64,
-    /// The leading board's name (absent: not said).
+    /// The process of the board that sends it (absent: not said).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub board: Option<String>,
 }

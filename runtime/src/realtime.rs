@@ -200,7 +200,6 @@ pub fn run_on(
                 shared: &shared,
                 board: &mut board,
                 heartbeat: config.heartbeat,
-                status_every: config.status_every,
                 end: start + duration,
                 stop: &stop,
                 clock: &clock,

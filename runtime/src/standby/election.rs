@@ -4,7 +4,9 @@
 //! - A board starts as a follower. It leads when it has heard no leader
 //!   for its lease (plus `stagger` per rank, so that two followers do not
 //!   take over at once); at start, when it has heard none for the join
-//!   time (two leases: a board that comes back hears the leader first).
+//!   time (two leases: a board that comes back hears the leader first),
+//!   one lease more per rank (the first listed leads when all start
+//!   together, even if it started a little later).
 //! - Its epoch is above every epoch it has seen and above the wall clock in
 //!   milliseconds, times 256, plus its rank: epochs grow across restarts
 //!   and two boards never pick the same one.
@@ -89,9 +91,7 @@ impl Election {
         }
         Some(match self.last_heard {
             Some(t) => t.saturating_add(self.patience()),
-            None => {
-                self.started.saturating_add(self.join).saturating_add(self.stagger.saturating_mul(self.rank as u64))
-            }
+            None => self.started.saturating_add(self.join).saturating_add(self.lease.saturating_mul(self.rank as u64)),
         })
     }
 
@@ -117,8 +117,12 @@ mod tests {
 
     const MS: u64 = 1_000_000;
 
+    /// Lease 400 ms, 100 ms more per rank.
     fn config(rank: u32) -> StandbyConfig {
-        StandbyConfig::new("b", rank, Duration::from_millis(200))
+        let mut c = StandbyConfig::new("b", rank, Duration::from_millis(200));
+        c.lease = Duration::from_millis(400);
+        c.stagger = Duration::from_millis(100);
+        c
     }
 
     #[test]
@@ -126,17 +130,21 @@ mod tests {
         let (mut a, mut b) = (Election::new(&config(0), 0, 0), Election::new(&config(1), 0, 0));
         assert_eq!(a.poll(799 * MS, 1000), None);
         let Some(Decision::Lead(e)) = a.poll(800 * MS, 1000) else { panic!("rank 0 leads at 800 ms") };
-        assert_eq!(e, (1000 << 8) | 0);
+        assert_eq!(e, 1000 << 8);
         // The second heard it before its own, later, deadline.
         assert_eq!(b.heard(e, 805 * MS), None);
         assert_eq!(b.poll(900 * MS, 1000), None);
         assert_eq!(b.deadline(), Some((805 + 400 + 100) * MS));
+        // Alone, the second would have led a lease after the first.
+        let mut c = Election::new(&config(1), 0, 0);
+        assert_eq!(c.poll(1199 * MS, 1000), None);
+        assert!(matches!(c.poll(1200 * MS, 1000), Some(Decision::Lead(_))));
     }
 
     #[test]
     fn a_follower_leads_with_a_higher_epoch_when_the_leader_falls_silent() {
         let mut b = Election::new(&config(1), 0, 0);
-        let old = (5000 << 8) | 0;
+        let old = 5000 << 8;
         b.heard(old, 10 * MS);
         assert_eq!(b.poll(509 * MS, 1), None);
         let Some(Decision::Lead(e)) = b.poll(510 * MS, 1) else { panic!("leads after lease + stagger") };
@@ -163,7 +171,7 @@ mod tests {
         // Restarted with a journal whose epoch is ahead of the wall clock.
         let mut a = Election::new(&config(0), 0, (9000 << 8) | 1);
         let Some(Decision::Lead(e)) = a.poll(800 * MS, 10) else { panic!() };
-        assert_eq!(e, (9001 << 8) | 0);
+        assert_eq!(e, 9001 << 8);
         // Restarted without one: the wall clock.
         let mut b = Election::new(&config(0), 0, 0);
         assert_eq!(b.poll(800 * MS, 12345), Some(Decision::Lead(12345 << 8)));

@@ -67,8 +67,13 @@ impl Replica {
             }
         }
         if fresh.is_empty() && batch.last() < applied && batch.entries.is_empty() {
-            // A beat: the leader's whole log is shorter than ours.
-            return Offer::Diverged;
+            // A beat says the leader's log is shorter than ours. If the
+            // entry after its end was written by this leader, the beat is
+            // only older than what we applied since (it came late); if by
+            // an older one, the leader never had it.
+            if log.epoch_at(batch.last() + 1) != Some(batch.epoch) {
+                return Offer::Diverged;
+            }
         }
         if fresh.is_empty() {
             Offer::Nothing
@@ -175,8 +180,11 @@ mod tests {
         // Entry 2 was written in epoch 1 here, in epoch 3 at the leader.
         assert_eq!(r.offer(&batch(3, 3, &[3]), &log_of(&[1, 1])), Offer::Diverged);
         assert_eq!(r.offer(&batch(2, 1, &[3]), &log_of(&[1, 1])), Offer::Diverged);
-        // The leader's beat says its log has 1 entry; ours has 2.
+        // The leader (epoch 9)'s beat says its log has 1 entry; ours has 2,
+        // the second written by epoch 1: the leader never had it.
         assert_eq!(r.offer(&batch(2, 1, &[]), &log_of(&[1, 1])), Offer::Diverged);
+        // The second written by epoch 9: the beat is only late.
+        assert_eq!(r.offer(&batch(2, 1, &[]), &log_of(&[1, 9])), Offer::Nothing);
         // A beat at our length is nothing new.
         assert_eq!(r.offer(&batch(3, 1, &[]), &log_of(&[1, 1])), Offer::Nothing);
     }

@@ -23,8 +23,6 @@ pub struct BoardLoop<'a> {
     pub board: &'a mut BoardRunner,
     /// The engine's heartbeat period (the clock moves without events).
     pub heartbeat: Duration,
-    /// How often the leader repeats its status.
-    pub status_every: Duration,
     pub end: Instant,
     pub stop: &'a AtomicBool,
     /// The wall clock, ns since the Unix epoch.
@@ -79,7 +77,7 @@ impl LogOut for ToFollowers {
 /// Runs the board's thread until `end` or `stop`; `deliver` sees the
 /// changes of the state at rest this board made or applied.
 pub fn run(standby: &Standby, l: BoardLoop<'_>, deliver: &mut dyn FnMut(&[StateChange])) {
-    let BoardLoop { shared, board, heartbeat, status_every, end, stop, clock, known_epoch } = l;
+    let BoardLoop { shared, board, heartbeat, end, stop, clock, known_epoch } = l;
     let cfg = &standby.config;
     let peers = &standby.peers;
     let origin = Instant::now();
@@ -90,11 +88,16 @@ pub fn run(standby: &Standby, l: BoardLoop<'_>, deliver: &mut dyn FnMut(&[StateC
     let (mut events, mut batches): (Vec<EventMsg>, Vec<Batch>) = (Vec::new(), Vec::new());
     let mut changes: Vec<StateChange> = Vec::new();
     let mut next_beat = Instant::now();
-    let mut next_status = Instant::now();
     let mut next_tick = Instant::now() + heartbeat;
     // A catch-up request in flight: from where, and when it was sent.
     let mut asked: Option<(u64, Instant)> = None;
     let say = |level: Level, text: String| shared.record(|s| s.diagnostic(clock(), level, &text));
+    let tell = |text: String| {
+        if let Some(t) = &standby.tell {
+            t(&text);
+        }
+        say(Level::Warning, text);
+    };
     peers.set_leading(None);
     let mut reported_unacked = 0;
     loop {
@@ -106,7 +109,7 @@ pub fn run(standby: &Standby, l: BoardLoop<'_>, deliver: &mut dyn FnMut(&[StateC
             if let Some(Decision::StepDown { higher }) = election.heard(epoch, ns(at)) {
                 peers.set_leading(None);
                 board.set_log_out(None);
-                say(Level::Warning, format!("board `{}` steps down: epoch {higher} leads", cfg.name));
+                tell(format!("board `{}` steps down: epoch {higher} leads", cfg.name));
             }
         }
         match election.leading() {
@@ -122,12 +125,11 @@ pub fn run(standby: &Standby, l: BoardLoop<'_>, deliver: &mut dyn FnMut(&[StateC
                     changes.extend(board.tick(shared, clock()));
                 }
                 board.flush_log(false);
-                if now >= next_status {
-                    next_status = now + status_every;
-                    board.reassure(shared, clock());
-                }
                 if now >= next_beat {
                     next_beat = now + cfg.beat;
+                    // The beat: the status to the agents, the log's length
+                    // to the boards.
+                    board.reassure(shared, clock());
                     let beat = {
                         let log = standby.log.lock().unwrap_or_else(|p| p.into_inner());
                         log.batch_from(log.len() + 1, 0, epoch, &cfg.name)
@@ -204,16 +206,12 @@ pub fn run(standby: &Standby, l: BoardLoop<'_>, deliver: &mut dyn FnMut(&[StateC
                 }
                 if let Some(Decision::Lead(epoch)) = election.poll(ns(Instant::now()), clock() / 1_000_000) {
                     take_over(shared, board, standby, epoch, &mut replica, ns(Instant::now()), &unacknowledged);
-                    say(
-                        Level::Warning,
-                        format!(
-                            "board `{}` leads at epoch {epoch}, from entry {} of the log",
-                            cfg.name,
-                            standby.log.lock().unwrap_or_else(|p| p.into_inner()).len()
-                        ),
-                    );
+                    tell(format!(
+                        "board `{}` leads at epoch {epoch}, from entry {} of the log",
+                        cfg.name,
+                        standby.log.lock().unwrap_or_else(|p| p.into_inner()).len()
+                    ));
                     board.announce(shared, clock());
-                    next_status = Instant::now() + status_every;
                     next_beat = Instant::now();
                     next_tick = Instant::now();
                 }
