@@ -329,6 +329,9 @@ impl Peers for BoardPeers {
         let _ = self
             .session
             .get(sync_key(&self.robot, from))
+            // Every chunk: they share one key, which Zenoh's default
+            // consolidation would reduce to the latest.
+            .consolidation(zenoh::query::ConsolidationMode::None)
             .timeout(SYNC_TIMEOUT)
             .callback(move |reply| {
                 if let Ok(sample) = reply.result() {

@@ -186,6 +186,10 @@ pub fn run(standby: &Standby, l: BoardLoop<'_>, deliver: &mut dyn FnMut(&[StateC
                         }
                         Offer::Behind { from } => {
                             if asked.is_none_or(|(f, at)| f != from || at.elapsed() > cfg.lease) {
+                                say(
+                                    Level::Info,
+                                    format!("board `{}` asks `{}` for the log from entry {from}", cfg.name, b.board),
+                                );
                                 peers.request(from);
                                 asked = Some((from, Instant::now()));
                             }
