@@ -275,6 +275,19 @@ fn soak_kill_the_leader_again_and_again() {
         q(1.0),
         all.len()
     );
+    // Safe mode entered by the agents' processes (no status for 600 ms).
+    let safe: usize = ["sensors", "pipeline"]
+        .iter()
+        .map(|p| {
+            let m = messages(&dir.path().join(format!("{p}.mcap")));
+            m.iter()
+                .filter(|(t, _, j)| {
+                    t == "/diagnostics" && j["message"].as_str().is_some_and(|s| s.contains("safe mode ("))
+                })
+                .count()
+        })
+        .sum();
+    eprintln!("the agents' two processes entered safe mode {safe} time(s) in {kills} takeovers");
     for (err, name) in [(sensors.end(), "sensors"), (pipeline.end(), "pipeline")] {
         assert_eq!(followed(&err, name), ["RO"], "{name} followed an old state: {err}");
     }
