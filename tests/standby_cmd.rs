@@ -86,6 +86,12 @@ impl Proc {
         t
     }
 
+    /// Kills it; its standard error.
+    fn kill_and_tell(&mut self) -> String {
+        self.kill();
+        self.end()
+    }
+
     /// Waits for its end; its standard error.
     fn end(&mut self) -> String {
         let _ = self.child.wait();
@@ -242,7 +248,10 @@ fn soak_kill_the_leader_again_and_again() {
         while boards[f].led_after(t).is_none() && Instant::now() < deadline {
             std::thread::sleep(Duration::from_millis(5));
         }
-        let led = boards[f].led_after(t).unwrap_or_else(|| panic!("kill {k}: {} did not lead", names[f]));
+        let Some(led) = boards[f].led_after(t) else {
+            let err = boards[f].kill_and_tell();
+            panic!("kill {k}: {} did not lead within 5 s; it said:\n{err}", names[f]);
+        };
         takeovers.push((led - t) as f64 / 1e6);
         std::thread::sleep(Duration::from_millis(800));
         incarnation[l] += 1;
