@@ -2,7 +2,7 @@
 //! every change of the state.
 
 use crate::error::{call, situ_status, Failure};
-use crate::handle;
+use crate::handle::{self, Kind};
 use crate::program::{situ_program, ProgramItem};
 use crate::value::{arg, c_string, place, situ_arg, situ_value, slice, text};
 use situ_api::{Arg, Board, Change, Clock, Posted};
@@ -129,6 +129,10 @@ pub(crate) struct BoardCell {
 unsafe impl Send for BoardCell {}
 
 type Cell = Mutex<BoardCell>;
+
+impl Kind for Cell {
+    const WHAT: &'static str = "situ_board";
+}
 
 fn lock(cell: &Cell) -> Result<MutexGuard<'_, BoardCell>, Failure> {
     cell.lock()

@@ -11,50 +11,18 @@
 //! works without holding the registry's lock, so a callback may free the
 //! board whose call is running it (the call finishes on its own clone).
 
-use crate::board::BoardCell;
 use crate::error::{situ_status, Failure};
-use crate::program::ProgramItem;
-use crate::read::{AgentsView, FactsView, WhyView};
+use std::any::Any;
 use std::sync::{Arc, Mutex, MutexGuard};
 
-/// What a handle holds.
-pub(crate) enum Item {
-    Program(Arc<ProgramItem>),
-    Board(Arc<Mutex<BoardCell>>),
-    Agents(Arc<AgentsView>),
-    Facts(Arc<FactsView>),
-    Why(Arc<WhyView>),
-}
+/// What a handle holds: an item of some [`Kind`].
+type Item = Arc<dyn Any + Send + Sync>;
 
-/// A kind of item: how it is wrapped, found and named in errors.
-pub(crate) trait Kind: Sized {
+/// A kind of item: how it is named in errors. Each kind is declared beside
+/// its item (a program, a board, a view), so the registry knows none of them.
+pub(crate) trait Kind: Any + Send + Sync {
     const WHAT: &'static str;
-    fn wrap(this: Arc<Self>) -> Item;
-    fn peek(item: &Item) -> Option<&Arc<Self>>;
 }
-
-macro_rules! kind {
-    ($ty:ty, $variant:ident, $what:literal) => {
-        impl Kind for $ty {
-            const WHAT: &'static str = $what;
-            fn wrap(this: Arc<Self>) -> Item {
-                Item::$variant(this)
-            }
-            fn peek(item: &Item) -> Option<&Arc<Self>> {
-                match item {
-                    Item::$variant(x) => Some(x),
-                    _ => None,
-                }
-            }
-        }
-    };
-}
-
-kind!(ProgramItem, Program, "situ_program");
-kind!(Mutex<BoardCell>, Board, "situ_board");
-kind!(AgentsView, Agents, "situ_agents");
-kind!(FactsView, Facts, "situ_facts");
-kind!(WhyView, Why, "situ_why");
 
 struct Slot {
     generation: usize,
@@ -94,7 +62,7 @@ pub(crate) fn insert<T: Kind>(value: T) -> usize {
         // never frees. Refusing needs a status; this is far past any use.
         None => panic!("more than {} live situ handles", LOW - 1),
     };
-    r.slots[index].item = Some(T::wrap(Arc::new(value)));
+    r.slots[index].item = Some(Arc::new(value));
     r.live += 1;
     encode(index, r.slots[index].generation)
 }
@@ -113,7 +81,7 @@ fn find<T: Kind>(r: &Registry, handle: usize) -> Result<usize, Failure> {
     }
     let (index, generation) = ((handle & LOW).wrapping_sub(1), handle >> HALF);
     match r.slots.get(index) {
-        Some(Slot { generation: g, item: Some(item) }) if *g == generation && T::peek(item).is_some() => Ok(index),
+        Some(Slot { generation: g, item: Some(item) }) if *g == generation && (**item).is::<T>() => Ok(index),
         _ => Err(unknown::<T>()),
     }
 }
@@ -122,7 +90,8 @@ fn find<T: Kind>(r: &Registry, handle: usize) -> Result<usize, Failure> {
 pub(crate) fn get<T: Kind>(handle: usize) -> Result<Arc<T>, Failure> {
     let r = registry();
     let index = find::<T>(&r, handle)?;
-    Ok(r.slots[index].item.as_ref().and_then(T::peek).cloned().expect("found above"))
+    let item = r.slots[index].item.clone().expect("found above");
+    item.downcast::<T>().map_err(|_| unknown::<T>())
 }
 
 /// Frees a handle of kind `T`; a null handle is nothing to free.

@@ -2,7 +2,7 @@
 //! under a trust policy, or from a `.situ` source (checked and built).
 
 use crate::error::{call, situ_status, Failure};
-use crate::handle;
+use crate::handle::{self, Kind};
 use crate::value::{place, slice, text};
 use situ_api::{Content, Trust};
 use std::ffi::c_char;
@@ -17,6 +17,10 @@ pub struct situ_program {
 
 pub(crate) struct ProgramItem {
     pub content: Arc<Content>,
+}
+
+impl Kind for ProgramItem {
+    const WHAT: &'static str = "situ_program";
 }
 
 /// The trust policy of a list of public-key files: none, any valid bundle.

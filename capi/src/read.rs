@@ -193,6 +193,16 @@ unsafe impl Sync for FactsView {}
 unsafe impl Send for WhyView {}
 unsafe impl Sync for WhyView {}
 
+impl Kind for AgentsView {
+    const WHAT: &'static str = "situ_agents";
+}
+impl Kind for FactsView {
+    const WHAT: &'static str = "situ_facts";
+}
+impl Kind for WhyView {
+    const WHAT: &'static str = "situ_why";
+}
+
 fn agent(a: &mut Arena, now: &AgentNow) -> situ_agent {
     let mode = match now.mode {
         "running" => situ_mode::SITU_RUNNING,

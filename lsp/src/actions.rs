@@ -2,8 +2,9 @@
 //! actions (the diagnostics' fixes, the missing table row, `#[allow(code)]`),
 //! and inlay hints.
 
+pub use crate::data::CodeAction;
 use crate::data::{TextEdit, WorkspaceEdit};
-use crate::diagnostics::{finding, of_file, Finding};
+use crate::diagnostics::{finding, of_file};
 use crate::world::Analysis;
 use lsp_types::{InlayHintKind, Position};
 use situ_compiler::codes;
@@ -59,17 +60,6 @@ pub fn range_formatting(a: &Analysis, file: FileId, span: Span) -> Option<Vec<Te
             .map(|(s, t)| vec![text_edit(a, file, Span::new(whole.start + s.start, whole.start + s.end), &t)])
             .unwrap_or_default(),
     )
-}
-
-/// A quick fix of one finding.
-#[derive(Debug, Clone, PartialEq)]
-pub struct CodeAction {
-    pub title: String,
-    /// The finding it fixes.
-    pub finding: Finding,
-    /// The first fix the compiler gives.
-    pub preferred: bool,
-    pub edit: WorkspaceEdit,
 }
 
 fn action(

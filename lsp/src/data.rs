@@ -1,6 +1,7 @@
-//! What the features answer with, in the protocol's terms (places, edits),
-//! before [`crate::protocol`] writes it as JSON: the pieces several features
-//! share. Each feature declares its own answers beside its code.
+//! What the features answer with, in the protocol's terms (places, edits,
+//! findings, fixes), before [`crate::protocol`] writes it as JSON: the pieces
+//! several features share. Each feature declares its own answers beside its
+//! code.
 
 use lsp_types::Range;
 use std::collections::BTreeMap;
@@ -26,3 +27,33 @@ pub type WorkspaceEdit = BTreeMap<String, Vec<TextEdit>>;
 /// name already taken): the user's to read.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Refusal(pub String);
+
+/// One finding, placed in the editor's terms: the compiler's
+/// ([`crate::diagnostics`]) or a verdict's ([`crate::verdicts`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Finding {
+    pub range: Range,
+    pub error: bool,
+    pub code: &'static str,
+    /// The message, with the help on a line of its own.
+    pub message: String,
+    /// The primary label, the secondary ones, the help and the witness, each
+    /// with its place.
+    pub related: Vec<(Location, String)>,
+    pub help: Option<String>,
+    /// The compiler's evidence, passed on as it gives it.
+    pub witness: Option<serde_json::Value>,
+    /// Shown faded: an event or a function nothing uses.
+    pub unnecessary: bool,
+}
+
+/// A quick fix of one finding ([`crate::actions`], [`crate::verdicts`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CodeAction {
+    pub title: String,
+    /// The finding it fixes.
+    pub finding: Finding,
+    /// The first fix the compiler gives.
+    pub preferred: bool,
+    pub edit: WorkspaceEdit,
+}

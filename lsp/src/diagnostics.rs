@@ -2,30 +2,11 @@
 //! place, every further label as related information, the help and the
 //! witness.
 
-use crate::data::Location;
+pub use crate::data::Finding;
 use crate::world::{Analysis, World};
-use lsp_types::Range;
 use situ_compiler::codes;
 use situ_grammar::diag::{Diagnostic, FileId, Severity};
 use std::collections::BTreeMap;
-
-/// One finding, placed in the editor's terms.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Finding {
-    pub range: Range,
-    pub error: bool,
-    pub code: &'static str,
-    /// The message, with the help on a line of its own.
-    pub message: String,
-    /// The primary label, the secondary ones, the help and the witness, each
-    /// with its place.
-    pub related: Vec<(Location, String)>,
-    pub help: Option<String>,
-    /// The compiler's evidence, passed on as it gives it.
-    pub witness: Option<serde_json::Value>,
-    /// Shown faded: an event or a function nothing uses.
-    pub unnecessary: bool,
-}
 
 /// One finding of the analysis.
 pub fn finding(a: &Analysis, d: &Diagnostic) -> Finding {
@@ -79,7 +60,7 @@ pub fn all(world: &World) -> Published {
         let uri = a.uri(file);
         let mut found: Vec<Finding> = of_file(a, file).map(|d| finding(a, d)).collect();
         // The verdicts of the properties and tests, while they are of these documents.
-        found.extend(crate::verdicts::findings(world, a, &uri).iter().cloned());
+        found.extend(world.verdicts.found(&a.root, world.generation(&a.root), &uri).iter().cloned());
         let version = world.docs.get(&path).map(|d| d.version);
         out.insert(uri, Some((version, found)));
     }

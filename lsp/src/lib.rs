@@ -15,11 +15,14 @@
 //!   JSON-RPC errors;
 //! - the features ([`nav`], [`complete`], [`actions`], [`tokens`],
 //!   [`diagnostics`], [`verdicts`]) take an analysis and a place and return
-//!   data in the protocol's terms ([`data`]), with no JSON.
+//!   data in the protocol's terms ([`data`]), with no JSON; they import
+//!   the documents ([`world`]), the data and [`diagnostics`] (a compiler
+//!   finding placed), and nothing below them imports a feature.
 //!
 //! The verdicts of properties and tests ([`verdicts`]) run `situ test`'s
 //! policy (`situ_verify::suite`) when a document is opened or saved, on a
-//! worker thread and a budget of work suited to an editor.
+//! worker thread and a budget of work suited to an editor; their state
+//! ([`runs`]) is kept by the [`world`], which imports no feature.
 
 pub mod actions;
 pub mod complete;
@@ -28,6 +31,7 @@ pub mod diagnostics;
 pub mod index;
 pub mod nav;
 pub mod protocol;
+pub mod runs;
 pub mod server;
 pub mod text;
 pub mod tokens;

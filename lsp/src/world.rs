@@ -8,6 +8,7 @@
 
 use crate::data::Location;
 use crate::index::Index;
+use crate::runs::Board;
 use crate::text::{path_to_uri, LineIndex};
 use situ_compiler::loader::{normalize, FsLoader, Loader};
 use situ_compiler::Checked;
@@ -173,7 +174,7 @@ pub struct World {
     generations: BTreeMap<PathBuf, u64>,
     next_generation: u64,
     /// The verdicts of the properties and tests, run on open and save.
-    pub verdicts: crate::verdicts::Board,
+    pub verdicts: Board,
 }
 
 impl World {

@@ -1,5 +1,8 @@
 use super::*;
 use crate::text::path_to_uri;
+use situ_verify::explore::Limits;
+use situ_verify::property::Engines;
+use situ_verify::random::Search;
 
 const FIXTURE: &str = include_str!("../../tests/fixtures/verdicts.situ");
 
