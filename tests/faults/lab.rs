@@ -3,7 +3,7 @@
 //! pair, each host with its own address in a /24 of the lab's own. Faults
 //! are made from outside the hosts: a partition sets the switch's end of a
 //! host's veth down; loss is an nftables rule in the host (`numgen random
-//! mod 100 < P drop` on what it sends to other hosts); delay is a relay of
+//! mod 100 < P drop` on what reaches it from other hosts); delay is a relay of
 //! our own (`relay.py`) in the switch namespace that holds each chunk of a
 //! TCP stream for D ms before passing it on.
 //!
@@ -66,7 +66,10 @@ pub struct Relay {
 impl Relay {
     /// The Zenoh endpoint through the relay to `host`'s `port`.
     pub fn endpoint(&self, host: &str, port: u16) -> String {
-        let p = self.ports.get(&(host.to_string(), port)).unwrap_or_else(|| panic!("the relay has no route to {host}:{port}"));
+        let p = self
+            .ports
+            .get(&(host.to_string(), port))
+            .unwrap_or_else(|| panic!("the relay has no route to {host}:{port}"));
         format!("tcp/{}:{p}", self.addr)
     }
 }
@@ -269,7 +272,11 @@ impl Lab {
     pub fn expect_success(&mut self, pid: Pid, timeout: Duration) {
         let status = self.wait(pid, timeout);
         if !status.is_some_and(|s| s.success()) {
-            panic!("`{}` ended with {status:?} (None: still running after {timeout:?})\n{}", self.label(pid), self.output(pid));
+            panic!(
+                "`{}` ended with {status:?} (None: still running after {timeout:?})\n{}",
+                self.label(pid),
+                self.output(pid)
+            );
         }
     }
 
@@ -327,8 +334,10 @@ impl Lab {
         ip(&["-n", &self.switch_ns(), "link", "set", &port, "up"]).unwrap_or_else(|e| panic!("heal: {e}"));
     }
 
-    /// Drops `percent` % of the packets `host` sends to other hosts (the
-    /// relay included), at random (nftables' `numgen random`); 0 ends it.
+    /// Drops `percent` % of the packets that reach `host` from other hosts
+    /// (the relay included), at random (nftables' `numgen random` in the
+    /// host's input hook); 0 ends it. Loss on every host is loss on every
+    /// link, each way.
     pub fn loss(&mut self, host: &str, percent: u8) {
         assert!(percent <= 100);
         let f = self.filters.entry(host.to_string()).or_default();
@@ -347,21 +356,24 @@ impl Lab {
 
     fn write_filter(&self, host: &str) {
         let f = self.filters.get(host).copied().unwrap_or_default();
-        let mut rules = String::new();
+        let mut out = String::new();
         if f.only_switch {
-            rules += &format!(
-                "    oifname \"eth0\" ip daddr {} ip daddr != {} drop\n",
-                self.subnet(),
-                self.switch_addr()
-            );
+            out +=
+                &format!("    oifname \"eth0\" ip daddr {} ip daddr != {} drop\n", self.subnet(), self.switch_addr());
         }
+        // Loss is made where the packets arrive: a packet dropped on its
+        // way out of its sender is not lost on the wire (the sender's call
+        // fails with EPERM, and TCP sends the segment again at once).
+        let mut input = String::new();
         if f.loss > 0 {
-            rules += &format!("    oifname \"eth0\" numgen random mod 100 < {} drop\n", f.loss);
+            input += &format!("    iifname \"eth0\" numgen random mod 100 < {} drop\n", f.loss);
         }
         // Made (if missing) then deleted, so that the script works on a
         // host with or without the table; then written anew.
         let script = format!(
-            "table inet {TABLE}\ndelete table inet {TABLE}\ntable inet {TABLE} {{\n  chain out {{\n    type filter hook output priority 0; policy accept;\n{rules}  }}\n}}\n"
+            "table inet {TABLE}\ndelete table inet {TABLE}\ntable inet {TABLE} {{\n\
+             \x20 chain out {{\n    type filter hook output priority 0; policy accept;\n{out}  }}\n\
+             \x20 chain in {{\n    type filter hook input priority 0; policy accept;\n{input}  }}\n}}\n"
         );
         let path = self.dir().join(format!("nft-{host}.conf"));
         std::fs::write(&path, script).expect("the nftables script");
@@ -369,32 +381,35 @@ impl Lab {
             .unwrap_or_else(|e| panic!("nftables in `{host}`: {e}"));
     }
 
-    /// The least retransmission timeout of `host`'s TCP towards the other
-    /// hosts (the route's `rto_min`; Linux's default is 200 ms).
-    pub fn rto_min(&self, host: &str, ms: u32) {
-        let ns = self.ns(host);
+    /// The least retransmission timeout of TCP between the lab's
+    /// namespaces, the switch's (a relay's sockets) included: the route's
+    /// `rto_min` (Linux's default is 200 ms).
+    pub fn rto_min(&self, ms: u32) {
         let rto = format!("{ms}ms");
         let subnet = self.subnet();
-        let addr = self.addr(host);
-        ip(&[
-            "-n", &ns, "route", "replace", &subnet, "dev", "eth0", "proto", "kernel", "scope", "link", "src", &addr,
-            "rto_min", &rto,
-        ])
-        .unwrap_or_else(|e| panic!("rto_min in `{host}`: {e}"));
+        let mut places: Vec<(String, &str, String)> =
+            self.hosts.iter().map(|h| (self.ns(h), "eth0", self.addr(h))).collect();
+        places.push((self.switch_ns(), "br0", self.switch_addr()));
+        for (ns, dev, addr) in places {
+            ip(&[
+                "-n", &ns, "route", "replace", &subnet, "dev", dev, "proto", "kernel", "scope", "link", "src", &addr,
+                "rto_min", &rto,
+            ])
+            .unwrap_or_else(|e| panic!("rto_min in {ns}: {e}"));
+        }
     }
 
     /// The kernel's TCP counters in `host` (`nstat -asz`: absolute values,
     /// zeros too): `TcpRetransSegs`, `TcpExtTCPTimeouts`,
     /// `TcpExtTCPLossProbes`, …
     pub fn tcp_counters(&self, host: &str) -> BTreeMap<String, u64> {
-        let out = run(Command::new("ip").args(["netns", "exec", &self.ns(host), "nstat", "-asz"]))
-            .unwrap_or_else(|e| panic!("nstat in `{host}`: {e}"));
-        out.lines()
-            .filter_map(|l| {
-                let mut w = l.split_whitespace();
-                Some((w.next()?.to_string(), w.next()?.parse().ok()?))
-            })
-            .collect()
+        counters(&self.ns(host))
+    }
+
+    /// The kernel's TCP counters of the switch's namespace (a relay's
+    /// sockets).
+    pub fn switch_tcp_counters(&self) -> BTreeMap<String, u64> {
+        counters(&self.switch_ns())
     }
 
     /// A relay in the switch namespace: one port of the switch's address for
@@ -419,6 +434,18 @@ impl Lab {
         }
         Relay { pid, ports, addr }
     }
+}
+
+/// The kernel's counters of a namespace (`nstat -asz`).
+fn counters(ns: &str) -> BTreeMap<String, u64> {
+    let out = run(Command::new("ip").args(["netns", "exec", ns, "nstat", "-asz"]))
+        .unwrap_or_else(|e| panic!("nstat in {ns}: {e}"));
+    out.lines()
+        .filter_map(|l| {
+            let mut w = l.split_whitespace();
+            Some((w.next()?.to_string(), w.next()?.parse().ok()?))
+        })
+        .collect()
 }
 
 impl Drop for Lab {

@@ -66,7 +66,15 @@ pub fn fig5_router() -> Vec<Proc> {
         connect: &["router"],
     };
     vec![
-        Proc { name: "router", host: "router", board: false, agents: &[], mode: "router", listen: Some(7447), connect: &[] },
+        Proc {
+            name: "router",
+            host: "router",
+            board: false,
+            agents: &[],
+            mode: "router",
+            listen: Some(7447),
+            connect: &[],
+        },
         client("board", &[], true),
         client("sensors", &["RFCCD", "LADAR"], false),
         client("pipeline", &["Fusion", "LPL", "Drive"], false),
@@ -244,7 +252,13 @@ pub fn seen(lab: &Lab, observer: Pid) -> Vec<Seen> {
 /// Waits until the observer has seen a status for which `f` holds (a
 /// status that arrived after `after_ns`); the first such, or `None` after
 /// `timeout`.
-pub fn wait_seen(lab: &Lab, observer: Pid, after_ns: u64, timeout: Duration, f: impl Fn(&Seen) -> bool) -> Option<Seen> {
+pub fn wait_seen(
+    lab: &Lab,
+    observer: Pid,
+    after_ns: u64,
+    timeout: Duration,
+    f: impl Fn(&Seen) -> bool,
+) -> Option<Seen> {
     let end = Instant::now() + timeout;
     loop {
         if let Some(s) = seen(lab, observer).into_iter().find(|s| s.at_ns > after_ns && f(s)) {
