@@ -10,11 +10,16 @@ use std::time::{Duration, Instant};
 
 pub const LONG: Duration = Duration::from_secs(60);
 
-/// Waits until the observer has seen `n` statuses after `after_ns`.
-fn wait_statuses(lab: &Lab, running: &Running, after_ns: u64, n: usize) {
+/// Waits until the observer has seen `n` statuses after `after_ns`, or
+/// the board's process has ended (its rules reached a final state).
+fn wait_statuses(lab: &mut Lab, running: &Running, after_ns: u64, n: usize) {
     let observer = running.observer.expect("an observer");
     let end = Instant::now() + LONG;
     while seen(lab, observer).iter().filter(|s| s.at_ns > after_ns).count() < n {
+        if lab.wait(running.procs["board"], Duration::ZERO).is_some() {
+            std::thread::sleep(Duration::from_secs(1));
+            return;
+        }
         if Instant::now() >= end {
             panic!("fewer than {n} statuses reached the observer within {LONG:?}\n{}", lab.outputs());
         }
@@ -59,7 +64,7 @@ pub fn partition_pipeline(cut: Duration) -> Partition {
     std::thread::sleep(cut);
     let healed_ns = now_ns();
     lab.heal("pipeline");
-    wait_statuses(&lab, &running, healed_ns, 5);
+    wait_statuses(&mut lab, &running, healed_ns, 5);
     stop_all(&mut lab, &running);
     let seen = seen(&lab, running.observer.unwrap());
     check_monotonic(&seen).unwrap();
@@ -80,24 +85,32 @@ pub fn partition_pipeline(cut: Duration) -> Partition {
 #[derive(Debug)]
 pub struct RouterRestart {
     pub killed_ns: u64,
-    /// The pipeline host's time without status across the kill (ms).
-    pub gap_ms: f64,
+    /// The pipeline host's time without status across the kill (ms);
+    /// `None`: no status came after it (the board stopped at a final state
+    /// before the router was back).
+    pub gap_ms: Option<f64>,
     /// From the new router's start to the first status (ms).
-    pub back_after_ms: f64,
+    pub back_after_ms: Option<f64>,
     pub safe: Vec<(u64, Option<u64>)>,
     pub board_out: String,
     pub pipeline_out: String,
+    /// The states the board's recording went through.
+    pub board_states: Vec<String>,
 }
 
 /// Fig. 5's processes as clients of a router process, each on its own host
-/// (the sensors' `stale after` 5 s, `fig5_rules_with_stale`); once every
-/// process follows RO, the router is killed (SIGKILL) and started again
-/// after `down`; the run goes on until the observer (a client of the
-/// router, on the pipeline's host) has had 5 statuses after the restart.
-pub fn restart_router(down: Duration) -> RouterRestart {
+/// (the sensors' `stale after` is `stale`, `fig5_rules_with_stale`, or the
+/// file's 500 ms); once every process follows RO, the router is killed
+/// (SIGKILL) and started again after `down`; the run goes on until the
+/// observer (a client of the router, on the pipeline's host) has had 5
+/// statuses after the restart.
+pub fn restart_router(down: Duration, stale: Option<&str>) -> RouterRestart {
     let mut lab = Lab::new(&["router", "board", "sensors", "pipeline"]);
     let procs = fig5_router();
-    let rules = fig5_rules_with_stale(&lab, "5s");
+    let rules = match stale {
+        Some(stale) => fig5_rules_with_stale(&lab, stale),
+        None => fig5_rules(),
+    };
     let deploy = write_deployment(&lab, "fig5", &procs, None);
     let mut running = start(&mut lab, &rules, &deploy, &procs);
     let at = format!("tcp/{}:7447", lab.addr("router"));
@@ -112,18 +125,19 @@ pub fn restart_router(down: Duration) -> RouterRestart {
     let restarted_ns = now_ns();
     let again = lab.spawn("router", "router-again", situ_run(&lab, &rules, &deploy, "router"));
     running.procs.insert("router".into(), again);
-    wait_statuses(&lab, &running, restarted_ns, 5);
+    wait_statuses(&mut lab, &running, restarted_ns, 5);
     stop_all(&mut lab, &running);
     let seen = seen(&lab, running.observer.unwrap());
     check_monotonic(&seen).unwrap();
-    let (gap_ms, back) = gap_across(&seen, killed_ns).expect("statuses before the kill and after it");
+    let across = gap_across(&seen, killed_ns);
     RouterRestart {
         killed_ns,
-        gap_ms,
-        back_after_ms: back.saturating_sub(restarted_ns) as f64 / 1e6,
+        gap_ms: across.map(|a| a.0),
+        back_after_ms: across.map(|a| a.1.saturating_sub(restarted_ns) as f64 / 1e6),
         safe: safe_mode_periods(&recording(&lab, "pipeline")),
         board_out: lab.stdout(running.procs["board"]),
         pipeline_out: lab.stdout(running.procs["pipeline"]),
+        board_states: recorded_states(&recording(&lab, "board")),
     }
 }
 

@@ -165,12 +165,15 @@ pub fn recording(lab: &Lab, process: &str) -> PathBuf {
 /// A deployment running in a lab: each process's `Pid` by name.
 pub struct Running {
     pub procs: BTreeMap<String, Pid>,
+    /// The processes with `board = true`.
+    pub boards: Vec<String>,
     pub observer: Option<Pid>,
 }
 
 /// Starts every process of `procs` in its host.
 pub fn start(lab: &mut Lab, rules: &Path, deploy: &Path, procs: &[Proc]) -> Running {
-    let mut running = Running { procs: BTreeMap::new(), observer: None };
+    let boards = procs.iter().filter(|p| p.board).map(|p| p.name.to_string()).collect();
+    let mut running = Running { procs: BTreeMap::new(), boards, observer: None };
     for p in procs {
         let cmd = situ_run(lab, rules, deploy, p.name);
         let pid = lab.spawn(p.host, p.name, cmd);
@@ -202,12 +205,13 @@ pub fn terminate(lab: &mut Lab, pid: Pid) {
     }
 }
 
-/// Stops the agents' processes first, then the board, then the router,
-/// and checks that each ended well.
+/// Stops the agents' processes first, then the boards, then the router,
+/// and checks that each ended well (a process the scenario killed is
+/// taken out of `running.procs` first).
 pub fn stop_all(lab: &mut Lab, running: &Running) {
     let order = |name: &str| match name {
         "router" => 2,
-        n if n.starts_with("board") => 1,
+        n if running.boards.iter().any(|b| b == n) => 1,
         _ => 0,
     };
     let mut names: Vec<&String> = running.procs.keys().collect();

@@ -1,0 +1,108 @@
+//! The standby board's scenario (issue 31): Fig. 5 with two boards, the
+//! leader killed. A deployment marks two processes `board = true` (the
+//! first listed leads at start); every status carries `epoch` (the highest
+//! wins) and `board` (the leading process's name).
+
+use super::lab::Lab;
+use super::scenarios::LONG;
+use super::stack::*;
+use std::time::{Duration, Instant};
+
+/// Fig. 5 as peers with a second board: `board` (leads at start) and
+/// `standby` on hosts of their own; the agents' processes meet both.
+pub fn fig5_two_boards() -> Vec<Proc> {
+    let mut procs = fig5_peers();
+    procs.insert(
+        1,
+        Proc {
+            name: "standby",
+            host: "standby",
+            board: true,
+            agents: &[],
+            mode: "peer",
+            listen: Some(7447),
+            connect: &["board"],
+        },
+    );
+    for p in &mut procs {
+        match p.name {
+            "sensors" => p.connect = &["board", "standby"],
+            "pipeline" => p.connect = &["board", "standby", "sensors"],
+            _ => {}
+        }
+    }
+    procs
+}
+
+/// What killing the leading board did.
+#[derive(Debug)]
+pub struct Takeover {
+    pub killed_ns: u64,
+    /// The epoch and board of the last status before the kill.
+    pub epoch_before: u64,
+    pub board_before: Option<String>,
+    /// From the kill to the first status of a higher epoch on the
+    /// pipeline's host (ms).
+    pub takeover_ms: f64,
+    pub epoch_after: u64,
+    pub board_after: Option<String>,
+    /// The pipeline host's time without status across the kill (ms).
+    pub gap_ms: f64,
+    /// The pipeline's safe-mode periods (ns).
+    pub safe: Vec<(u64, Option<u64>)>,
+    pub standby_out: String,
+    pub pipeline_out: String,
+    /// The states the standby's recording went through.
+    pub standby_states: Vec<String>,
+}
+
+/// Fig. 5 with two boards on four hosts (`board`, `standby`, `sensors`,
+/// `pipeline`); once the observer on the pipeline's host (a client of the
+/// pipeline's process: what it gets) has seen RO from the leader, the
+/// leader's process is killed (SIGKILL); the run goes on until the
+/// observer has had a status of a higher epoch and 5 statuses after it.
+/// Panics if no higher epoch comes within a minute, or if an epoch seen
+/// ever goes back.
+pub fn kill_leading_board() -> Takeover {
+    let mut lab = Lab::new(&["board", "standby", "sensors", "pipeline"]);
+    let procs = fig5_two_boards();
+    let deploy = write_deployment(&lab, "fig5", &procs, None);
+    let mut running = start(&mut lab, &fig5_rules(), &deploy, &procs);
+    let at = format!("tcp/{}:7449", lab.addr("pipeline"));
+    let observer = observe(&mut lab, "pipeline", &at, "client", "fig5");
+    running.observer = Some(observer);
+    for p in ["sensors", "pipeline"] {
+        wait_state(&mut lab, &running, p, "RO", LONG);
+    }
+    wait_seen(&lab, observer, 0, LONG, |s| s.state == "RO" && s.epoch.is_some())
+        .unwrap_or_else(|| panic!("no status with an epoch in RO\n{}", lab.outputs()));
+    std::thread::sleep(Duration::from_millis(500));
+    let before = seen(&lab, observer).pop().expect("a status before the kill");
+    let epoch_before = before.epoch.expect("statuses carry their epoch");
+    let killed_ns = now_ns();
+    lab.kill9(running.procs.remove("board").expect("the leading board"));
+    let after = wait_seen(&lab, observer, killed_ns, LONG, |s| s.epoch.is_some_and(|e| e > epoch_before))
+        .unwrap_or_else(|| panic!("no status of an epoch above {epoch_before} after the kill\n{}", lab.outputs()));
+    let end = Instant::now() + LONG;
+    while seen(&lab, observer).iter().filter(|s| s.at_ns > after.at_ns).count() < 5 {
+        assert!(Instant::now() < end, "statuses stopped after the takeover\n{}", lab.outputs());
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    stop_all(&mut lab, &running);
+    let all = seen(&lab, observer);
+    check_monotonic(&all).unwrap_or_else(|e| panic!("{e}"));
+    let (gap_ms, _) = gap_across(&all, killed_ns).expect("statuses before and after the kill");
+    Takeover {
+        killed_ns,
+        epoch_before,
+        board_before: before.board,
+        takeover_ms: after.at_ns.saturating_sub(killed_ns) as f64 / 1e6,
+        epoch_after: after.epoch.unwrap_or(0),
+        board_after: after.board,
+        gap_ms,
+        safe: safe_mode_periods(&recording(&lab, "pipeline")),
+        standby_out: lab.stdout(running.procs["standby"]),
+        pipeline_out: lab.stdout(running.procs["pipeline"]),
+        standby_states: recorded_states(&recording(&lab, "standby")),
+    }
+}
