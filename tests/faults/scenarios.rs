@@ -32,7 +32,7 @@ fn wait_statuses(lab: &mut Lab, running: &Running, after_ns: u64, n: usize) {
 pub struct Partition {
     pub cut_ns: u64,
     pub healed_ns: u64,
-    /// The pipeline host's time without status across the cut (ms).
+    /// The pipeline host's time without status across the heal (ms).
     pub gap_ms: f64,
     /// From the heal to the first status there (ms).
     pub back_after_ms: f64,
@@ -68,7 +68,10 @@ pub fn partition_pipeline(cut: Duration) -> Partition {
     stop_all(&mut lab, &running);
     let seen = seen(&lab, running.observer.unwrap());
     check_monotonic(&seen).unwrap();
-    let (gap_ms, back) = gap_across(&seen, cut_ns).expect("statuses before the cut and after it");
+    // Nothing arrives while the host is cut off (a status on its way at
+    // the cut may arrive just after it): the time without status is the
+    // one across the heal.
+    let (gap_ms, back) = gap_across(&seen, healed_ns).expect("statuses before the heal and after it");
     Partition {
         cut_ns,
         healed_ns,
@@ -85,7 +88,7 @@ pub fn partition_pipeline(cut: Duration) -> Partition {
 #[derive(Debug)]
 pub struct RouterRestart {
     pub killed_ns: u64,
-    /// The pipeline host's time without status across the kill (ms);
+    /// The pipeline host's time without status across the restart (ms);
     /// `None`: no status came after it (the board stopped at a final state
     /// before the router was back).
     pub gap_ms: Option<f64>,
@@ -129,7 +132,10 @@ pub fn restart_router(down: Duration, stale: Option<&str>) -> RouterRestart {
     stop_all(&mut lab, &running);
     let seen = seen(&lab, running.observer.unwrap());
     check_monotonic(&seen).unwrap();
-    let across = gap_across(&seen, killed_ns);
+    // Nothing arrives while no router runs (a status on its way at the
+    // kill may arrive just after it): the time without status is the one
+    // across the restart.
+    let across = gap_across(&seen, restarted_ns);
     RouterRestart {
         killed_ns,
         gap_ms: across.map(|a| a.0),

@@ -306,9 +306,11 @@ pub fn percentiles(v: &[f64]) -> (f64, f64, f64) {
     (at(0.5), at(0.99), v[v.len() - 1])
 }
 
-/// The longest time without status around `t_ns`: from the last arrival
-/// at or before `t_ns` to the first after it (ms), with that first
-/// arrival; `None` if nothing came after.
+/// The time without status across `t_ns`: from the last arrival at or
+/// before `t_ns` to the first after it (ms), with that first arrival;
+/// `None` if nothing came after. Choose `t_ns` when nothing can arrive
+/// (a cut host's heal, a router's restart): a status on its way at a
+/// fault's start may arrive just after it.
 pub fn gap_across(seen: &[Seen], t_ns: u64) -> Option<(f64, u64)> {
     let before = seen.iter().filter(|s| s.at_ns <= t_ns).map(|s| s.at_ns).max()?;
     let after = seen.iter().find(|s| s.at_ns > t_ns)?.at_ns;

@@ -46,7 +46,8 @@ pub struct Takeover {
     pub takeover_ms: f64,
     pub epoch_after: u64,
     pub board_after: Option<String>,
-    /// The pipeline host's time without status across the kill (ms).
+    /// The pipeline host's time without status before the first status of
+    /// the new epoch (ms).
     pub gap_ms: f64,
     /// The pipeline's safe-mode periods (ns).
     pub safe: Vec<(u64, Option<u64>)>,
@@ -91,7 +92,9 @@ pub fn kill_leading_board() -> Takeover {
     stop_all(&mut lab, &running);
     let all = seen(&lab, observer);
     check_monotonic(&all).unwrap_or_else(|e| panic!("{e}"));
-    let (gap_ms, _) = gap_across(&all, killed_ns).expect("statuses before and after the kill");
+    // The time without status: up to the first status of the new epoch
+    // (one of the old leader's may arrive just after the kill).
+    let (gap_ms, _) = gap_across(&all, after.at_ns - 1).expect("statuses before and after the takeover");
     Takeover {
         killed_ns,
         epoch_before,
