@@ -461,5 +461,11 @@ impl Drop for Lab {
                 eprintln!("lab: {e}");
             }
         }
+        // SITU_LAB_KEEP=1 keeps the lab's files (the deployment, the
+        // recordings, each process's output) of a test that failed.
+        if std::thread::panicking() && std::env::var_os("SITU_LAB_KEEP").is_some() {
+            let dir = std::mem::replace(&mut self.dir, tempfile::tempdir().expect("a temporary directory"));
+            eprintln!("lab: kept {}", dir.keep().display());
+        }
     }
 }

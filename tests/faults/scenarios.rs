@@ -42,6 +42,10 @@ pub struct Partition {
     pub sensors_safe: Vec<(u64, Option<u64>)>,
     pub board_out: String,
     pub pipeline_out: String,
+    /// The states the board's recording went through before the
+    /// stop, and the path the pipeline followed.
+    pub board_states: Vec<String>,
+    pub pipeline_path: Vec<String>,
 }
 
 /// Fig. 5 on three hosts; once every process follows RO, the pipeline's
@@ -65,7 +69,7 @@ pub fn partition_pipeline(cut: Duration) -> Partition {
     let healed_ns = now_ns();
     lab.heal("pipeline");
     wait_statuses(&mut lab, &running, healed_ns, 5);
-    stop_all(&mut lab, &running);
+    let stopped = stop_all(&mut lab, &running);
     let seen = seen(&lab, running.observer.unwrap());
     check_monotonic(&seen).unwrap();
     // Nothing arrives while the host is cut off (a status on its way at
@@ -77,10 +81,12 @@ pub fn partition_pipeline(cut: Duration) -> Partition {
         healed_ns,
         gap_ms,
         back_after_ms: back.saturating_sub(healed_ns) as f64 / 1e6,
-        safe: safe_mode_periods(&recording(&lab, "pipeline")),
-        sensors_safe: safe_mode_periods(&recording(&lab, "sensors")),
+        safe: safe_mode_periods(&recording(&lab, "pipeline"), stopped),
+        sensors_safe: safe_mode_periods(&recording(&lab, "sensors"), stopped),
         board_out: lab.stdout(running.procs["board"]),
         pipeline_out: lab.stdout(running.procs["pipeline"]),
+        board_states: recorded_states(&recording(&lab, "board"), stopped),
+        pipeline_path: path(&lab.stdout(running.procs["pipeline"])),
     }
 }
 
@@ -97,8 +103,10 @@ pub struct RouterRestart {
     pub safe: Vec<(u64, Option<u64>)>,
     pub board_out: String,
     pub pipeline_out: String,
-    /// The states the board's recording went through.
+    /// The states the board's recording went through before the
+    /// stop, and the path the pipeline followed.
     pub board_states: Vec<String>,
+    pub pipeline_path: Vec<String>,
 }
 
 /// Fig. 5's processes as clients of a router process, each on its own host
@@ -129,7 +137,7 @@ pub fn restart_router(down: Duration, stale: Option<&str>) -> RouterRestart {
     let again = lab.spawn("router", "router-again", situ_run(&lab, &rules, &deploy, "router"));
     running.procs.insert("router".into(), again);
     wait_statuses(&mut lab, &running, restarted_ns, 5);
-    stop_all(&mut lab, &running);
+    let stopped = stop_all(&mut lab, &running);
     let seen = seen(&lab, running.observer.unwrap());
     check_monotonic(&seen).unwrap();
     // Nothing arrives while no router runs (a status on its way at the
@@ -140,10 +148,11 @@ pub fn restart_router(down: Duration, stale: Option<&str>) -> RouterRestart {
         killed_ns,
         gap_ms: across.map(|a| a.0),
         back_after_ms: across.map(|a| a.1.saturating_sub(restarted_ns) as f64 / 1e6),
-        safe: safe_mode_periods(&recording(&lab, "pipeline")),
+        safe: safe_mode_periods(&recording(&lab, "pipeline"), stopped),
         board_out: lab.stdout(running.procs["board"]),
         pipeline_out: lab.stdout(running.procs["pipeline"]),
-        board_states: recorded_states(&recording(&lab, "board")),
+        board_states: recorded_states(&recording(&lab, "board"), stopped),
+        pipeline_path: path(&lab.stdout(running.procs["pipeline"])),
     }
 }
 
@@ -163,7 +172,10 @@ pub struct Lossy {
     /// the loss lasted.
     pub tcp: BTreeMap<String, u64>,
     pub board_out: String,
+    /// The states the board's recording went through before the
+    /// stop, and the path the pipeline followed.
     pub board_states: Vec<String>,
+    pub pipeline_path: Vec<String>,
 }
 
 /// The settings of [`delay_and_loss`].
@@ -228,7 +240,7 @@ pub fn delay_and_loss(s: &LossySettings) -> Lossy {
     let to_ns = now_ns();
     let after = tcp_total(&lab);
     std::thread::sleep(Duration::from_millis(500));
-    stop_all(&mut lab, &running);
+    let stopped = stop_all(&mut lab, &running);
     let seen = seen(&lab, running.observer.unwrap());
     check_monotonic(&seen).unwrap();
     let within: Vec<f64> =
@@ -239,11 +251,12 @@ pub fn delay_and_loss(s: &LossySettings) -> Lossy {
         to_ns,
         statuses: within.len(),
         gaps_ms: within,
-        safe: safe_mode_periods(&recording(&lab, "pipeline")),
+        safe: safe_mode_periods(&recording(&lab, "pipeline"), stopped),
         arrivals: seen.iter().map(|s| s.at_ns).collect(),
         tcp,
         board_out: lab.stdout(running.procs["board"]),
-        board_states: recorded_states(&recording(&lab, "board")),
+        board_states: recorded_states(&recording(&lab, "board"), stopped),
+        pipeline_path: path(&lab.stdout(running.procs["pipeline"])),
     }
 }
 

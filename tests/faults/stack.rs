@@ -205,22 +205,21 @@ pub fn terminate(lab: &mut Lab, pid: Pid) {
     }
 }
 
-/// Stops the agents' processes first, then the boards, then the router,
-/// and checks that each ended well (a process the scenario killed is
-/// taken out of `running.procs` first).
-pub fn stop_all(lab: &mut Lab, running: &Running) {
-    let order = |name: &str| match name {
-        "router" => 2,
-        n if running.boards.iter().any(|b| b == n) => 1,
-        _ => 0,
-    };
-    let mut names: Vec<&String> = running.procs.keys().collect();
-    names.sort_by_key(|n| order(n));
-    for n in names {
-        let pid = running.procs[n];
-        terminate(lab, pid);
-        lab.expect_success(pid, Duration::from_secs(60));
+/// Stops every process of `running` at once (SIGTERM), checks that each
+/// ended well, and returns when the signals went (ns). At once: a board
+/// that outlives its agents by their `stale after` takes them for silent
+/// (an emergency), agents that outlive the board by 600 ms enter safe
+/// mode; the scenarios judge what happened before this time. A process
+/// the scenario killed is taken out of `running.procs` first.
+pub fn stop_all(lab: &mut Lab, running: &Running) -> u64 {
+    let stopping = now_ns();
+    for pid in running.procs.values() {
+        terminate(lab, *pid);
     }
+    for pid in running.procs.values() {
+        lab.expect_success(*pid, Duration::from_secs(60));
+    }
+    stopping
 }
 
 pub fn now_ns() -> u64 {
@@ -334,9 +333,10 @@ pub fn check_monotonic(seen: &[Seen]) -> Result<(), String> {
     Ok(())
 }
 
-/// The safe-mode periods of a follower's recording: `(entered, left)`,
-/// times in ns (`None`: still in safe mode when the recording ended).
-pub fn safe_mode_periods(path: &Path) -> Vec<(u64, Option<u64>)> {
+/// The safe-mode periods of a follower's recording that began before
+/// `before` (ns): `(entered, left)`, times in ns (`None`: still in safe
+/// mode when the recording ended).
+pub fn safe_mode_periods(path: &Path, before: u64) -> Vec<(u64, Option<u64>)> {
     let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let (messages, _) = situ_runtime::record::mcap::read_messages(&bytes).expect("a readable recording");
     let mut periods: Vec<(u64, Option<u64>)> = Vec::new();
@@ -345,7 +345,7 @@ pub fn safe_mode_periods(path: &Path) -> Vec<(u64, Option<u64>)> {
             continue;
         }
         let text = m["message"].as_str().unwrap_or("");
-        if text.contains("no status from the Bulletinboard: safe mode") {
+        if text.contains("no status from the Bulletinboard: safe mode") && *time < before {
             periods.push((*time, None));
         } else if text.contains("safe mode ends") {
             if let Some(last) = periods.last_mut().filter(|p| p.1.is_none()) {
@@ -356,13 +356,21 @@ pub fn safe_mode_periods(path: &Path) -> Vec<(u64, Option<u64>)> {
     periods
 }
 
-/// The states a recording's process went through (`/state` changes).
-pub fn recorded_states(path: &Path) -> Vec<String> {
+/// The path a process's summary prints (`path: RS → RO`), as states.
+pub fn path(stdout: &str) -> Vec<String> {
+    let line = stdout.lines().find_map(|l| l.strip_prefix("path: ")).unwrap_or("");
+    line.split(" → ").filter(|s| !s.is_empty()).map(str::to_string).collect()
+}
+
+/// The states the Bulletinboard's recording went through before `before`
+/// (ns; its `/state` changes: a follower's recording has none, its
+/// summary's [`path`] says what it followed).
+pub fn recorded_states(path: &Path, before: u64) -> Vec<String> {
     let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let (messages, _) = situ_runtime::record::mcap::read_messages(&bytes).expect("a readable recording");
     messages
         .iter()
-        .filter(|(t, _, m)| t == "/state" && m["from"] != m["state"])
+        .filter(|(t, time, m)| t == "/state" && m["from"] != m["state"] && *time < before)
         .filter_map(|(_, _, m)| m["state"].as_str().map(str::to_string))
         .collect()
 }

@@ -53,8 +53,10 @@ pub struct Takeover {
     pub safe: Vec<(u64, Option<u64>)>,
     pub standby_out: String,
     pub pipeline_out: String,
-    /// The states the standby's recording went through.
+    /// The states the standby's recording went through before the
+    /// stop, and the path the pipeline followed.
     pub standby_states: Vec<String>,
+    pub pipeline_path: Vec<String>,
 }
 
 /// Fig. 5 with two boards on four hosts (`board`, `standby`, `sensors`,
@@ -89,7 +91,7 @@ pub fn kill_leading_board() -> Takeover {
         assert!(Instant::now() < end, "statuses stopped after the takeover\n{}", lab.outputs());
         std::thread::sleep(Duration::from_millis(50));
     }
-    stop_all(&mut lab, &running);
+    let stopped = stop_all(&mut lab, &running);
     let all = seen(&lab, observer);
     check_monotonic(&all).unwrap_or_else(|e| panic!("{e}"));
     // The time without status: up to the first status of the new epoch
@@ -103,9 +105,10 @@ pub fn kill_leading_board() -> Takeover {
         epoch_after: after.epoch.unwrap_or(0),
         board_after: after.board,
         gap_ms,
-        safe: safe_mode_periods(&recording(&lab, "pipeline")),
+        safe: safe_mode_periods(&recording(&lab, "pipeline"), stopped),
         standby_out: lab.stdout(running.procs["standby"]),
         pipeline_out: lab.stdout(running.procs["pipeline"]),
-        standby_states: recorded_states(&recording(&lab, "standby")),
+        standby_states: recorded_states(&recording(&lab, "standby"), stopped),
+        pipeline_path: path(&lab.stdout(running.procs["pipeline"])),
     }
 }
