@@ -17,6 +17,15 @@
 //! cert = "certs/board.pem"           # with TLS
 //! key = "certs/board.key"
 //!
+//! # [[process]]                    # a second board: a standby (issue of
+//! # name = "board-b"                 # docs/reliability.md): the first listed
+//! # board = true                     # leads at start, the others follow its log
+//! # listen = ["tcp/127.0.0.1:7450"]  # and one of them leads when it falls silent
+//!
+//! # [standby]                        # optional, with two boards or more
+//! # lease_ms = 400                   # a follower leads after this long without the leader
+//! # replicate_within_ms = 100        # a change waits this long at most for the followers
+//!
 //! [[process]]
 //! name = "sensors"
 //! agents = ["RFCCD", "LADAR"]
@@ -49,9 +58,26 @@ pub struct Deployment {
     pub tls: Option<Tls>,
     #[serde(rename = "process")]
     pub processes: Vec<Process>,
+    /// The standby boards' settings (with two boards or more).
+    #[serde(default)]
+    pub standby: Option<StandbySettings>,
     /// The directory of the file (relative paths are relative to it).
     #[serde(skip)]
     pub dir: PathBuf,
+}
+
+/// `[standby]`: how the boards of a standby group hand over.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StandbySettings {
+    /// A follower leads after this long without hearing the leader (ms;
+    /// default two status periods, 400).
+    #[serde(default)]
+    pub lease_ms: Option<u64>,
+    /// A change of state waits at most this long for the followers to have
+    /// its entries before it is broadcast (ms; default 100).
+    #[serde(default)]
+    pub replicate_within_ms: Option<u64>,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -199,11 +225,27 @@ impl Deployment {
             )));
         }
         let boards: Vec<&str> = d.processes.iter().filter(|p| p.board).map(|p| p.name.as_str()).collect();
-        if boards.len() != 1 {
-            return Err(DeployError(format!(
-                "exactly one process hosts the Bulletinboard (`board = true`); found {}",
-                if boards.is_empty() { "none".to_string() } else { boards.join(", ") }
-            )));
+        if boards.is_empty() {
+            return Err(DeployError(
+                "no process hosts the Bulletinboard (`board = true`): one does, or two and more (a standby group)"
+                    .into(),
+            ));
+        }
+        if boards.len() > 255 {
+            return Err(DeployError(format!("{} boards: at most 255", boards.len())));
+        }
+        if let Some(s) = &d.standby {
+            if boards.len() < 2 {
+                return Err(DeployError(
+                    "`[standby]` with one board: a standby group has two boards or more (`board = true`)".into(),
+                ));
+            }
+            if s.lease_ms.is_some_and(|ms| !(50..=60_000).contains(&ms)) {
+                return Err(DeployError("`[standby] lease_ms`: from 50 to 60000".into()));
+            }
+            if s.replicate_within_ms.is_some_and(|ms| ms > 10_000) {
+                return Err(DeployError("`[standby] replicate_within_ms`: at most 10000".into()));
+            }
         }
         let mut seen: Vec<(&str, &str)> = Vec::new();
         for p in &d.processes {
@@ -286,8 +328,24 @@ impl Deployment {
         self.processes.iter().find(|p| agents.iter().all(|a| p.agents.contains(a)))
     }
 
+    /// The process of the board that leads at start (the first listed).
     pub fn board(&self) -> &Process {
-        self.processes.iter().find(|p| p.board).expect("checked: one board")
+        self.processes.iter().find(|p| p.board).expect("checked: a board")
+    }
+
+    /// The boards, in their order of rank (the first leads at start).
+    pub fn boards(&self) -> Vec<&Process> {
+        self.processes.iter().filter(|p| p.board).collect()
+    }
+
+    /// Whether the boards form a standby group (two or more).
+    pub fn has_standby(&self) -> bool {
+        self.processes.iter().filter(|p| p.board).count() > 1
+    }
+
+    /// A board's place among the boards (0 leads at start), if it is one.
+    pub fn rank(&self, process: &str) -> Option<u32> {
+        self.boards().iter().position(|p| p.name == process).map(|i| i as u32)
     }
 
     fn path(&self, p: &Path) -> String {
@@ -347,15 +405,17 @@ impl Deployment {
                   "key_exprs": [format!("situ/{robot}/status")] },
                 { "id": "streams", "messages": ["put"], "flows": ["ingress", "egress"], "permission": "allow",
                   "key_exprs": [format!("situ/{robot}/event/**"), format!("situ/{robot}/data/**")] },
-                { "id": "subscribe", "messages": ["declare_subscriber", "declare_liveliness_subscriber", "liveliness_token"],
+                { "id": "boards", "messages": ["put", "query", "reply"], "flows": ["ingress", "egress"], "permission": "allow",
+                  "key_exprs": [format!("situ/{robot}/board/**")] },
+                { "id": "subscribe", "messages": ["declare_subscriber", "declare_liveliness_subscriber", "liveliness_token", "declare_queryable"],
                   "flows": ["ingress", "egress"], "permission": "allow", "key_exprs": ["**"] },
             ],
             "subjects": [
-                { "id": "board", "cert_common_names": [self.board().name] },
+                { "id": "board", "cert_common_names": self.boards().iter().map(|p| p.name.as_str()).collect::<Vec<_>>() },
                 { "id": "members", "cert_common_names": all },
             ],
             "policies": [
-                { "id": "board_status", "rules": ["status_in"], "subjects": ["board"] },
+                { "id": "board_status", "rules": ["status_in", "boards"], "subjects": ["board"] },
                 { "id": "members_streams", "rules": ["status_out", "streams", "subscribe"], "subjects": ["members"] },
             ],
         })
@@ -405,9 +465,20 @@ connect = ["tcp/127.0.0.1:7447"]
     }
 
     #[test]
+    fn two_boards_are_a_standby_group_ranked_in_their_order() {
+        let text = format!("{GOOD}[[process]]\nname = \"b2\"\nboard = true\n[standby]\nlease_ms = 500\n");
+        let d = Deployment::parse(&text, &agents()).unwrap();
+        assert!(d.has_standby());
+        assert_eq!((d.rank("board"), d.rank("b2"), d.rank("sensors")), (Some(0), Some(1), None));
+        assert_eq!(d.board().name, "board");
+        assert_eq!(d.standby.as_ref().and_then(|s| s.lease_ms), Some(500));
+        assert!(!Deployment::parse(GOOD, &agents()).unwrap().has_standby());
+    }
+
+    #[test]
     fn bad_files_say_what_is_wrong() {
         let cases = [
-            (GOOD.replace("board = true", ""), "exactly one process hosts the Bulletinboard"),
+            (GOOD.replace("board = true", ""), "no process hosts the Bulletinboard"),
             (GOOD.replace("\"LADAR\"]", "\"LADAR\", \"Ghost\"]"), "`Ghost`, which the rules do not declare"),
             (
                 GOOD.replace(
@@ -420,6 +491,11 @@ connect = ["tcp/127.0.0.1:7447"]
             (GOOD.replace("agents = [", "agent = ["), "unknown field `agent`"),
             (format!("{GOOD}\n[tls]\nca = \"ca.pem\"\n"), "use `tls/` endpoints"),
             (GOOD.replace("robot = \"amr\"", "robot = \"amr\"\nmax_skew_ms = 3600000"), "at most 10000"),
+            (format!("{GOOD}[standby]\nlease_ms = 300\n"), "a standby group has two boards or more"),
+            (
+                format!("{GOOD}[[process]]\nname = \"b2\"\nboard = true\n[standby]\nlease_ms = 10\n"),
+                "`[standby] lease_ms`: from 50 to 60000",
+            ),
             (
                 format!("{GOOD}[[process]]\nname = \"x\"\nexternal = true\n"),
                 "process `x`: `external = true` but it runs no agents",

@@ -15,6 +15,7 @@
 
 pub mod deploy;
 pub mod limit;
+pub mod standby;
 pub mod wire;
 
 use situ_compiler::bundle::Content;
@@ -76,7 +77,12 @@ pub struct ZenohBus {
     refusals: Arc<Mutex<Refusals>>,
     /// Per agent, the events refused for going over its limit.
     limits: Arc<Mutex<limit::EventLimits>>,
+    /// The other boards, when this process's board is one of a standby group.
+    peers: Option<Arc<standby::BoardPeers>>,
+    /// Statuses of an epoch below the highest seen: an old leader's, ignored.
+    old_epoch: Arc<AtomicU64>,
     _subscribers: Vec<zenoh::pubsub::Subscriber<()>>,
+    _queryable: Option<zenoh::query::Queryable<()>>,
 }
 
 /// Why the bus could not start.
@@ -99,6 +105,20 @@ impl ZenohBus {
         placement: Placement,
         config: &str,
         capacity: Capacity,
+    ) -> Result<ZenohBus, BusError> {
+        Self::open_in_group(content, placement, config, capacity, None)
+    }
+
+    /// As [`open`](Self::open), for a board of a standby group: it also
+    /// hears the other boards (their status, log, acknowledgements) and
+    /// answers their catch-up requests; it publishes its status only while
+    /// it leads ([`standby::BoardPeers`], through [`peers`](Self::peers)).
+    pub fn open_in_group(
+        content: Arc<Content>,
+        placement: Placement,
+        config: &str,
+        capacity: Capacity,
+        group: Option<standby::BoardGroup>,
     ) -> Result<ZenohBus, BusError> {
         let config = zenoh::Config::from_json5(config).map_err(|e| BusError(format!("Zenoh configuration: {e}")))?;
         let session =
@@ -167,15 +187,68 @@ impl ZenohBus {
                 .wait()
                 .map_err(|e| BusError(format!("cannot subscribe to events: {e}")))?;
             subscribers.push(sub);
-        } else {
+        }
+        let old_epoch = Arc::new(AtomicU64::new(0));
+        let peers = match (&group, placement.board) {
+            (Some(g), true) => {
+                Some(Arc::new(standby::BoardPeers::new(g, &robot, session.clone(), content.clone(), local.clone())))
+            }
+            _ => None,
+        };
+        let mut queryable = None;
+        if let Some(peers) = &peers {
+            // The other boards' status, log and acknowledgements.
+            let p = peers.clone();
+            let sub = session
+                .declare_subscriber(wire::status_key(&robot))
+                .callback(move |sample| {
+                    if let Ok(w) = wire::parse::<StatusWire>(&sample.payload().to_bytes()) {
+                        p.on_status(&w);
+                    }
+                })
+                .wait()
+                .map_err(|e| BusError(format!("cannot subscribe to the status: {e}")))?;
+            subscribers.push(sub);
+            let p = peers.clone();
+            let sub = session
+                .declare_subscriber(standby::log_key(&robot))
+                .callback(move |sample| p.on_batch(&sample.payload().to_bytes()))
+                .wait()
+                .map_err(|e| BusError(format!("cannot subscribe to the boards' log: {e}")))?;
+            subscribers.push(sub);
+            let p = peers.clone();
+            let sub = session
+                .declare_subscriber(format!("situ/{robot}/board/ack/*"))
+                .callback(move |sample| p.on_ack(&sample.payload().to_bytes()))
+                .wait()
+                .map_err(|e| BusError(format!("cannot subscribe to the boards' acknowledgements: {e}")))?;
+            subscribers.push(sub);
+            let p = peers.clone();
+            let q = session
+                .declare_queryable(format!("situ/{robot}/board/sync/*"))
+                .callback(move |query| p.answer(&query))
+                .wait()
+                .map_err(|e| BusError(format!("cannot answer the boards' catch-up requests: {e}")))?;
+            queryable = Some(q);
+        } else if !placement.board {
             let (local, content, refuse) = (local.clone(), content.clone(), refuse.clone());
+            // The highest epoch seen: a status of a lower one is an old
+            // leader's (a board that has not yet learned it was replaced).
+            let highest = Arc::new(AtomicU64::new(0));
+            let old = old_epoch.clone();
             let sub = session
                 .declare_subscriber(wire::status_key(&robot))
                 .callback(move |sample| {
                     let bytes = sample.payload().to_bytes();
                     match wire::parse::<StatusWire>(&bytes) {
                         Ok(w) => match content.state_id(&w.state) {
-                            Some(state) => local.send_status(StatusMsg { state, time: w.time_ns, seq: w.seq }),
+                            Some(state) => {
+                                if w.epoch < highest.fetch_max(w.epoch, Ordering::AcqRel) {
+                                    old.fetch_add(1, Ordering::Relaxed);
+                                    return;
+                                }
+                                local.send_status(StatusMsg { state, time: w.time_ns, seq: w.seq })
+                            }
                             None => refuse(format!("status: unknown state `{}`", w.state)),
                         },
                         Err(e) => refuse(format!("status: {e}")),
@@ -213,7 +286,30 @@ impl ZenohBus {
                 .map_err(|e| BusError(format!("cannot subscribe to data: {e}")))?;
             subscribers.push(sub);
         }
-        Ok(ZenohBus { local, session, content, placement, counters, refusals, limits, _subscribers: subscribers })
+        Ok(ZenohBus {
+            local,
+            session,
+            content,
+            placement,
+            counters,
+            refusals,
+            limits,
+            peers,
+            old_epoch,
+            _subscribers: subscribers,
+            _queryable: queryable,
+        })
+    }
+
+    /// The other boards, when this process's board is one of a standby
+    /// group (to give the runtime's [`situ_runtime::standby::run`]).
+    pub fn peers(&self) -> Option<Arc<standby::BoardPeers>> {
+        self.peers.clone()
+    }
+
+    /// Statuses ignored because an agent here had seen a higher epoch.
+    pub fn old_epoch_statuses(&self) -> u64 {
+        self.old_epoch.load(Ordering::Relaxed)
     }
 
     /// The Zenoh session under the bus, for a tool that puts or subscribes
@@ -271,12 +367,22 @@ impl Bus for ZenohBus {
 
     fn send_status(&self, msg: StatusMsg) {
         self.local.send_status(msg);
-        if self.placement.board {
+        // A board of a standby group speaks only while it leads.
+        let (speaks, epoch, board) = match &self.peers {
+            None => (self.placement.board, 0, None),
+            Some(p) => match p.leading() {
+                Some(epoch) => (true, epoch, Some(p.name().to_string())),
+                None => (false, 0, None),
+            },
+        };
+        if speaks {
             let w = StatusWire {
                 v: VERSION,
                 state: self.content.states[msg.state as usize].name.clone(),
                 time_ns: msg.time,
                 seq: msg.seq,
+                epoch,
+                board,
             };
             let key = wire::status_key(&self.placement.robot);
             self.put(

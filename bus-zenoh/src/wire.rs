@@ -50,6 +50,13 @@ pub struct StatusWire {
     pub state: String,
     pub time_ns: u64,
     pub seq: u64,
+    /// The epoch of the board that sends it (absent: 0). An agent follows
+    /// only the highest epoch it has seen: a lower one is an old leader's.
+    #[serde(default)]
+    pub epoch: u64,
+    /// The process of the board that sends it (absent: not said).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub board: Option<String>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -47,5 +47,6 @@ pub mod rete;
 pub mod runner;
 pub mod sched;
 pub mod script;
+pub mod standby;
 pub mod stream;
 pub mod summary;

@@ -21,6 +21,7 @@ use crate::bus::{Bus, Doorbell};
 use crate::record::Sink;
 use crate::rete::StateChange;
 use crate::runner::{AgentRunner, BoardRunner, Shared};
+use crate::standby::{self, Standby};
 use crate::summary::Summary;
 use situ_bundle::Content;
 use std::collections::BTreeMap;
@@ -50,6 +51,11 @@ pub struct RealtimeConfig {
     /// How far ahead of the Bulletinboard's clock an event may be stamped
     /// (further is refused: it would age every other fact).
     pub max_skew: Duration,
+    /// This process's board is one of a standby group (with `board`): it
+    /// follows the leader's log until it leads ([`crate::standby`]).
+    pub standby: Option<Standby>,
+    /// The highest epoch this board knew before it started (its journal's).
+    pub known_epoch: u64,
 }
 
 impl Default for RealtimeConfig {
@@ -65,6 +71,8 @@ impl Default for RealtimeConfig {
             safe_after: Duration::from_millis(600),
             stop: None,
             max_skew: Duration::from_nanos(crate::runner::DEFAULT_MAX_SKEW),
+            standby: None,
+            known_epoch: 0,
         }
     }
 }
@@ -169,8 +177,29 @@ pub fn run_on(
                 c.extend(group.iter().map(|s| (s.runner.id, s.runner.counters)));
             });
         }
+        let mut deliver = |changes: &[StateChange]| {
+            for c in changes {
+                summary.add_steps(steps.swap(0, Ordering::Relaxed));
+                summary.change(c);
+                on_change(c);
+                if config.stop_on_final && content.states[c.to as usize].is_final {
+                    stop.store(true, Ordering::Release);
+                }
+            }
+        };
         if !config.board {
             follow(&shared, &local, &config, start + duration, &stop, &mut summary, steps, on_change, &clock);
+        } else if let Some(sb) = &config.standby {
+            let l = standby::run::BoardLoop {
+                shared: &shared,
+                board: &mut board,
+                heartbeat: config.heartbeat,
+                end: start + duration,
+                stop: &stop,
+                clock: &clock,
+                known_epoch: config.known_epoch,
+            };
+            standby::run::run(sb, l, &mut deliver);
         } else {
             // The Bulletinboard, on this thread.
             let end = start + duration;
@@ -195,20 +224,15 @@ pub fn run_on(
                     }
                     changes.extend(board.tick(&shared, clock()));
                 }
+                board.flush_log(false);
                 if now >= next_status {
                     next_status = now + config.status_every;
                     board.reassure(&shared, clock());
                 }
-                for c in &changes {
-                    summary.add_steps(steps.swap(0, Ordering::Relaxed));
-                    summary.change(c);
-                    on_change(c);
-                    if config.stop_on_final && content.states[c.to as usize].is_final {
-                        stop.store(true, Ordering::Release);
-                    }
-                }
+                deliver(&changes);
             }
         }
+        board.flush_log(false);
         stop.store(true, Ordering::Release);
         for why in shared.bus.take_refusals() {
             shared.record(|s| s.diagnostic(clock(), crate::record::Level::Warning, &format!("message refused: {why}")));

@@ -17,6 +17,7 @@ use crate::bus::{Bus, DataMsg, EventMsg, StatusMsg};
 use crate::organise::Organisation;
 use crate::record::{DataRecord, EventRecord, Fate, Level, ModeRecord, Sink, Verdict};
 use crate::rete::{PostError, StateChange};
+use crate::standby::{Entry, LogOut};
 use situ_bundle::{Content, Mode, Value};
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex, RwLock};
@@ -306,6 +307,10 @@ pub struct BoardRunner {
     status_seq: u64,
     /// The modes last recorded, per agent.
     modes: Vec<Option<(Mode, Option<u32>)>>,
+    /// Where the log goes (a journal, the followers), if anywhere; and the
+    /// entries not yet written there.
+    out: Option<Box<dyn LogOut>>,
+    log: Vec<Entry>,
 }
 
 impl BoardRunner {
@@ -319,6 +324,90 @@ impl BoardRunner {
             events: Vec::new(),
             overflow_event,
             status_seq: 0,
+            out: None,
+            log: Vec::new(),
+        }
+    }
+
+    /// Writes the log to `out` from now on (a journal, the followers), or
+    /// nowhere with `None`; entries not yet written are written first.
+    pub fn set_log_out(&mut self, out: Option<Box<dyn LogOut>>) {
+        self.flush_log(false);
+        self.out = out;
+    }
+
+    /// Writes the entries taken since the last call to the log's output;
+    /// `change`: a change of state is about to be broadcast after them.
+    pub fn flush_log(&mut self, change: bool) {
+        match &mut self.out {
+            Some(out) => out.write(&mut self.log, change),
+            None => self.log.clear(),
+        }
+    }
+
+    /// Keeps an entry for the log's output, when there is one.
+    fn logged(&mut self, entry: impl FnOnce() -> Entry) {
+        if self.out.is_some() {
+            self.log.push(entry());
+        }
+    }
+
+    /// Broadcasts the state at rest as a new status (a board that has just
+    /// taken over says so at once).
+    pub fn announce(&mut self, shared: &Shared, now: u64) {
+        self.broadcast(shared, now);
+    }
+
+    /// Forgets the state, the facts and the log not yet written, as a board
+    /// that has just started (the FSMs too), and broadcasts the initial
+    /// status here: a follower that starts again from the leader's log.
+    pub fn start_again(&mut self, shared: &Shared, now: u64) {
+        let skew = self.board.engine().max_skew();
+        self.board = Bulletinboard::new(self.board.content().clone());
+        self.board.set_max_skew(skew);
+        self.pending_tick = None;
+        self.status_seq = 0;
+        self.log.clear();
+        self.modes.fill(None);
+        shared.org_mut().reset();
+        self.start(shared, now);
+    }
+
+    /// The sequence number of the latest status broadcast.
+    pub fn status_seq(&self) -> u64 {
+        self.status_seq
+    }
+
+    /// Applies an entry of the leading board's log (a follower, or a
+    /// journal read back): the same steps as the leader took, so the same
+    /// state, facts and FSM states; the changes are broadcast to this
+    /// process's agents as the leader's were to all. Returns the change.
+    pub fn apply(&mut self, shared: &Shared, entry: &Entry) -> Option<StateChange> {
+        self.pending_tick = None;
+        match entry {
+            Entry::Tick { time } => {
+                self.logged(|| entry.clone());
+                shared.record(|s| s.tick(*time));
+                match self.board.advance(*time) {
+                    Ok(Some(change)) => {
+                        self.after(shared, &change, *time);
+                        change.changed().then_some(change)
+                    }
+                    Ok(None) => None,
+                    Err(e) => {
+                        self.cascade(shared, &e, *time);
+                        None
+                    }
+                }
+            }
+            Entry::Event { msg, accepted: false } => {
+                self.logged(|| entry.clone());
+                *self.counters.refused.entry("leader".into()).or_default() += 1;
+                let rec = record_of(msg, Verdict::Refused("refused by the leading Bulletinboard".into()));
+                shared.record(|s| s.event(&rec));
+                None
+            }
+            Entry::Event { msg, accepted: true } => self.accept(shared, msg, msg.time),
         }
     }
 
@@ -392,6 +481,7 @@ impl BoardRunner {
         match self.board.advance(now) {
             Ok(Some(change)) => {
                 self.pending_tick = None;
+                self.logged(|| Entry::Tick { time: now });
                 shared.record(|s| s.tick(now));
                 self.after(shared, &change, now);
                 change.changed().then_some(change)
@@ -444,6 +534,7 @@ impl BoardRunner {
             let key = error.key().to_string();
             let reason = error.describe(&c);
             *self.counters.refused.entry(key).or_default() += 1;
+            self.logged(|| Entry::Event { msg: msg.clone(), accepted: false });
             let rec = record_of(msg, Verdict::Refused(reason.clone()));
             shared.record(|s| {
                 s.event(&rec);
@@ -451,13 +542,20 @@ impl BoardRunner {
             });
             return None;
         }
-        self.counters.accepted += 1;
         // An event that arrives after a heartbeat but is stamped before it
         // (real time: it was on its way) changes the state at the board's
         // clock, not at its stamp: the recording says where the clock was.
         if let Some(t) = self.pending_tick.take().filter(|&t| msg.time < t) {
+            self.logged(|| Entry::Tick { time: t });
             shared.record(|s| s.tick(t));
         }
+        self.accept(shared, msg, now)
+    }
+
+    /// Takes an accepted event (`clock`: the board's clock it arrived at).
+    fn accept(&mut self, shared: &Shared, msg: &EventMsg, clock: u64) -> Option<StateChange> {
+        self.counters.accepted += 1;
+        self.logged(|| Entry::Event { msg: msg.clone(), accepted: true });
         let rec = record_of(msg, Verdict::Accepted);
         shared.record(|s| s.event(&rec));
         // The agent's FSM sees its own event before the Bulletinboard's rest.
@@ -465,7 +563,7 @@ impl BoardRunner {
         if moved.is_some() {
             self.record_modes(shared, msg.time);
         }
-        match self.board.post_at(now, msg.event, msg.time, &msg.payload) {
+        match self.board.post_at(clock, msg.event, msg.time, &msg.payload) {
             Ok(Some(change)) => {
                 self.after(shared, &change, msg.time);
                 change.changed().then_some(change)
@@ -504,6 +602,9 @@ impl BoardRunner {
     }
 
     fn broadcast(&mut self, shared: &Shared, now: u64) {
+        // What led to the change is safe (journaled, replicated) before the
+        // change is said.
+        self.flush_log(true);
         self.status_seq += 1;
         self.counters.status_sent += 1;
         shared.bus.send_status(StatusMsg { state: self.board.state(), time: now, seq: self.status_seq });

@@ -229,12 +229,40 @@ fn zenoh(args: &Args, content: Arc<Content>, file: Option<&[u8]>, checked: Optio
     };
     let local: Vec<bool> = content.agents.iter().map(|a| here.contains(&a.name)).collect();
     let placement = Placement { robot: d.robot.clone(), local, board: process.board };
-    let bus = match ZenohBus::open(content.clone(), placement, &d.zenoh_config(&process), Default::default()) {
-        Ok(b) => b,
-        Err(e) => {
-            eprintln!("error: process `{}`: {e}", process.name);
-            return USAGE;
+    // A board of a standby group: its log, shared with the bus that answers
+    // the other boards' catch-up requests.
+    let standby = d.rank(&process.name).filter(|_| d.has_standby()).map(|rank| {
+        let settings = d.standby.clone().unwrap_or_default();
+        let mut config = situ_runtime::standby::StandbyConfig::new(&process.name, rank, STATUS_EVERY);
+        if let Some(ms) = settings.lease_ms {
+            config.lease = Duration::from_millis(ms);
         }
+        if let Some(ms) = settings.replicate_within_ms {
+            config.replicate_within = Duration::from_millis(ms);
+        }
+        (config, situ_runtime::standby::SharedLog::default())
+    });
+    let group = standby.as_ref().map(|(config, log)| situ_bus_zenoh::standby::BoardGroup {
+        name: config.name.clone(),
+        lease: config.lease,
+        log: log.clone(),
+    });
+    let bus =
+        match ZenohBus::open_in_group(content.clone(), placement, &d.zenoh_config(&process), Default::default(), group)
+        {
+            Ok(b) => b,
+            Err(e) => {
+                eprintln!("error: process `{}`: {e}", process.name);
+                return USAGE;
+            }
+        };
+    let standby = match (standby, bus.peers()) {
+        (Some((config, log)), Some(peers)) => {
+            let name = process.name.clone();
+            let tell: situ_runtime::standby::Tell = std::sync::Arc::new(move |what: &str| eprintln!("{name}: {what}"));
+            Some(situ_runtime::standby::Standby { config, peers, log, tell: Some(tell) })
+        }
+        _ => None,
     };
     if !process.board && (args.serve.is_some() || args.foxglove.is_some()) {
         eprintln!(
@@ -255,6 +283,8 @@ fn zenoh(args: &Args, content: Arc<Content>, file: Option<&[u8]>, checked: Optio
         max_skew: d.max_skew(),
         stop_on_final: true,
         stop: Some(stop_flag()),
+        status_every: STATUS_EVERY,
+        standby,
         ..RealtimeConfig::default()
     };
     let name = process.name.clone();
@@ -299,6 +329,10 @@ fn route(args: &Args, d: &situ_bus_zenoh::deploy::Deployment, process: &situ_bus
     eprintln!("{name}: stopped routing");
     OK
 }
+
+/// How often a Bulletinboard of a deployment repeats its status.
+#[cfg(feature = "zenoh")]
+const STATUS_EVERY: Duration = Duration::from_millis(200);
 
 #[cfg(not(feature = "zenoh"))]
 const NO_ZENOH: &str =

@@ -43,6 +43,9 @@ struct Board {
     events: VecDeque<EventMsg>,
     urgent: VecDeque<EventMsg>,
     lost: u64,
+    /// Something other than an event arrived for the board (another
+    /// board's log): its wait ends.
+    rung: bool,
 }
 
 struct Slot<T> {
@@ -80,6 +83,13 @@ pub struct InProc {
 }
 
 impl InProc {
+    /// Ends the board's [`Bus::wait_events`] now (something other than an
+    /// event arrived for it: another board's log).
+    pub fn ring_board(&self) {
+        self.board.lock().rung = true;
+        self.board.bell.notify_all();
+    }
+
     /// A bus for `agents` agents.
     pub fn new(agents: usize, capacity: Capacity) -> InProc {
         InProc {
@@ -250,7 +260,7 @@ impl Bus for InProc {
             if !b.urgent.is_empty() {
                 return Wake::Urgent;
             }
-            if !b.events.is_empty() || b.lost > 0 {
+            if !b.events.is_empty() || b.lost > 0 || std::mem::take(&mut b.rung) {
                 return Wake::Deadline;
             }
             let now = Instant::now();

@@ -1,0 +1,247 @@
+//! Two boards of a standby group over Zenoh on loopback, without agents:
+//! a follower catches up on a log longer than one answer's chunk, the
+//! leader waits for its acknowledgement, and a status carries the epoch.
+
+use situ_bus_zenoh::deploy::Deployment;
+use situ_bus_zenoh::standby::BoardGroup;
+use situ_bus_zenoh::{Placement, ZenohBus};
+use situ_runtime::bus::inproc::Capacity;
+use situ_runtime::bus::EventMsg;
+use situ_runtime::standby::{Batch, Entry, Logged, Peers, SharedLog};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+const RULES: &str = "states { A initial B } agent S sensor { event E { x: f64 } }
+                     rule r { when state == A and E(x > 1.0) then B }";
+
+fn port() -> u16 {
+    std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port()
+}
+
+fn open(d: &Deployment, name: &str, content: &Arc<situ_compiler::bundle::Content>, log: SharedLog) -> ZenohBus {
+    let p = d.process(name).unwrap();
+    let placement = Placement { robot: d.robot.clone(), local: vec![false; content.agents.len()], board: true };
+    let group = BoardGroup { name: name.into(), lease: Duration::from_secs(5), log };
+    ZenohBus::open_in_group(content.clone(), placement, &d.zenoh_config(p), Capacity::default(), Some(group)).unwrap()
+}
+
+fn until(what: &str, mut ok: impl FnMut() -> bool) {
+    let deadline = Instant::now() + Duration::from_secs(20);
+    while !ok() {
+        assert!(Instant::now() < deadline, "{what}");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+#[test]
+fn a_follower_catches_up_on_a_long_log_and_the_leader_waits_for_its_acknowledgement() {
+    let checked = situ_compiler::check_source("t.situ", RULES);
+    let content = Arc::new(situ_compiler::bundle::build(&checked));
+    let (a, b) = (port(), port());
+    let text = format!(
+        "robot = \"sb{a}\"\n[[process]]\nname = \"a\"\nboard = true\nlisten = [\"tcp/127.0.0.1:{a}\"]\n\
+         [[process]]\nname = \"b\"\nboard = true\nlisten = [\"tcp/127.0.0.1:{b}\"]\nconnect = [\"tcp/127.0.0.1:{a}\"]\n"
+    );
+    let d = Deployment::parse(&text, &["S".to_string()]).unwrap();
+    // The leader's log: 1,500 entries (three answers' worth), NaN included.
+    let leader_log = SharedLog::default();
+    for i in 0..1500u64 {
+        let entry = if i % 3 == 0 {
+            Entry::Tick { time: i }
+        } else {
+            let x = if i % 7 == 0 { f64::NAN } else { i as f64 };
+            let msg = EventMsg {
+                agent: 0,
+                event: 0,
+                time: i,
+                payload: vec![situ_compiler::bundle::Value::F64(x)],
+                urgent: false,
+            };
+            Entry::Event { msg, accepted: i % 5 != 0 }
+        };
+        leader_log.lock().unwrap().push(Logged { epoch: 7 << 8, entry });
+    }
+    let leader = open(&d, "a", &content, leader_log.clone());
+    let follower = open(&d, "b", &content, SharedLog::default());
+    let (lp, fp) = (leader.peers().unwrap(), follower.peers().unwrap());
+    lp.set_leading(Some(7 << 8));
+    // The follower asks until the leader's queryable is known to it.
+    let mut got: Vec<Batch> = Vec::new();
+    until("the follower gets the whole log", || {
+        if got.is_empty() {
+            fp.request(1);
+            std::thread::sleep(Duration::from_millis(200));
+        }
+        fp.take_batches(&mut got);
+        got.iter().map(|b| b.entries.len()).sum::<usize>() >= 1500
+    });
+    let mut entries: Vec<Logged> = Vec::new();
+    let mut next = 1;
+    got.sort_by_key(|b| b.first);
+    for b in &got {
+        if b.first == next {
+            next = b.last() + 1;
+            entries.extend(b.entries.iter().cloned());
+        }
+    }
+    assert_eq!(
+        entries.len(),
+        1500,
+        "three chunks, in order: {:?}",
+        got.iter().map(|b| (b.first, b.entries.len())).collect::<Vec<_>>()
+    );
+    let theirs = leader_log.lock().unwrap();
+    for (i, e) in entries.iter().enumerate() {
+        let want = theirs.batch_from(i as u64 + 1, 1, 0, "a").entries[0].clone();
+        match (&e.entry, &want.entry) {
+            (Entry::Event { msg: m, accepted: x }, Entry::Event { msg: w, accepted: y }) => {
+                assert!(situ_runtime::standby::same_event(m, w) && x == y, "entry {}", i + 1)
+            }
+            (a, b) => assert_eq!(a, b, "entry {}", i + 1),
+        }
+        assert_eq!(e.epoch, want.epoch);
+    }
+    drop(theirs);
+    // The follower has the first 1,500 entries: the leader, waiting for
+    // the followers in step, is held for entry 1,501 until its
+    // acknowledgement comes, and released by it.
+    until("the leader hears the follower and waits for it", || {
+        fp.ack(7 << 8, 1500);
+        !lp.wait_acks(1501, 1501, Instant::now() + Duration::from_millis(50))
+    });
+    fp.ack(7 << 8, 1501);
+    assert!(lp.wait_acks(1501, 1501, Instant::now() + Duration::from_secs(10)));
+    // The follower heard the leader's epoch.
+    until("the follower hears the leader's epoch", || {
+        lp.publish(&leader_log.lock().unwrap().batch_from(1501, 0, 7 << 8, "a"));
+        fp.heard().is_some_and(|(e, _)| e == 7 << 8)
+    });
+}
+
+/// The Base of DLA: it drives or stops, and reports nothing here.
+struct Base;
+
+impl situ_runtime::agent::Agent for Base {
+    fn name(&self) -> &str {
+        "Base"
+    }
+    fn functions(&self) -> Vec<String> {
+        vec!["drive".into(), "stop".into()]
+    }
+    fn step(&mut self, _: &mut situ_runtime::agent::Context<'_>) {}
+}
+
+/// DLA's central server with a standby: two boards and the agents' processes
+/// meet only through a router. The route takes the stack to `Following`;
+/// the leading board then goes silent (its process ends), the other leads
+/// from `Following`, and the agents never see `Planning` again.
+#[test]
+fn dla_through_a_router_keeps_its_state_when_the_leading_board_goes_silent() {
+    use situ_runtime::bus::Bus;
+    use situ_runtime::realtime::{self, RealtimeConfig};
+    use situ_runtime::standby::{Standby, StandbyConfig};
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let checked = situ_compiler::check(&root.join("rules/dla.situ"), &situ_compiler::loader::FsLoader).unwrap();
+    let c = Arc::new(situ_compiler::bundle::build(&checked));
+    let names: Vec<String> = c.agents.iter().map(|a| a.name.clone()).collect();
+    let r = port();
+    let client = |name: &str, extra: &str| {
+        format!("[[process]]\nname = \"{name}\"\nmode = \"client\"\nconnect = [\"tcp/127.0.0.1:{r}\"]\n{extra}")
+    };
+    let text = format!(
+        "robot = \"dla{r}\"\n[[process]]\nname = \"router\"\nmode = \"router\"\nlisten = [\"tcp/127.0.0.1:{r}\"]\n{}{}{}{}",
+        client("board-a", "board = true\n"),
+        client("board-b", "board = true\n"),
+        client("deliberative", "agents = [\"Mapper\", \"RoutePlanner\", \"PathPlanner\"]\n"),
+        client("reactive", "agents = [\"Reactive\", \"Base\"]\n"),
+    );
+    let d = Deployment::parse(&text, &names).unwrap();
+    let router = situ_bus_zenoh::Router::open(&d.zenoh_config(d.process("router").unwrap())).unwrap();
+    let board = |name: &str, seconds: u64| {
+        let p = d.process(name).unwrap();
+        let config = StandbyConfig::new(name, d.rank(name).unwrap(), Duration::from_millis(200));
+        let log = SharedLog::default();
+        let group = BoardGroup { name: name.into(), lease: config.lease, log: log.clone() };
+        let bus = ZenohBus::open_in_group(
+            c.clone(),
+            Placement::of(&d, p, &c),
+            &d.zenoh_config(p),
+            Capacity::default(),
+            Some(group),
+        )
+        .unwrap();
+        let peers = bus.peers().unwrap();
+        let standby = Standby { config, peers, log, tell: None };
+        let config =
+            RealtimeConfig { board: true, stop_on_final: false, standby: Some(standby), ..RealtimeConfig::default() };
+        let bound = situ_runtime::agent::bind(&c, Vec::new(), false).unwrap();
+        realtime::run_on(c.clone(), bound, None, config, Duration::from_secs(seconds), Arc::new(bus), &mut |_| {})
+    };
+    let (a, b, reactive, seen) = std::thread::scope(|scope| {
+        let a = scope.spawn(|| board("board-a", 4));
+        let b = scope.spawn(|| {
+            std::thread::sleep(Duration::from_millis(200));
+            board("board-b", 8)
+        });
+        let reactive = scope.spawn(|| {
+            let p = d.process("reactive").unwrap();
+            let bus: Arc<dyn Bus> = Arc::new(
+                ZenohBus::open(c.clone(), Placement::of(&d, p, &c), &d.zenoh_config(p), Capacity::default()).unwrap(),
+            );
+            let config = RealtimeConfig { board: false, stop_on_final: false, ..RealtimeConfig::default() };
+            let bound = situ_runtime::agent::bind(&c, vec![Box::new(Base)], false).unwrap();
+            realtime::run_on(c.clone(), bound, None, config, Duration::from_secs(8), bus, &mut |_| {})
+        });
+        // The deliberative process reports a route until its state comes
+        // back, then watches the status: still `Following` once board-a
+        // has gone silent (at 4 s), from board-b.
+        let deliberative = scope.spawn(|| {
+            let p = d.process("deliberative").unwrap();
+            let bus =
+                ZenohBus::open(c.clone(), Placement::of(&d, p, &c), &d.zenoh_config(p), Capacity::default()).unwrap();
+            let (route, planner) = (c.event_id("ROUTE").unwrap(), c.agent_id("RoutePlanner").unwrap());
+            let following = c.state_id("Following").unwrap();
+            let start = Instant::now();
+            let mut next = start;
+            let mut routed = false;
+            let mut late = None;
+            while start.elapsed() < Duration::from_secs(7) {
+                let status = bus.status(planner);
+                routed |= status.is_some_and(|s| s.state == following);
+                if !routed && Instant::now() >= next {
+                    let time = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap();
+                    let msg = EventMsg {
+                        agent: planner,
+                        event: route,
+                        time: time.as_nanos() as u64,
+                        payload: vec![situ_compiler::bundle::Value::I64(1), situ_compiler::bundle::Value::I64(4)],
+                        urgent: false,
+                    };
+                    bus.send_event(msg);
+                    next = Instant::now() + Duration::from_millis(200);
+                }
+                if start.elapsed() > Duration::from_millis(6500) {
+                    // The status and how old it is (a board beats every 50 ms).
+                    let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap();
+                    late =
+                        status.map(|s| (s.state, Duration::from_nanos((now.as_nanos() as u64).saturating_sub(s.time))));
+                }
+                std::thread::sleep(Duration::from_millis(5));
+            }
+            (routed, late)
+        });
+        (a.join().unwrap(), b.join().unwrap(), reactive.join().unwrap(), deliberative.join().unwrap())
+    });
+    drop(router);
+    let following = c.state_id("Following").unwrap();
+    assert!(seen.0, "the route took the stack to Following");
+    let (state, age) = seen.1.expect("a status at the end");
+    assert_eq!(state, following, "the state is still Following after board-a went silent");
+    assert!(
+        age < Duration::from_millis(1500),
+        "and a board still broadcasts it ({age:?} old at 6.5 s; board-a ended at 4 s)"
+    );
+    assert_eq!(a.path, ["Planning", "Following"], "board-a led: {:?}", a.path);
+    assert_eq!(b.path, ["Planning", "Following"], "board-b applied the log, then led from Following: {:?}", b.path);
+    assert_eq!(reactive.path, ["Planning", "Following"], "the agents never went back: {:?}", reactive.path);
+}
