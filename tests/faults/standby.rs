@@ -66,11 +66,18 @@ pub struct Takeover {
 /// observer has had a status of a higher epoch and 5 statuses after it.
 /// Panics if no higher epoch comes within a minute, or if an epoch seen
 /// ever goes back.
-pub fn kill_leading_board() -> Takeover {
+///
+/// The sensors' `stale after` is `stale` (`fig5_rules_with_stale`), or the
+/// file's 500 ms.
+pub fn kill_leading_board(stale: Option<&str>) -> Takeover {
     let mut lab = Lab::new(&["board", "standby", "sensors", "pipeline"]);
     let procs = fig5_two_boards();
+    let rules = match stale {
+        Some(stale) => fig5_rules_with_stale(&lab, stale),
+        None => fig5_rules(),
+    };
     let deploy = write_deployment(&lab, "fig5", &procs, None);
-    let mut running = start(&mut lab, &fig5_rules(), &deploy, &procs);
+    let mut running = start(&mut lab, &rules, &deploy, &procs);
     let at = format!("tcp/{}:7449", lab.addr("pipeline"));
     let observer = observe(&mut lab, "pipeline", &at, "client", "fig5");
     running.observer = Some(observer);
