@@ -139,6 +139,35 @@ fn the_standby_board_takes_over_from_a_killed_leader_and_the_mission_goes_on() {
     assert_eq!(t.pipeline_path, ["RS", "RO"], "{t:#?}");
 }
 
+#[test]
+fn the_leader_cut_off_is_replaced_and_steps_down_when_joined_again() {
+    let c = standby::partition_leader(Duration::from_millis(1500), Some("3s"));
+    eprintln!(
+        "leader cut off 1.5 s: a status of a higher epoch ({} from {:?}) {:.0} ms after the cut; the old leader's \
+         epoch reached the pipeline's host {} more time(s) after that (ignored by agents: a lower epoch), the last \
+         {:?} ms after the heal; at the end epoch {} from {:?}; the pipeline's safe mode: {:?}",
+        c.epoch_after,
+        c.board_after,
+        c.takeover_ms,
+        c.old_after_takeover,
+        c.last_old_after_heal_ms.map(|m| m.round()),
+        c.epoch_last,
+        c.board_last,
+        c.safe.iter().map(|(e, l)| (ms(e - c.cut_ns), l.map(|l| ms(l - c.cut_ns)))).collect::<Vec<_>>()
+    );
+    assert_eq!(c.board_after.as_deref(), Some("standby"), "{c:#?}");
+    // The old leader, joined again, stepped down: the highest epoch is
+    // still the standby's, and the old one stopped coming (what it sent
+    // while cut off arrives after the heal, after TCP's backoff: up to
+    // about 2 s; a leader that did not step down would go on for the 5 s
+    // the run lasts).
+    assert_eq!((c.epoch_last, c.board_last.as_deref()), (c.epoch_after, Some("standby")), "{c:#?}");
+    assert!(c.last_old_after_heal_ms.is_none_or(|ms| ms < 4000.0), "{c:#?}");
+    assert!(c.safe.iter().all(|(_, l)| l.is_some()), "every safe mode ends: {c:#?}");
+    assert!(!c.standby_states.iter().any(|s| s == "EM" || s == "SP"), "{c:#?}");
+    assert_eq!(c.pipeline_path, ["RS", "RO"], "{c:#?}");
+}
+
 /// `SITU_SOAK_ROUNDS` (10) kills of the leading board, each on a fresh
 /// lab, with the sensors stale after 3 s, then with Fig. 5's own 500 ms.
 #[test]

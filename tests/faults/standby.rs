@@ -119,3 +119,83 @@ pub fn kill_leading_board(stale: Option<&str>) -> Takeover {
         pipeline_path: path(&lab.stdout(running.procs["pipeline"])),
     }
 }
+
+/// What cutting the leading board's host off did.
+#[derive(Debug)]
+pub struct LeaderCut {
+    pub cut_ns: u64,
+    pub healed_ns: u64,
+    pub epoch_before: u64,
+    /// From the cut to the first status of a higher epoch on the pipeline's
+    /// host (ms), and that status's epoch and board.
+    pub takeover_ms: f64,
+    pub epoch_after: u64,
+    pub board_after: Option<String>,
+    /// Statuses of the old leader's epoch that reached the pipeline's host
+    /// after the takeover (agents ignore them: a lower epoch), and the last
+    /// one's arrival after the heal (ms; `None`: none after the heal).
+    pub old_after_takeover: usize,
+    pub last_old_after_heal_ms: Option<f64>,
+    /// The highest epoch the observer saw at the end, and from whom.
+    pub epoch_last: u64,
+    pub board_last: Option<String>,
+    pub safe: Vec<(u64, Option<u64>)>,
+    pub standby_states: Vec<String>,
+    pub pipeline_path: Vec<String>,
+    pub board_err: String,
+}
+
+/// Fig. 5 with two boards on four hosts, as [`kill_leading_board`]; once
+/// the observer has seen RO from the leader, the leader's host is cut off
+/// for `cut` (at least until a status of a higher epoch came), then joined
+/// again, and the run goes on for 5 s more.
+pub fn partition_leader(cut: Duration, stale: Option<&str>) -> LeaderCut {
+    let mut lab = Lab::new(&["board", "standby", "sensors", "pipeline"]);
+    let procs = fig5_two_boards();
+    let rules = match stale {
+        Some(stale) => fig5_rules_with_stale(&lab, stale),
+        None => fig5_rules(),
+    };
+    let deploy = write_deployment(&lab, "fig5", &procs, None);
+    let mut running = start(&mut lab, &rules, &deploy, &procs);
+    let at = format!("tcp/{}:7449", lab.addr("pipeline"));
+    let observer = observe(&mut lab, "pipeline", &at, "client", "fig5");
+    running.observer = Some(observer);
+    for p in ["sensors", "pipeline"] {
+        wait_state(&mut lab, &running, p, "RO", LONG);
+    }
+    wait_seen(&lab, observer, 0, LONG, |s| s.state == "RO" && s.epoch.is_some())
+        .unwrap_or_else(|| panic!("no status with an epoch in RO\n{}", lab.outputs()));
+    std::thread::sleep(Duration::from_millis(500));
+    let epoch_before = seen(&lab, observer).pop().and_then(|s| s.epoch).expect("statuses carry their epoch");
+    let cut_ns = now_ns();
+    lab.partition("board");
+    let after = wait_seen(&lab, observer, cut_ns, LONG, |s| s.epoch.is_some_and(|e| e > epoch_before))
+        .unwrap_or_else(|| panic!("no status of an epoch above {epoch_before} after the cut\n{}", lab.outputs()));
+    let until = cut_ns + cut.as_nanos() as u64;
+    std::thread::sleep(Duration::from_nanos(until.saturating_sub(now_ns())));
+    let healed_ns = now_ns();
+    lab.heal("board");
+    std::thread::sleep(Duration::from_secs(5));
+    let stopped = stop_all(&mut lab, &running);
+    let all = seen(&lab, observer);
+    let old: Vec<u64> =
+        all.iter().filter(|s| s.at_ns > after.at_ns && s.epoch == Some(epoch_before)).map(|s| s.at_ns).collect();
+    let last = all.iter().filter(|s| s.epoch.is_some()).max_by_key(|s| (s.epoch, s.at_ns)).cloned();
+    LeaderCut {
+        cut_ns,
+        healed_ns,
+        epoch_before,
+        takeover_ms: after.at_ns.saturating_sub(cut_ns) as f64 / 1e6,
+        epoch_after: after.epoch.unwrap_or(0),
+        board_after: after.board,
+        old_after_takeover: old.len(),
+        last_old_after_heal_ms: old.iter().filter(|t| **t > healed_ns).max().map(|t| (t - healed_ns) as f64 / 1e6),
+        epoch_last: last.as_ref().and_then(|s| s.epoch).unwrap_or(0),
+        board_last: last.and_then(|s| s.board),
+        safe: safe_mode_periods(&recording(&lab, "pipeline"), stopped),
+        standby_states: recorded_states(&recording(&lab, "standby"), stopped),
+        pipeline_path: path(&lab.stdout(running.procs["pipeline"])),
+        board_err: lab.stderr(running.procs["board"]),
+    }
+}
