@@ -180,7 +180,10 @@ fn soak_takeover() {
             takeovers.push(t.takeover_ms);
             gaps.push(t.gap_ms);
             safe += t.safe.len();
-            emergencies += usize::from(t.standby_states.iter().any(|s| s == "EM"));
+            if t.standby_states.iter().any(|s| s == "EM") {
+                emergencies += 1;
+                eprintln!("soak: the new leader went {}: {t:#?}", t.standby_states.join(" -> "));
+            }
         }
         let (t50, t99, tmax) = percentiles(&takeovers);
         let (g50, g99, gmax) = percentiles(&gaps);
