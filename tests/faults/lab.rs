@@ -112,13 +112,22 @@ fn check_tools() -> Result<(), String> {
     Ok(())
 }
 
-/// Deletes the namespaces of labs whose test process is gone.
+/// Deletes the namespaces of labs whose test process is gone, and kills
+/// what still runs in them.
 fn sweep_stale() {
     let Ok(list) = ip(&["netns", "list"]) else { return };
     for name in list.lines().filter_map(|l| l.split_whitespace().next()) {
         let Some(rest) = name.strip_prefix(PREFIX) else { continue };
         let Some(pid) = rest.split('-').next().and_then(|p| p.parse::<u32>().ok()) else { continue };
         if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
+            // What that test started still runs in them (it died without
+            // its lab's drop): those processes first, by their ids.
+            for p in ip(&["netns", "pids", name]).unwrap_or_default().split_whitespace() {
+                if let Ok(p) = p.parse::<i32>() {
+                    // SAFETY: kill(2) with a process id and a signal number.
+                    unsafe { libc::kill(p, libc::SIGKILL) };
+                }
+            }
             let _ = ip(&["netns", "del", name]);
         }
     }
