@@ -315,6 +315,64 @@ print("python runtime ok")
 }
 
 #[test]
+fn the_python_runner_follows_only_the_highest_epoch() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = situ_at_root(&["gen", "agent", "Flight", "tests/gen/launch.situ", "--lang", "python", "-o", "-"]);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    std::fs::write(tmp.path().join("flight_agent.py"), stdout(&o)).unwrap();
+    let script = r#"
+import json, time
+import flight_agent as flight
+
+class Payload:
+    def __init__(self, text): self.text = text
+    def to_string(self): return self.text
+
+class Sample:
+    def __init__(self, obj): self.payload = Payload(json.dumps(obj))
+
+class Session:
+    def declare_subscriber(self, key, callback): return key
+    def put(self, key, value): pass
+
+def status(runner, state, seq, **more):
+    runner._on_status(Sample({"v": 1, "state": state, "time_ns": time.time_ns(), "seq": seq, **more}))
+
+log = []
+class Fc(flight.Handlers):
+    def on_status(self, state, seq): log.append((state, seq))
+    def on_board_restart(self): log.append("restart")
+
+r = flight.Runner(Fc(), Session(), "t")
+# No epoch: 0, as a board without a standby says it.
+status(r, "GROUND", 1); status(r, "PLANNED", 2); r.follow()
+assert (r.epoch, r.board) == (0, None) and log == [("GROUND", 1), ("PLANNED", 2)], log
+# A board leads at epoch 7: followed, though its seq is lower (a takeover,
+# not a restart).
+status(r, "PLANNED", 1, epoch=7, board="b"); status(r, "FLYING", 2, epoch=7, board="b"); r.follow()
+assert (r.epoch, r.board) == (7, "b") and log[2:] == [("PLANNED", 1), ("FLYING", 2)], log
+assert r.counters["restarts"] == 0
+# The old leader (epoch 0, then 5) says another state: ignored, and it
+# does not keep the agent out of safe mode.
+r._last_status -= 1.0
+status(r, "GROUND", 3); status(r, "GROUND", 9, epoch=5, board="a"); r.follow()
+assert r.state == "FLYING" and r.epoch == 7 and r.counters["old_epoch"] == 2, (r.state, r.counters)
+assert r.safe_mode() and log[4:] == [], log
+# The leader again, then a restart within its epoch (seq back).
+status(r, "FLYING", 3, epoch=7, board="b"); status(r, "FLYING", 1, epoch=7, board="b"); r.follow()
+assert not r.safe_mode() and log[4:] == [("FLYING", 3), "restart", ("FLYING", 1)], log
+# A bad epoch or board is refused.
+status(r, "DONE", 4, epoch=-1); status(r, "DONE", 4, epoch="x"); status(r, "DONE", 4, epoch=8, board=3)
+assert r.state == "FLYING" and r.counters["refused"] == 3, r.counters
+print("epochs ok")
+"#;
+    std::fs::write(tmp.path().join("epochs.py"), script).unwrap();
+    let o = python(&["epochs.py"], tmp.path());
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(stdout(&o).contains("epochs ok"), "{}", text(&o));
+}
+
+#[test]
 fn the_committed_battery_agent_is_what_gen_writes() {
     let o = situ_at_root(&["gen", "agent", "Battery", "examples/mower/mower.situ", "--lang", "rust", "-o", "-"]);
     assert_eq!(code(&o), 0, "{}", text(&o));

@@ -86,6 +86,12 @@ impl Proc {
         t
     }
 
+    /// Kills it; its standard error.
+    fn kill_and_tell(&mut self) -> String {
+        self.kill();
+        self.end()
+    }
+
     /// Waits for its end; its standard error.
     fn end(&mut self) -> String {
         let _ = self.child.wait();
@@ -242,7 +248,10 @@ fn soak_kill_the_leader_again_and_again() {
         while boards[f].led_after(t).is_none() && Instant::now() < deadline {
             std::thread::sleep(Duration::from_millis(5));
         }
-        let led = boards[f].led_after(t).unwrap_or_else(|| panic!("kill {k}: {} did not lead", names[f]));
+        let Some(led) = boards[f].led_after(t) else {
+            let err = boards[f].kill_and_tell();
+            panic!("kill {k}: {} did not lead within 5 s; it said:\n{err}", names[f]);
+        };
         takeovers.push((led - t) as f64 / 1e6);
         std::thread::sleep(Duration::from_millis(800));
         incarnation[l] += 1;
@@ -275,6 +284,19 @@ fn soak_kill_the_leader_again_and_again() {
         q(1.0),
         all.len()
     );
+    // Safe mode entered by the agents' processes (no status for 600 ms).
+    let safe: usize = ["sensors", "pipeline"]
+        .iter()
+        .map(|p| {
+            let m = messages(&dir.path().join(format!("{p}.mcap")));
+            m.iter()
+                .filter(|(t, _, j)| {
+                    t == "/diagnostics" && j["message"].as_str().is_some_and(|s| s.contains("safe mode ("))
+                })
+                .count()
+        })
+        .sum();
+    eprintln!("the agents' two processes entered safe mode {safe} time(s) in {kills} takeovers");
     for (err, name) in [(sensors.end(), "sensors"), (pipeline.end(), "pipeline")] {
         assert_eq!(followed(&err, name), ["RO"], "{name} followed an old state: {err}");
     }

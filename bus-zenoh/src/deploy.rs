@@ -13,6 +13,7 @@
 //! [[process]]
 //! name = "board"                     # with TLS, its certificate's common name
 //! board = true                       # hosts the Bulletinboard
+//! journal = "board.journal"          # optional: its log, to resume from after a crash
 //! listen = ["tcp/127.0.0.1:7447"]
 //! cert = "certs/board.pem"           # with TLS
 //! key = "certs/board.key"
@@ -152,6 +153,11 @@ pub struct Process {
     /// join.
     #[serde(default)]
     pub external: bool,
+    /// The board's journal (`board = true` only): a board restarted with it
+    /// resumes its state and facts (`situ_runtime::journal`). Relative to
+    /// the file's directory ([`Deployment::journal`]).
+    #[serde(default)]
+    pub journal: Option<PathBuf>,
 }
 
 impl Process {
@@ -288,6 +294,19 @@ impl Deployment {
                     p.name
                 )));
             }
+            if p.journal.is_some() && !p.board {
+                return Err(DeployError(format!(
+                    "process `{}`: `journal` belongs to the process that hosts the Bulletinboard (`board = true`)",
+                    p.name
+                )));
+            }
+            if p.journal.is_some() && boards.len() > 1 {
+                return Err(DeployError(format!(
+                    "process `{}`: `journal` is for a single board; the boards of a standby group recover from \
+                     each other's log",
+                    p.name
+                )));
+            }
             if p.mode == Mode::Client && p.connect.is_empty() {
                 return Err(DeployError(format!(
                     "process `{}`: a client talks through what it connects to: give it `connect` (the router)",
@@ -346,6 +365,12 @@ impl Deployment {
     /// A board's place among the boards (0 leads at start), if it is one.
     pub fn rank(&self, process: &str) -> Option<u32> {
         self.boards().iter().position(|p| p.name == process).map(|i| i as u32)
+    }
+
+    /// Where `process` keeps its journal, if it does (a relative `journal`
+    /// is relative to the file's directory).
+    pub fn journal(&self, process: &Process) -> Option<PathBuf> {
+        process.journal.as_deref().map(|p| if p.is_absolute() { p.to_path_buf() } else { self.dir.join(p) })
     }
 
     fn path(&self, p: &Path) -> String {
@@ -465,6 +490,18 @@ connect = ["tcp/127.0.0.1:7447"]
     }
 
     #[test]
+    fn the_board_journal_is_relative_to_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("d.toml");
+        std::fs::write(&path, GOOD.replace("board = true", "board = true\njournal = \"state/board.journal\"")).unwrap();
+        let d = Deployment::load(&path, &agents()).unwrap();
+        assert_eq!(d.journal(d.board()), Some(dir.path().join("state/board.journal")));
+        assert_eq!(d.journal(d.process("sensors").unwrap()), None);
+        let d = Deployment::parse(&GOOD.replace("board = true", "board = true\njournal = \"/var/b.j\""), &agents());
+        assert_eq!(d.as_ref().map(|d| d.journal(d.board())).unwrap(), Some(PathBuf::from("/var/b.j")));
+    }
+
+    #[test]
     fn two_boards_are_a_standby_group_ranked_in_their_order() {
         let text = format!("{GOOD}[[process]]\nname = \"b2\"\nboard = true\n[standby]\nlease_ms = 500\n");
         let d = Deployment::parse(&text, &agents()).unwrap();
@@ -499,6 +536,17 @@ connect = ["tcp/127.0.0.1:7447"]
             (
                 format!("{GOOD}[[process]]\nname = \"x\"\nexternal = true\n"),
                 "process `x`: `external = true` but it runs no agents",
+            ),
+            (
+                format!(
+                    "{}[[process]]\nname = \"b2\"\nboard = true\n",
+                    GOOD.replace("board = true", "board = true\njournal = \"j\"")
+                ),
+                "process `board`: `journal` is for a single board",
+            ),
+            (
+                GOOD.replace("agents = [", "journal = \"s.journal\"\nagents = ["),
+                "process `sensors`: `journal` belongs to the process that hosts the Bulletinboard",
             ),
         ];
         for (text, want) in cases {

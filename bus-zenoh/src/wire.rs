@@ -205,6 +205,16 @@ mod tests {
     }
 
     #[test]
+    fn a_status_without_an_epoch_is_epoch_0_and_the_fields_round_trip() {
+        let old: StatusWire = serde_json::from_str(r#"{"v":1,"state":"RS","time_ns":5,"seq":2}"#).unwrap();
+        assert_eq!((old.epoch, old.board.as_deref()), (0, None));
+        assert_eq!(serde_json::to_string(&old).unwrap(), r#"{"v":1,"state":"RS","time_ns":5,"seq":2,"epoch":0}"#);
+        let new = StatusWire { epoch: 7, board: Some("b".into()), ..old };
+        let text = serde_json::to_string(&new).unwrap();
+        assert_eq!(serde_json::from_str::<StatusWire>(&text).unwrap(), new);
+    }
+
+    #[test]
     fn garbage_is_refused_with_the_reason() {
         let c = content();
         assert!(matches!(parse::<EventWire>(b"\x00\x01"), Err(WireError::NotJson(_))));

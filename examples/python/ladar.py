@@ -5,7 +5,8 @@ It joins a situ stack over Zenoh with nothing of situ but the wire protocol
 (docs/protocol.md): it reports `LAOBN` ("no obstacle") ten times a second,
 then, after `--obstacle-after` seconds, `LAOBS` with the obstacle's distance
 and height, on `situ/<robot>/event/LADAR`; and it listens to the
-Bulletinboard's status on `situ/<robot>/status`.
+Bulletinboard's status on `situ/<robot>/status`, following only the highest
+`epoch` it has seen (a lower one is an old leader's, with a standby board).
 
 It exits 0 when the status says RO (the obstacle woke the stack), 1 if
 that does not happen within `--timeout` seconds.
@@ -38,11 +39,15 @@ def main() -> int:
 
     states = []
     woken = threading.Event()
+    epoch = [0]  # the highest epoch seen (absent: 0)
 
     def on_status(sample):
         msg = json.loads(sample.payload.to_string())
         if msg.get("v") != 1:
             return
+        if int(msg.get("epoch", 0)) < epoch[0]:
+            return  # an old leader's status: another Bulletinboard leads
+        epoch[0] = int(msg.get("epoch", 0))
         if not states or states[-1] != msg["state"]:
             states.append(msg["state"])
             print(f"status: {msg['state']}", flush=True)

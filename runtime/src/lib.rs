@@ -26,6 +26,8 @@
 //! - [`record`]: the recorder (MCAP), its reader, the page's timeline and
 //!   live log;
 //! - [`replay`]: a recording's events fed to a bundle, the differences said;
+//! - [`journal`]: the board's log in an append-only file, so that a board
+//!   restarted after a crash recovers its state and facts;
 //! - [`repl`]: a session of posts, waits and explanations (`situ repl`);
 //! - [`bench`], [`stream`]: throughput and latency on seeded event streams
 //!   (`situ bench`), and the streams' text form.
@@ -37,6 +39,7 @@ pub mod bench;
 pub mod bulletinboard;
 pub mod bus;
 pub mod demo;
+pub mod journal;
 pub mod local;
 pub mod organise;
 pub mod realtime;

@@ -56,6 +56,10 @@ pub struct RealtimeConfig {
     pub standby: Option<Standby>,
     /// The highest epoch this board knew before it started (its journal's).
     pub known_epoch: u64,
+    /// The board's journal (with `board`, without `standby`): what it
+    /// holds is applied before the board starts, and the board's log is
+    /// written to it ([`crate::journal`]).
+    pub journal: Option<crate::journal::Opened>,
 }
 
 impl Default for RealtimeConfig {
@@ -73,6 +77,7 @@ impl Default for RealtimeConfig {
             max_skew: Duration::from_nanos(crate::runner::DEFAULT_MAX_SKEW),
             standby: None,
             known_epoch: 0,
+            journal: None,
         }
     }
 }
@@ -123,7 +128,8 @@ pub fn run_on(
     let steps = &AtomicU64::new(0);
     let mut board = BoardRunner::new(content.clone());
     board.set_max_skew(config.max_skew.as_nanos().min(u64::MAX as u128) as u64);
-    let mut summary = Summary::new(&content).starting_at(epoch);
+    let journal_failures = resume_from_journal(&config, &mut board, &shared, epoch);
+    let mut summary = Summary::new(&content).starting_at(epoch).starting_in(board.board.state());
     if config.board {
         board.start(&shared, epoch);
     }
@@ -225,6 +231,12 @@ pub fn run_on(
                     changes.extend(board.tick(&shared, clock()));
                 }
                 board.flush_log(false);
+                if let Some(e) =
+                    journal_failures.as_ref().and_then(|f| f.lock().unwrap_or_else(|p| p.into_inner()).take())
+                {
+                    let text = format!("{e}: the board goes on without its journal");
+                    shared.record(|s| s.diagnostic(clock(), crate::record::Level::Error, &text));
+                }
                 if now >= next_status {
                     next_status = now + config.status_every;
                     board.reassure(&shared, clock());
@@ -247,6 +259,30 @@ pub fn run_on(
         let _ = s.finish();
     });
     summary
+}
+
+/// The board of `config` with a journal: applies what it recovered, says
+/// so in the recording and writes its log there from now on; where the
+/// journal tells of a failed write.
+fn resume_from_journal(
+    config: &RealtimeConfig,
+    board: &mut BoardRunner,
+    shared: &Shared,
+    now: u64,
+) -> Option<Arc<Mutex<Option<crate::journal::JournalError>>>> {
+    let opened = config.journal.as_ref()?;
+    let (journal, recovered) = opened.take()?;
+    let say = |level, text: &str| shared.record(|s| s.diagnostic(now, level, text));
+    if !config.board || config.standby.is_some() {
+        say(crate::record::Level::Warning, "the journal is kept by a single board: it is not used here");
+        return None;
+    }
+    let text = crate::journal::recover(board, shared, &journal, &recovered);
+    say(crate::record::Level::Info, &text);
+    opened.tell(&text);
+    let failures = journal.failures();
+    board.set_log_out(Some(Box::new(journal)));
+    Some(failures)
 }
 
 /// A process without the Bulletinboard: its organisation follows the status

@@ -76,6 +76,20 @@ impl Summary {
         self
     }
 
+    /// The run starts in `state` rather than the initial state (a board
+    /// that resumed from its journal).
+    pub fn starting_in(mut self, state: u32) -> Summary {
+        let state = state as usize;
+        if state != self.current && state < self.states.len() {
+            self.states[self.current].entered -= 1;
+            self.states[state].entered += 1;
+            self.current = state;
+            self.final_state = self.names[state].clone();
+            self.path = vec![self.names[state].clone()];
+        }
+        self
+    }
+
     /// A change of the state at rest.
     pub fn change(&mut self, c: &StateChange) {
         if !c.changed() {

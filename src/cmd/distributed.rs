@@ -22,6 +22,7 @@ use super::{FAILED, OK, USAGE};
 use situ_compiler::bundle::{self, Content, Encoding};
 use situ_runtime::agent::{self, Agent};
 use situ_runtime::demo;
+use situ_runtime::journal;
 use situ_runtime::realtime::{self, RealtimeConfig};
 use situ_runtime::record::mcap::McapRecorder;
 use situ_runtime::record::Sink;
@@ -56,6 +57,8 @@ pub struct Args {
     pub process: Option<String>,
     pub only: Option<Vec<String>>,
     pub duration: f64,
+    /// The board's journal (over a deployment's `journal`).
+    pub journal: Option<PathBuf>,
     pub record: Option<PathBuf>,
     /// Serve the run live over Foxglove's WebSocket protocol at this address.
     pub foxglove: Option<String>,
@@ -151,6 +154,20 @@ fn bound_agents(stack: Stack, content: &Content, names: &[String]) -> Result<age
     })
 }
 
+/// The board's journal at `path`, if any, opened for `content`: what it
+/// recovers is said on standard error as `NAME: recovered …`.
+fn open_journal(path: Option<&Path>, content: &Content, name: &str) -> Result<Option<journal::Opened>, u8> {
+    let Some(path) = path else { return Ok(None) };
+    let name = name.to_string();
+    match journal::Opened::open(path, content) {
+        Ok(j) => Ok(Some(j.telling(move |text| eprintln!("{name}: {text}")))),
+        Err(e) => {
+            eprintln!("error: {e}");
+            Err(USAGE)
+        }
+    }
+}
+
 fn finish(summary: situ_runtime::summary::Summary) -> u8 {
     print!("{}", summary.table());
     if summary.board.cascade_errors > 0 {
@@ -170,7 +187,11 @@ fn inproc(args: &Args, content: Arc<Content>, file: Option<&[u8]>, checked: Opti
         Ok(s) => s,
         Err(code) => return code,
     };
-    let config = RealtimeConfig { stop: Some(stop_flag()), ..RealtimeConfig::default() };
+    let journal = match open_journal(args.journal.as_deref(), &content, "board") {
+        Ok(j) => j,
+        Err(code) => return code,
+    };
+    let config = RealtimeConfig { stop: Some(stop_flag()), journal, ..RealtimeConfig::default() };
     let summary = realtime::run(content, bound, sink, config, Duration::from_secs_f64(args.duration), &mut |c| {
         eprintln!("state {}", c.to)
     });
@@ -278,7 +299,27 @@ fn zenoh(args: &Args, content: Arc<Content>, file: Option<&[u8]>, checked: Optio
         Err(code) => return code,
     };
     let bus: Arc<dyn Bus> = Arc::new(bus);
+    let journal = match (process.board, args.journal.clone().or_else(|| d.journal(&process))) {
+        (true, Some(_)) if standby.is_some() => {
+            eprintln!(
+                "error: --journal: process `{}` is a board of a standby group: a journal is for a single board",
+                process.name
+            );
+            Err(USAGE)
+        }
+        (true, path) => open_journal(path.as_deref(), &content, &process.name),
+        (false, Some(_)) => {
+            eprintln!("error: --journal: process `{}` has no Bulletinboard", process.name);
+            Err(USAGE)
+        }
+        (false, None) => Ok(None),
+    };
+    let journal = match journal {
+        Ok(j) => j,
+        Err(code) => return code,
+    };
     let config = RealtimeConfig {
+        journal,
         board: process.board,
         max_skew: d.max_skew(),
         stop_on_final: true,

@@ -87,6 +87,10 @@ pub struct Args {
     /// Run only these agents (the process of the deployment that has them).
     #[arg(long, value_delimiter = ',')]
     pub only: Option<Vec<String>>,
+    /// Real-time runs (demo, none): the Bulletinboard journals its log to this file and, started
+    /// again with it, resumes the state and facts it holds (a deployment's board: `journal = …`).
+    #[arg(long, value_name = "PATH", conflicts_with_all = ["script", "random", "compare", "missions"])]
+    pub journal: Option<PathBuf>,
     /// Real-time runs (demo, none): how long, in seconds.
     #[arg(long, default_value_t = 10.0)]
     pub duration: f64,
@@ -119,6 +123,7 @@ pub fn run(args: Args) -> super::Outcome {
         process,
         only,
         duration,
+        journal,
         ..
     } = args;
     let local = stack == super::distributed::Stack::Sim && transport == super::distributed::Transport::Inproc;
@@ -138,6 +143,7 @@ pub fn run(args: Args) -> super::Outcome {
             process,
             only,
             duration,
+            journal,
             record,
             foxglove,
             serve,

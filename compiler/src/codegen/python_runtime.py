@@ -166,6 +166,10 @@ class Runner:
         self.robot = robot
         self.state = INITIAL_STATE
         self.seq = -1
+        # The highest epoch of a leading Bulletinboard seen, and its name: a
+        # status of a lower epoch is an old leader's and is ignored.
+        self.epoch = 0
+        self.board: str | None = None
         self.finished = False
         self.fsm_state: str | None = FSM.initial if FSM is not None else None
         self.others = {name: fsm.initial for name, fsm in OTHER_FSMS.items()}
@@ -173,6 +177,7 @@ class Runner:
         self.counters = {"steps": 0, "events": 0, "data_out": 0, "suppressed": 0}
         self.counters.update({"data_in": 0, "dropped": 0, "refused": 0})
         self.counters.update({"held": 0, "held_dropped": 0, "restarts": 0})
+        self.counters.update({"old_epoch": 0})
         self._lock = _threading.Lock()
         self._wake = _threading.Event()
         self._heard = False
@@ -197,20 +202,31 @@ class Runner:
         try:
             msg = _json.loads(sample.payload.to_string())
             state, seq = msg["state"], int(msg["seq"])
-            if msg.get("v") != PROTOCOL_VERSION or state not in STATES:
+            epoch, board = int(msg.get("epoch", 0)), msg.get("board")
+            if msg.get("v") != PROTOCOL_VERSION or state not in STATES or epoch < 0:
                 raise ValueError(state)
+            if board is not None and not isinstance(board, str):
+                raise ValueError(board)
         except (ValueError, KeyError, TypeError):
             self.counters["refused"] += 1
             return
         with self._lock:
+            if epoch < self.epoch:
+                # An old leader's: another Bulletinboard leads now. Not
+                # followed, and not a sign of life (safe mode still counts).
+                self.counters["old_epoch"] += 1
+                return
             was_safe = self.safe_mode()
             self._last_status = _time.monotonic()
-            # A new status: the first, a change, or a Bulletinboard that
-            # restarted (its `seq` starts again); not a repetition.
-            new = not self._heard or seq != self.seq or state != self.state
-            restart = self._heard and seq < self.seq
+            # A new status: the first, a change, a new leader (a higher
+            # epoch), or a Bulletinboard that restarted (its `seq` starts
+            # again in the same epoch); not a repetition.
+            takeover = epoch > self.epoch
+            new = not self._heard or takeover or seq != self.seq or state != self.state
+            restart = self._heard and not takeover and seq < self.seq
             self._heard = True
             self.seq = seq
+            self.epoch, self.board = epoch, board
             if new:
                 self._statuses.append((state, seq, restart))
             if state != self.state:
