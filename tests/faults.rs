@@ -103,14 +103,19 @@ fn delay_and_loss_between_hosts_keep_the_safe_mode_rule() {
         loss_percent: 5,
         lasting: Duration::from_secs(12),
         rto_min_ms: None,
-        stale: None,
+        // The sensors stale after 3 s: with the file's 500 ms, two losses
+        // in a row on the sensors' link (or a loaded machine) rightly make
+        // it an emergency and a stop, which is not what this test is
+        // about (the soak runs the file's 500 ms and reports it).
+        stale: Some("3s"),
     };
     let l = delay_and_loss(&settings);
     eprintln!("50 ms delay, 5 % loss, 12 s: {}", l.figures());
     // Statuses kept coming (one every 200 ms when nothing is lost).
     assert!(l.statuses >= 20, "{}", l.figures());
     l.check_safe_mode_rule(500.0, 1500.0).unwrap_or_else(|e| panic!("{e}: {}", l.figures()));
-    assert!(l.safe.iter().all(|(_, left)| left.is_some()) || l.board_states.last().is_some_and(|s| s == "SP"));
+    assert!(l.safe.iter().all(|(_, left)| left.is_some()), "every safe mode ends: {}", l.figures());
+    assert_eq!(l.board_states, ["RO"], "the mission went on: {}", l.figures());
 }
 
 #[test]
