@@ -13,6 +13,7 @@ python3 -m pip install --quiet --disable-pip-version-check -r examples/python/re
 bash scripts/install-graphviz.sh # situ graph lays pictures out with Graphviz; tests/graph_cmd.rs needs it
 bash scripts/install-chromium.sh # tests/view_cmd.rs drives situ view's page in headless Chromium
 bash scripts/install-capi-tools.sh # capi/tests/c_programs.rs: CMake, gcc, g++ and valgrind for the C API
+bash scripts/install-net-tools.sh # tests/faults.rs: iproute2 and nftables for the test hosts (network namespaces, as root)
 echo "== the runtime depends on the bundle crate, not on the compiler (cargo tree -p situ-runtime)"
 tree=$(cargo tree -p situ-runtime) # dev-dependencies included
 grep -q "^situ-runtime " <<<"$tree" || { echo "cargo tree printed no tree for situ-runtime" >&2; exit 1; }
