@@ -345,6 +345,11 @@ impl Peers for BoardPeers {
         *self.inbox.heard.lock().unwrap_or_else(|p| p.into_inner())
     }
 
+    fn linked(&self) -> bool {
+        let info = self.session.info();
+        info.peers_zid().wait().next().is_some() || info.routers_zid().wait().next().is_some()
+    }
+
     fn set_leading(&self, epoch: Option<u64>) {
         if let Some(e) = epoch {
             self.epoch.store(e, Ordering::Release);

@@ -466,13 +466,16 @@ impl BoardRunner {
             }
         }
         let events = std::mem::take(&mut self.events);
-        for msg in &events {
-            if let Some(c) = self.take(shared, msg, now) {
-                changes.push(c);
-            }
-        }
+        changes.extend(self.take_events(shared, &events, now));
         self.events = events;
         changes
+    }
+
+    /// Takes `events` in their order, as [`pump`](Self::pump) takes the
+    /// queue's (a board that has just taken over takes the events no
+    /// leader sequenced this way, before the queue); returns the changes.
+    pub fn take_events(&mut self, shared: &Shared, events: &[EventMsg], now: u64) -> Vec<StateChange> {
+        events.iter().filter_map(|msg| self.take(shared, msg, now)).collect()
     }
 
     /// The heartbeat: the clock moves to `now` without an event, so that a

@@ -4,9 +4,12 @@
 //! - A board starts as a follower. It leads when it has heard no leader
 //!   for its lease (plus `stagger` per rank, so that two followers do not
 //!   take over at once); at start, when it has heard none for the join
-//!   time (two leases: a board that comes back hears the leader first),
-//!   one lease more per rank (the first listed leads when all start
-//!   together, even if it started a little later).
+//!   time (a lease from its first link to another process, [`linked`]:
+//!   a board that comes back hears the leader first), one lease more per
+//!   rank (the first listed leads when all start together, even if it
+//!   started a little later).
+//!
+//! [`linked`]: Election::linked
 //! - Its epoch is above every epoch it has seen and above the wall clock in
 //!   milliseconds, times 256, plus its rank: epochs grow across restarts
 //!   and two boards never pick the same one.
@@ -47,12 +50,18 @@ impl Election {
             rank: config.rank,
             lease,
             stagger: config.stagger.as_nanos() as u64,
-            join: lease.saturating_mul(2),
+            join: lease,
             started: now,
             leading: None,
             highest: known,
             last_heard: None,
         }
+    }
+
+    /// The board's first link to another process came at `now`: its join
+    /// time counts from here.
+    pub fn linked(&mut self, now: u64) {
+        self.started = now;
     }
 
     pub fn leading(&self) -> Option<u64> {
@@ -128,17 +137,22 @@ mod tests {
     #[test]
     fn the_first_board_leads_after_the_join_time_and_the_second_later() {
         let (mut a, mut b) = (Election::new(&config(0), 0, 0), Election::new(&config(1), 0, 0));
-        assert_eq!(a.poll(799 * MS, 1000), None);
-        let Some(Decision::Lead(e)) = a.poll(800 * MS, 1000) else { panic!("rank 0 leads at 800 ms") };
+        assert_eq!(a.poll(399 * MS, 1000), None);
+        let Some(Decision::Lead(e)) = a.poll(400 * MS, 1000) else { panic!("rank 0 leads at 400 ms") };
         assert_eq!(e, 1000 << 8);
         // The second heard it before its own, later, deadline.
-        assert_eq!(b.heard(e, 805 * MS), None);
-        assert_eq!(b.poll(900 * MS, 1000), None);
-        assert_eq!(b.deadline(), Some((805 + 400 + 100) * MS));
+        assert_eq!(b.heard(e, 405 * MS), None);
+        assert_eq!(b.poll(500 * MS, 1000), None);
+        assert_eq!(b.deadline(), Some((405 + 400 + 100) * MS));
         // Alone, the second would have led a lease after the first.
         let mut c = Election::new(&config(1), 0, 0);
-        assert_eq!(c.poll(1199 * MS, 1000), None);
-        assert!(matches!(c.poll(1200 * MS, 1000), Some(Decision::Lead(_))));
+        assert_eq!(c.poll(799 * MS, 1000), None);
+        assert!(matches!(c.poll(800 * MS, 1000), Some(Decision::Lead(_))));
+        // The join time counts from the first link.
+        let mut d = Election::new(&config(0), 0, 0);
+        d.linked(1000 * MS);
+        assert_eq!(d.poll(1399 * MS, 1000), None);
+        assert!(matches!(d.poll(1400 * MS, 1000), Some(Decision::Lead(_))));
     }
 
     #[test]

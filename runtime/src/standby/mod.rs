@@ -185,6 +185,12 @@ pub trait Peers: Send + Sync {
     /// This process leads at `epoch` (its status messages carry it) or,
     /// with `None`, follows (it broadcasts no status).
     fn set_leading(&self, epoch: Option<u64>);
+    /// Whether this process has a link to another (a board that has none
+    /// cannot tell "no leader" from "not connected yet", so it does not
+    /// count its join time before).
+    fn linked(&self) -> bool {
+        true
+    }
 }
 
 /// Whether two events are the same message (payloads compared bit for bit:

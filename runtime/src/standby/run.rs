@@ -100,6 +100,8 @@ pub fn run(standby: &Standby, l: BoardLoop<'_>, deliver: &mut dyn FnMut(&[StateC
     };
     peers.set_leading(None);
     let mut reported_unacked = 0;
+    // A board with no link yet cannot tell "no leader" from "not connected".
+    let mut linked = false;
     loop {
         let now = Instant::now();
         if now >= end || stop.load(Ordering::Acquire) {
@@ -208,14 +210,36 @@ pub fn run(standby: &Standby, l: BoardLoop<'_>, deliver: &mut dyn FnMut(&[StateC
                         }
                     }
                 }
+                if !linked && peers.linked() {
+                    linked = true;
+                    election.linked(ns(Instant::now()));
+                }
+                if !linked {
+                    continue;
+                }
                 if let Some(Decision::Lead(epoch)) = election.poll(ns(Instant::now()), clock() / 1_000_000) {
-                    take_over(shared, board, standby, epoch, &mut replica, ns(Instant::now()), &unacknowledged);
+                    // What came in since the last look is held too: the
+                    // held events go first, in the order they came.
+                    let _ = shared.bus.recv_events(&mut events);
+                    let t = ns(Instant::now());
+                    for m in events.drain(..) {
+                        replica.hold(m, t);
+                    }
+                    let held = take_over(board, standby, epoch, &mut replica, t, &unacknowledged);
                     tell(format!(
-                        "board `{}` leads at epoch {epoch}, from entry {} of the log",
+                        "board `{}` leads at epoch {epoch}, from entry {} of the log{}",
                         cfg.name,
-                        standby.log.lock().unwrap_or_else(|p| p.into_inner()).len()
+                        standby.log.lock().unwrap_or_else(|p| p.into_inner()).len(),
+                        if held.is_empty() {
+                            String::new()
+                        } else {
+                            format!(", and {} event(s) no leader took", held.len())
+                        }
                     ));
+                    // The state the log gives (the old leader's last word),
+                    // then what the events no leader took make of it.
                     board.announce(shared, clock());
+                    changes.extend(board.take_events(shared, &held, clock()));
                     next_beat = Instant::now();
                     next_tick = Instant::now();
                 }
@@ -229,17 +253,17 @@ pub fn run(standby: &Standby, l: BoardLoop<'_>, deliver: &mut dyn FnMut(&[StateC
     board.flush_log(false);
 }
 
-/// This board leads at `epoch`: the log goes to the followers, and the
-/// events no leader sequenced are taken first, in the order they came.
+/// This board leads at `epoch`: the log goes to the followers. Returns
+/// the events no leader sequenced, in the order they came, for the board to
+/// take before its queue.
 fn take_over(
-    shared: &Shared,
     board: &mut BoardRunner,
     standby: &Standby,
     epoch: u64,
     replica: &mut Replica,
     now: u64,
     unacknowledged: &Arc<std::sync::atomic::AtomicU64>,
-) {
+) -> Vec<EventMsg> {
     standby.peers.set_leading(Some(epoch));
     let waited = standby.log.lock().unwrap_or_else(|p| p.into_inner()).len();
     board.set_log_out(Some(Box::new(ToFollowers {
@@ -251,9 +275,7 @@ fn take_over(
         within: standby.config.replicate_within,
         unacknowledged: unacknowledged.clone(),
     })));
-    for m in replica.take_unsequenced(now) {
-        shared.bus.send_event(m);
-    }
+    replica.take_unsequenced(now)
 }
 
 /// Forgets this board's log, state and facts: it applies the leader's log
