@@ -540,8 +540,10 @@ def _access_control(robot: str, procs: list[dict[str, _Any]]) -> dict[str, _Any]
         "declare_subscriber",
         "declare_liveliness_subscriber",
         "liveliness_token",
+        "declare_queryable",
     ]
     both = ["ingress", "egress"]
+    boards = [f"situ/{robot}/board/**"]
     return {
         "enabled": True,
         "default_permission": "deny",
@@ -549,6 +551,7 @@ def _access_control(robot: str, procs: list[dict[str, _Any]]) -> dict[str, _Any]
             _rule("status_in", ["put"], ["ingress"], status),
             _rule("status_out", ["put"], ["egress"], status),
             _rule("streams", ["put"], both, streams),
+            _rule("boards", ["put", "query", "reply"], both, boards),
             _rule("subscribe", declares, both, ["**"]),
         ],
         "subjects": [
@@ -556,7 +559,11 @@ def _access_control(robot: str, procs: list[dict[str, _Any]]) -> dict[str, _Any]
             {"id": "members", "cert_common_names": [str(p["name"]) for p in procs]},
         ],
         "policies": [
-            {"id": "board_status", "rules": ["status_in"], "subjects": ["board"]},
+            {
+                "id": "board_status",
+                "rules": ["status_in", "boards"],
+                "subjects": ["board"],
+            },
             {
                 "id": "members_streams",
                 "rules": ["status_out", "streams", "subscribe"],
