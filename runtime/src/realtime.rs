@@ -54,8 +54,6 @@ pub struct RealtimeConfig {
     /// This process's board is one of a standby group (with `board`): it
     /// follows the leader's log until it leads ([`crate::standby`]).
     pub standby: Option<Standby>,
-    /// The highest epoch this board knew before it started (its journal's).
-    pub known_epoch: u64,
     /// The board's journal (with `board`, without `standby`): what it
     /// holds is applied before the board starts, and the board's log is
     /// written to it ([`crate::journal`]).
@@ -76,7 +74,6 @@ impl Default for RealtimeConfig {
             stop: None,
             max_skew: Duration::from_nanos(crate::runner::DEFAULT_MAX_SKEW),
             standby: None,
-            known_epoch: 0,
             journal: None,
         }
     }
@@ -203,7 +200,6 @@ pub fn run_on(
                 end: start + duration,
                 stop: &stop,
                 clock: &clock,
-                known_epoch: config.known_epoch,
             };
             standby::run::run(sb, l, &mut deliver);
         } else {

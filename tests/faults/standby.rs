@@ -3,7 +3,7 @@
 //! first listed leads at start); every status carries `epoch` (the highest
 //! wins) and `board` (the leading process's name).
 
-use super::lab::Lab;
+use super::lab::{Lab, Pid};
 use super::scenarios::LONG;
 use super::stack::*;
 use std::time::{Duration, Instant};
@@ -60,17 +60,12 @@ pub struct Takeover {
     pub pipeline_path: Vec<String>,
 }
 
-/// Fig. 5 with two boards on four hosts (`board`, `standby`, `sensors`,
-/// `pipeline`); once the observer on the pipeline's host (a client of the
-/// pipeline's process: what it gets) has seen RO from the leader, the
-/// leader's process is killed (SIGKILL); the run goes on until the
-/// observer has had a status of a higher epoch and 5 statuses after it.
-/// Panics if no higher epoch comes within a minute, or if an epoch seen
-/// ever goes back.
-///
-/// The sensors' `stale after` is `stale` (`fig5_rules_with_stale`), or the
-/// file's 500 ms.
-pub fn kill_leading_board(stale: Option<&str>) -> Takeover {
+/// Fig. 5 with two boards, each process on its host, the observer on the
+/// pipeline's: once every agent follows RO and the observer has a status
+/// with an epoch, 500 ms later. The sensors' `stale after` is `stale`
+/// (`fig5_rules_with_stale`), or the file's 500 ms. Returns the
+/// observer's latest status, with its epoch.
+fn two_boards_in_ro(stale: Option<&str>) -> (Lab, Running, Pid, Seen, u64) {
     let mut lab = Lab::new(&["board", "standby", "sensors", "pipeline"]);
     let procs = fig5_two_boards();
     let rules = match stale {
@@ -88,8 +83,23 @@ pub fn kill_leading_board(stale: Option<&str>) -> Takeover {
     wait_seen(&lab, observer, 0, LONG, |s| s.state == "RO" && s.epoch.is_some())
         .unwrap_or_else(|| panic!("no status with an epoch in RO\n{}", lab.outputs()));
     std::thread::sleep(Duration::from_millis(500));
-    let before = seen(&lab, observer).pop().expect("a status before the kill");
-    let epoch_before = before.epoch.expect("statuses carry their epoch");
+    let before = seen(&lab, observer).pop().expect("a status before the fault");
+    let epoch = before.epoch.expect("statuses carry their epoch");
+    (lab, running, observer, before, epoch)
+}
+
+/// Fig. 5 with two boards on four hosts (`board`, `standby`, `sensors`,
+/// `pipeline`); once the observer on the pipeline's host (a client of the
+/// pipeline's process: what it gets) has seen RO from the leader, the
+/// leader's process is killed (SIGKILL); the run goes on until the
+/// observer has had a status of a higher epoch and 5 statuses after it.
+/// Panics if no higher epoch comes within a minute, or if an epoch seen
+/// ever goes back.
+///
+/// The sensors' `stale after` is `stale` (`fig5_rules_with_stale`), or the
+/// file's 500 ms.
+pub fn kill_leading_board(stale: Option<&str>) -> Takeover {
+    let (mut lab, mut running, observer, before, epoch_before) = two_boards_in_ro(stale);
     let killed_ns = now_ns();
     lab.kill9(running.procs.remove("board").expect("the leading board"));
     let after = wait_seen(&lab, observer, killed_ns, LONG, |s| s.epoch.is_some_and(|e| e > epoch_before))
@@ -158,24 +168,7 @@ pub struct LeaderCut {
 /// for `cut` (at least until a status of a higher epoch came), then joined
 /// again, and the run goes on for 5 s more.
 pub fn partition_leader(cut: Duration, stale: Option<&str>) -> LeaderCut {
-    let mut lab = Lab::new(&["board", "standby", "sensors", "pipeline"]);
-    let procs = fig5_two_boards();
-    let rules = match stale {
-        Some(stale) => fig5_rules_with_stale(&lab, stale),
-        None => fig5_rules(),
-    };
-    let deploy = write_deployment(&lab, "fig5", &procs, None);
-    let mut running = start(&mut lab, &rules, &deploy, &procs);
-    let at = format!("tcp/{}:7449", lab.addr("pipeline"));
-    let observer = observe(&mut lab, "pipeline", &at, "client", "fig5");
-    running.observer = Some(observer);
-    for p in ["sensors", "pipeline"] {
-        wait_state(&mut lab, &running, p, "RO", LONG);
-    }
-    wait_seen(&lab, observer, 0, LONG, |s| s.state == "RO" && s.epoch.is_some())
-        .unwrap_or_else(|| panic!("no status with an epoch in RO\n{}", lab.outputs()));
-    std::thread::sleep(Duration::from_millis(500));
-    let epoch_before = seen(&lab, observer).pop().and_then(|s| s.epoch).expect("statuses carry their epoch");
+    let (mut lab, running, observer, _, epoch_before) = two_boards_in_ro(stale);
     let cut_ns = now_ns();
     lab.partition("board");
     let after = wait_seen(&lab, observer, cut_ns, LONG, |s| s.epoch.is_some_and(|e| e > epoch_before))

@@ -27,8 +27,6 @@ pub struct BoardLoop<'a> {
     pub stop: &'a AtomicBool,
     /// The wall clock, ns since the Unix epoch.
     pub clock: &'a (dyn Fn() -> u64 + Sync),
-    /// The highest epoch this board knew before it started (its journal's).
-    pub known_epoch: u64,
 }
 
 /// The leader's output: every entry into the shared log, then to the
@@ -77,12 +75,13 @@ impl LogOut for ToFollowers {
 /// Runs the board's thread until `end` or `stop`; `deliver` sees the
 /// changes of the state at rest this board made or applied.
 pub fn run(standby: &Standby, l: BoardLoop<'_>, deliver: &mut dyn FnMut(&[StateChange])) {
-    let BoardLoop { shared, board, heartbeat, end, stop, clock, known_epoch } = l;
+    let BoardLoop { shared, board, heartbeat, end, stop, clock } = l;
     let cfg = &standby.config;
     let peers = &standby.peers;
     let origin = Instant::now();
     let ns = |i: Instant| i.saturating_duration_since(origin).as_nanos() as u64;
-    let mut election = Election::new(cfg, 0, known_epoch);
+    // A board of a standby group has no journal: it knows no epoch at start.
+    let mut election = Election::new(cfg, 0, 0);
     let mut replica = Replica::new(HOLD.as_nanos() as u64);
     let unacknowledged = Arc::new(std::sync::atomic::AtomicU64::new(0));
     let (mut events, mut batches): (Vec<EventMsg>, Vec<Batch>) = (Vec::new(), Vec::new());
