@@ -41,23 +41,39 @@ fn replay_block(out: &str) -> String {
     panic!("an unclosed test block: {block}");
 }
 
+fn the_papers_stacks_pass_their_tests_and_properties(file: &str, at_least: usize) {
+    let o = situ(&["test", file]);
+    let out = stdout(&o);
+    assert_eq!(code(&o), 0, "{file}:\n{out}");
+    let last = out.lines().last().unwrap_or_default();
+    assert!(last.ends_with(" passed, 0 failed, 0 undecided"), "{last}");
+    assert!(!out.contains("FAILED"), "{out}");
+    // Every property is proved for runs of any length, not searched.
+    let properties = out.matches("\nproperty \"").count();
+    let proved = out.matches("symbolic: proved for runs of any length").count();
+    assert!(properties >= at_least, "{out}");
+    assert_eq!(proved, properties, "{out}");
+}
+
+// One test per file: they run side by side.
 #[test]
-fn the_papers_stacks_pass_their_tests_and_properties() {
-    for (file, at_least) in
-        [("rules/outdoor.situ", 7), ("rules/ugv.situ", 7), ("rules/ugv-merge.situ", 7), ("rules/dla.situ", 2)]
-    {
-        let o = situ(&["test", file]);
-        let out = stdout(&o);
-        assert_eq!(code(&o), 0, "{file}:\n{out}");
-        let last = out.lines().last().unwrap_or_default();
-        assert!(last.ends_with(" passed, 0 failed, 0 undecided"), "{last}");
-        assert!(!out.contains("FAILED"), "{out}");
-        // Every property is proved for runs of any length, not searched.
-        let properties = out.matches("\nproperty \"").count();
-        let proved = out.matches("symbolic: proved for runs of any length").count();
-        assert!(properties >= at_least, "{out}");
-        assert_eq!(proved, properties, "{out}");
-    }
+fn the_outdoor_rules_pass_their_tests_and_properties() {
+    the_papers_stacks_pass_their_tests_and_properties("rules/outdoor.situ", 7);
+}
+
+#[test]
+fn the_ugv_rules_pass_their_tests_and_properties() {
+    the_papers_stacks_pass_their_tests_and_properties("rules/ugv.situ", 7);
+}
+
+#[test]
+fn the_merging_ugv_rules_pass_their_tests_and_properties() {
+    the_papers_stacks_pass_their_tests_and_properties("rules/ugv-merge.situ", 7);
+}
+
+#[test]
+fn the_dla_rules_pass_their_tests_and_properties() {
+    the_papers_stacks_pass_their_tests_and_properties("rules/dla.situ", 2);
 }
 
 #[test]
