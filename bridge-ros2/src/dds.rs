@@ -16,7 +16,7 @@ use ros2_client::QosProfile;
 use ros2_client::{Context, ContextOptions, MessageTypeName, Name, Node, NodeName, NodeOptions, Publisher};
 use rustdds::mio1::{Events, Interest, Poll, Token};
 use rustdds::no_key::DataReader;
-use rustdds::{QosPolicyBuilder, ReadCondition};
+use rustdds::{QosPolicyBuilder, ReadCondition, GUID};
 use std::fmt;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -73,6 +73,9 @@ pub struct Report {
     pub record_error: Option<String>,
     /// The `get_state` requests written, per node of the map.
     pub get_state_sent: Vec<u64>,
+    /// Samples of the bridge's own writers that its readers took and
+    /// ignored (a map reading `/diagnostics` takes the bridge's status).
+    pub own_ignored: u64,
 }
 
 /// Where what came and went is recorded, if anywhere.
@@ -118,6 +121,16 @@ struct Shell {
     diagnostics: Publisher<DiagnosticArray>,
     readers: Vec<(String, DataReader<Raw, RawAdapter>)>,
     lifecycle: Vec<Lifecycle>,
+    /// The GUIDs of the bridge's own writers: a sample of theirs that a
+    /// reader takes (a map that reads `/diagnostics`) is not the robot's.
+    own: Vec<GUID>,
+}
+
+/// Whether a sample written by `writer` is the bridge's own: one of `own`,
+/// its publishers' GUIDs. Its readers ignore such a sample, whatever the
+/// map says: the bridge never feeds on what it writes.
+pub fn is_own(own: &[GUID], writer: GUID) -> bool {
+    own.contains(&writer)
 }
 
 /// The latched topics: a late subscriber (`ros2 topic echo`) gets the last one.
@@ -182,7 +195,8 @@ fn open(core: &Core, options: &Options) -> Result<Shell, DdsError> {
             patience: n.timeout,
         });
     }
-    Ok(Shell { _node: node, state, agents, diagnostics, readers, lifecycle })
+    let own = vec![state.guid(), agents.guid(), diagnostics.guid()];
+    Ok(Shell { _node: node, state, agents, diagnostics, readers, lifecycle, own })
 }
 
 impl Shell {
@@ -251,6 +265,7 @@ pub fn run(mut core: Core, options: &Options, bag: Option<Bag>) -> Result<Report
     let mut latencies = Vec::new();
     let mut busy = Duration::ZERO;
     let mut next_tick = Instant::now() + options.heartbeat;
+    let mut own_ignored = 0;
     loop {
         if options.stop.load(Ordering::Relaxed) || options.duration.is_some_and(|d| started.elapsed() >= d) {
             break;
@@ -277,6 +292,10 @@ pub fn run(mut core: Core, options: &Options, bag: Option<Bag>) -> Result<Report
                     }
                 };
                 for sample in samples {
+                    if is_own(&shell.own, sample.sample_info().writer_guid()) {
+                        own_ignored += 1;
+                        continue;
+                    }
                     let taken = Instant::now();
                     let bytes = sample.into_value().0;
                     let now = now_ns();
@@ -322,5 +341,6 @@ pub fn run(mut core: Core, options: &Options, bag: Option<Bag>) -> Result<Report
         busy,
         record_error: recording.error,
         get_state_sent,
+        own_ignored,
     })
 }
