@@ -141,7 +141,7 @@ pub fn bad_topics(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
         let name = &e.topic.value;
         let Some(p) = topic_problem(name) else { continue };
         let corrected = corrected_topic(name).filter(|c| c != name);
-        let help = match (&corrected, name.chars().next()) {
+        let help = match (&corrected, name.trim_start().chars().next()) {
             (Some(c), Some('/')) => format!("write `topic = \"{c}\"`: letters, digits and single `_` between `/`"),
             (Some(c), _) => format!(
                 "write `topic = \"{c}\"`: the bridge's node is in the root namespace, and a relative name \

@@ -166,7 +166,8 @@ fn meant(text: &str) -> Option<String> {
         _ => return None,
     };
     let candidate = format!("{number}{unit}");
-    (candidate != text && exact(&candidate).is_some()).then_some(candidate)
+    let fits = matches!(exact(&candidate), Some(Some(n)) if n > 0 && n <= MAX_TIMEOUT_NS);
+    (candidate != text && fits).then_some(candidate)
 }
 
 /// A parsed map.
@@ -314,7 +315,7 @@ mod tests {
         assert_eq!(meant("1,5 seconds").as_deref(), Some("1.5s"));
         assert_eq!(meant("250 millis").as_deref(), Some("250ms"));
         assert_eq!(meant("2 S").as_deref(), Some("2s"));
-        for none in ["", "2", "2h", "fast", "-1s"] {
+        for none in ["", "2", "2h", "fast", "-1s", "0 ms", "2 hours"] {
             assert_eq!(meant(none), None, "{none:?}");
         }
     }
