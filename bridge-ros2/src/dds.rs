@@ -344,3 +344,35 @@ pub fn run(mut core: Core, options: &Options, bag: Option<Bag>) -> Result<Report
         own_ignored,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The GUID of writer `key` (entity kind 0x03) of participant `prefix`.
+    fn writer(prefix: u8, key: u8) -> GUID {
+        let mut bytes = [prefix; 16];
+        bytes[12..].copy_from_slice(&[0, 0, key, 0x03]);
+        GUID::from_bytes(bytes)
+    }
+
+    #[test]
+    fn only_the_bridges_own_writers_are_ignored() {
+        let own = [writer(1, 1), writer(1, 2), writer(1, 3)];
+        assert!(own.iter().all(|&w| is_own(&own, w)));
+        // Another writer of the same participant, or the same entity of another.
+        assert!(!is_own(&own, writer(1, 4)));
+        assert!(!is_own(&own, writer(2, 1)));
+        assert!(!is_own(&[], writer(1, 1)));
+    }
+
+    /// Why the map refuses relative topic names (E0415): ros2-client
+    /// resolves one from the bridge's node, in the root namespace, to a DDS
+    /// topic with an empty token, which no ROS 2 node writes.
+    #[test]
+    fn a_relative_name_would_read_nothing() {
+        let node = NodeName::new("/", "situ_bridge").unwrap();
+        assert_eq!(Name::parse("scan").unwrap().to_dds_name("rt", &node, ""), "rt//scan");
+        assert_eq!(Name::parse("/scan").unwrap().to_dds_name("rt", &node, ""), "rt/scan");
+    }
+}

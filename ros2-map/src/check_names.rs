@@ -177,9 +177,8 @@ pub fn shared_nodes(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
     let known = |n: &NodeEntry| model.agents.iter().any(|a| a.name == n.agent.value);
     let mut out = Vec::new();
     for (i, n) in map.nodes.iter().enumerate().filter(|(_, n)| known(n)) {
-        let first = map.nodes[..i]
-            .iter()
-            .find(|m| known(m) && m.node.value == n.node.value && m.agent.value != n.agent.value);
+        let first =
+            map.nodes[..i].iter().find(|m| known(m) && m.node.value == n.node.value && m.agent.value != n.agent.value);
         let Some(first) = first else { continue };
         out.push(
             Diagnostic::error(
@@ -255,7 +254,10 @@ pub fn duplicates(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
         let same_payload = payload(first) == payload(e);
         let (message, help) = if same_payload {
             (
-                format!("this entry repeats another: every message on `{}` posts `{}` twice", e.topic.value, e.event.value),
+                format!(
+                    "this entry repeats another: every message on `{}` posts `{}` twice",
+                    e.topic.value, e.event.value
+                ),
                 "remove one of the two entries".to_string(),
             )
         } else {

@@ -500,7 +500,8 @@ fn at<'a>(map: &'a str, span: situ_grammar::ast::Span) -> &'a str {
 #[test]
 fn bad_topic_names() {
     let topic = |t: &str| ev("Lidar", "CLEAR", t, "sensor_msgs/LaserScan", "");
-    for bad in ["", "/wrist-range", "/e stop", "/2pick", "scan", "~/range", "/{robot}/scan", "/", "/a/", "/a//b", "/a__b"]
+    for bad in
+        ["", "/wrist-range", "/e stop", "/2pick", "scan", "~/range", "/{robot}/scan", "/", "/a/", "/a//b", "/a__b"]
     {
         raises(codes::ROS2_BAD_TOPIC, [&topic(bad), &topic(bad), &topic(bad)]);
     }
@@ -550,7 +551,10 @@ fn one_node_for_two_agents() {
     let map = n("Planner", "/a") + &n("Base", "/a");
     let d = &findings(&map, codes::ROS2_SHARED_NODE)[0];
     assert_eq!(d.message, "`/a` plays `Planner` and `Base`");
-    assert_eq!((d.primary.span.start, d.secondary[0].span.start), (map.rfind("\"/a\"").unwrap(), map.find("\"/a\"").unwrap()));
+    assert_eq!(
+        (d.primary.span.start, d.secondary[0].span.start),
+        (map.rfind("\"/a\"").unwrap(), map.find("\"/a\"").unwrap())
+    );
     assert!(d.help.as_deref().is_some_and(|h| h.contains("remove one `[[node]]`")), "{d:?}");
 }
 
@@ -574,17 +578,32 @@ fn repeated_entries() {
         codes::ROS2_DUPLICATE_ENTRY,
         [
             &(first.clone() + &obstacle("sensor_msgs/LaserScan", "min(ranges) < 0.4", "min(ranges)")),
-            &(first.clone() + &ev("Lidar", "OBSTACLE", "/front_scan", "sensor_msgs/LaserScan", &format!("when = \"min(ranges) < 0.5\"\n{DIST}"))),
+            &(first.clone()
+                + &ev(
+                    "Lidar",
+                    "OBSTACLE",
+                    "/front_scan",
+                    "sensor_msgs/LaserScan",
+                    &format!("when = \"min(ranges) < 0.5\"\n{DIST}"),
+                )),
             &(scan("CLEAR", "") + &scan("CLEAR", "when = \"min(ranges) > 1\"")),
         ],
     );
     raises(
         codes::ROS2_DUPLICATE_ENTRY,
-        [&(scan("CLEAR", "") + &scan("CLEAR", "")), &(node("Planner", "/p", "") + &node("Planner", "/p", "")), &(node("Planner", "/p", "timeout = \"1s\"") + &node("Planner", "/p", "timeout = \"1s\""))],
+        [
+            &(scan("CLEAR", "") + &scan("CLEAR", "")),
+            &(node("Planner", "/p", "") + &node("Planner", "/p", "")),
+            &(node("Planner", "/p", "timeout = \"1s\"") + &node("Planner", "/p", "timeout = \"1s\"")),
+        ],
     );
     spares(
         codes::ROS2_DUPLICATE_ENTRY,
-        [&(node("Planner", "/p", "") + &node("Planner", "/p", "timeout = \"2s\"")), &(node("Planner", "/p", "") + &node("Base", "/p", "")), &(scan("CLEAR", "") + &odom("STOPPED", ""))],
+        [
+            &(node("Planner", "/p", "") + &node("Planner", "/p", "timeout = \"2s\"")),
+            &(node("Planner", "/p", "") + &node("Base", "/p", "")),
+            &(scan("CLEAR", "") + &odom("STOPPED", "")),
+        ],
     );
     // A warning, both entries labelled; the help says to remove one.
     let map = first.clone() + &first;

@@ -297,7 +297,8 @@ mod tests {
         assert_eq!(parse_duration("60min"), Ok(Duration::from_secs(3600)));
         assert_eq!(parse_duration("750us"), Ok(Duration::from_micros(750)));
         assert_eq!(parse_duration("100ns"), Ok(Duration::from_nanos(100)));
-        for bad in ["", "2", "s", ".5s", "1.s", "1..5s", "-1s", "+1s", "2h", "1e3ms", "500 ms", " 500ms", "500ms ", "2 S"]
+        for bad in
+            ["", "2", "s", ".5s", "1.s", "1..5s", "-1s", "+1s", "2h", "1e3ms", "500 ms", " 500ms", "500ms ", "2 S"]
         {
             assert!(matches!(parse_duration(bad), Err(DurationError::NotADuration { .. })), "{bad:?}");
         }
