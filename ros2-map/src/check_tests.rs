@@ -493,7 +493,7 @@ fn findings(map: &str, code: &str) -> Vec<Diagnostic> {
 }
 
 /// The text of the map at a finding's place.
-fn at<'a>(map: &'a str, span: situ_grammar::ast::Span) -> &'a str {
+fn at(map: &str, span: situ_grammar::ast::Span) -> &str {
     &map[span.start..span.end]
 }
 
