@@ -2,7 +2,10 @@
 //! DDS (the `cyclonedds` Python package, `bridge-ros2/tests/peer.py`) plays
 //! the AMR of `tests/ros2/amr.situ` — its lifecycle nodes, its laser, goals
 //! and navigator, and a late subscriber of `/situ/state` — over DDS on this
-//! host. The bridge runs as a user runs it, the real binary.
+//! host. The bridge runs as a user runs it, the real binary. A last scenario
+//! has rules of their own (`tests/ros2/heartbeat.situ`) that read
+//! `/diagnostics`, where the bridge writes its own status: it must not read
+//! it back.
 //!
 //! A missing `python3` or `cyclonedds` fails the test: install the test
 //! requirements with `python3 -m pip install -r examples/python/requirements.txt`.
