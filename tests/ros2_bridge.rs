@@ -2,7 +2,10 @@
 //! DDS (the `cyclonedds` Python package, `bridge-ros2/tests/peer.py`) plays
 //! the AMR of `tests/ros2/amr.situ` — its lifecycle nodes, its laser, goals
 //! and navigator, and a late subscriber of `/situ/state` — over DDS on this
-//! host. The bridge runs as a user runs it, the real binary.
+//! host. The bridge runs as a user runs it, the real binary. A last scenario
+//! has rules of their own (`tests/ros2/heartbeat.situ`) that read
+//! `/diagnostics`, where the bridge writes its own status: it must not read
+//! it back.
 //!
 //! A missing `python3` or `cyclonedds` fails the test: install the test
 //! requirements with `python3 -m pip install -r examples/python/requirements.txt`.
@@ -18,10 +21,13 @@ fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
-fn bridge(domain: u16, extra: &[&std::ffi::OsStr]) -> Child {
+/// The rules and the map of the AMR.
+const AMR: (&str, &str) = ("tests/ros2/amr.situ", "tests/ros2/amr.toml");
+
+fn bridge((rules, map): (&str, &str), domain: u16, extra: &[&std::ffi::OsStr]) -> Child {
     Command::new(env!("CARGO_BIN_EXE_situ"))
         .current_dir(root())
-        .args(["ros2", "tests/ros2/amr.situ", "--map", "tests/ros2/amr.toml", "--rmw", "cyclonedds"])
+        .args(["ros2", rules, "--map", map, "--rmw", "cyclonedds"])
         .args(["--domain", &domain.to_string(), "--duration", "60"])
         .args(extra)
         .stdout(Stdio::piped())
@@ -33,18 +39,19 @@ fn bridge(domain: u16, extra: &[&std::ffi::OsStr]) -> Child {
 /// Runs the peer's scenario beside a bridge; the peer's lines, and the
 /// bridge's exit code and stderr after a Ctrl-C.
 fn scenario(name: &str, domain: u16, extra: &[&std::ffi::OsStr]) -> (Vec<Json>, i32, String) {
-    scenario_then(name, domain, extra, libc::SIGINT, Duration::ZERO)
+    scenario_then(AMR, name, domain, extra, libc::SIGINT, Duration::ZERO)
 }
 
 /// As [`scenario`], the bridge stopped by `signal` `after` the peer ended.
 fn scenario_then(
+    files: (&str, &str),
     name: &str,
     domain: u16,
     extra: &[&std::ffi::OsStr],
     signal: i32,
     after: Duration,
 ) -> (Vec<Json>, i32, String) {
-    let mut bridge = bridge(domain, extra);
+    let mut bridge = bridge(files, domain, extra);
     let peer = Command::new("python3")
         .current_dir(root())
         .args(["bridge-ros2/tests/peer.py", name, "--domain", &domain.to_string()])
@@ -189,6 +196,7 @@ fn a_killed_bridge_leaves_a_bag_that_reads_up_to_its_last_second() {
     let _ = std::fs::remove_dir_all(&bag);
     // SIGKILL 1.5 s after the mission: no clean end, one flush (a second) since the last message.
     let (lines, code, _) = scenario_then(
+        AMR,
         "mission",
         43,
         &["--record".as_ref(), bag.as_os_str()],
@@ -212,6 +220,29 @@ fn a_node_that_never_answers_is_its_failure_event() {
     // Nothing was activated: FAULT wants every node asleep.
     assert!(transitions(&lines).iter().all(|(_, l)| l == "configure"), "{lines:?}");
     assert!(stderr.contains("ended in FAULT") && stderr.contains("1 failures"), "{stderr}");
+}
+
+/// A map that reads `/diagnostics`, where the bridge writes its own status
+/// once a second (`tests/ros2/heartbeat.toml`: any status is a fault). The
+/// bridge ignores its own writers: the rules stay in RUNNING through three
+/// of its statuses, and move to FAULT on the first the peer writes.
+#[test]
+fn the_bridge_does_not_read_its_own_status() {
+    let files = ("tests/ros2/heartbeat.situ", "tests/ros2/heartbeat.toml");
+    let (lines, code, stderr) = scenario_then(files, "heartbeat", 45, &[], libc::SIGINT, Duration::ZERO);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(lines.iter().any(|l| l.get("done").is_some()), "{lines:?}\n{stderr}");
+    assert_eq!(states(&lines), ["RUNNING", "FAULT"], "{stderr}");
+    let ignored = lines.iter().find(|l| l["step"] == "own status ignored").expect("the quiet part");
+    assert!(ignored["statuses"].as_u64().is_some_and(|n| n >= 3), "{ignored}");
+    // The bridge took its own statuses off its reader and let them go.
+    let own: u64 = stderr
+        .lines()
+        .find_map(|l| l.strip_prefix("situ ros2: ")?.split_once(" messages of its own writers ignored"))
+        .and_then(|(n, _)| n.parse().ok())
+        .unwrap_or_else(|| panic!("no count of ignored messages: {stderr}"));
+    assert!(own >= 3, "{stderr}");
+    assert!(stderr.contains("ended in FAULT") && stderr.contains("1 state changes"), "{stderr}");
 }
 
 fn situ(dir: &Path, args: &[&str]) -> std::process::Output {

@@ -71,6 +71,58 @@ fn every_finding_of_a_map_is_reported_at_once() {
     assert_eq!(found.len(), 6, "{found:?}");
 }
 
+/// The JSON findings of a map, and the places of those of `code`.
+fn json_findings(map_name: &str) -> Vec<serde_json::Value> {
+    let o = check(map_name, &["--format", "json"]);
+    assert_eq!(code(&o), 1, "{}", text(&o));
+    stdout(&o).lines().map(|l| serde_json::from_str(l).expect("a JSON line")).collect()
+}
+
+fn places(found: &[serde_json::Value], code: &str) -> Vec<(u64, u64)> {
+    found
+        .iter()
+        .filter(|d| d["code"] == format!("situ::{code}"))
+        .map(|d| (d["line"].as_u64().unwrap(), d["column"].as_u64().unwrap()))
+        .collect()
+}
+
+#[test]
+fn names_repeats_and_the_bridges_own_topics_are_findings() {
+    let found = json_findings("bad_wiring.toml");
+    assert_eq!(places(&found, "E0415"), [(7, 15)], "{found:?}");
+    assert_eq!(places(&found, "W0417"), [(22, 9)], "{found:?}");
+    assert_eq!(places(&found, "E0418"), [(30, 9)], "{found:?}");
+    assert_eq!(places(&found, "W0421"), [(37, 9)], "{found:?}");
+    assert_eq!(places(&found, "E0414"), [(47, 11)], "{found:?}");
+    assert_eq!(places(&found, "E0416"), [(51, 8)], "{found:?}");
+    assert_eq!(found.len(), 6, "{found:?}");
+
+    // The human form: the corrected name and the duration's form in the helps.
+    let o = check("bad_wiring.toml", &[]);
+    let out = stdout(&o);
+    for expected in [
+        "`/scan-front` is not a ROS 2 topic name: `-` is not allowed in a name",
+        "write `topic = \"/scan_front\"`",
+        "every message on `/scan` posts `CLEAR` twice",
+        "`/situ/state` is the bridge's own output",
+        "the bridge ignores the messages of its own writers",
+        "write `timeout = \"500ms\"`",
+        "`/planner` plays `Planner` and `Orders`",
+        "delivery.situ: 4 errors, 2 warnings",
+    ] {
+        assert!(out.contains(expected), "{expected:?} not in\n{out}");
+    }
+}
+
+#[test]
+fn a_map_that_reads_diagnostics_warns_and_passes() {
+    let o = situ(&["check", "tests/ros2/heartbeat.situ", "--ros2-map", "tests/ros2/heartbeat.toml"]);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    assert!(stdout(&o).contains("situ::W0421") && stdout(&o).contains("heartbeat.toml:8:9"), "{}", text(&o));
+    let o = situ(&["check", "tests/ros2/heartbeat.situ", "--ros2-map", "tests/ros2/heartbeat.toml", "--deny-warnings"]);
+    assert_eq!(code(&o), 1, "{}", text(&o));
+}
+
 #[test]
 fn an_event_no_entry_produces_is_a_warning() {
     let o = check("unmapped.toml", &[]);
@@ -122,7 +174,7 @@ fn the_rules_are_checked_without_the_map_too() {
 
 #[test]
 fn explain_prints_the_codes_of_the_map() {
-    for code_name in ["E0401", "E0403", "W0411", "E0413"] {
+    for code_name in ["E0401", "E0403", "W0411", "E0413", "E0415", "E0416", "W0417", "E0418", "W0421"] {
         let o = situ(&["explain", code_name]);
         assert_eq!(code(&o), 0, "{}", text(&o));
         assert!(stdout(&o).contains(&format!("{code_name}: ")), "{}", text(&o));

@@ -16,7 +16,7 @@ use ros2_client::QosProfile;
 use ros2_client::{Context, ContextOptions, MessageTypeName, Name, Node, NodeName, NodeOptions, Publisher};
 use rustdds::mio1::{Events, Interest, Poll, Token};
 use rustdds::no_key::DataReader;
-use rustdds::{QosPolicyBuilder, ReadCondition};
+use rustdds::{QosPolicyBuilder, ReadCondition, GUID};
 use std::fmt;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -73,6 +73,9 @@ pub struct Report {
     pub record_error: Option<String>,
     /// The `get_state` requests written, per node of the map.
     pub get_state_sent: Vec<u64>,
+    /// Samples of the bridge's own writers that its readers took and
+    /// ignored (a map reading `/diagnostics` takes the bridge's status).
+    pub own_ignored: u64,
 }
 
 /// Where what came and went is recorded, if anywhere.
@@ -118,6 +121,16 @@ struct Shell {
     diagnostics: Publisher<DiagnosticArray>,
     readers: Vec<(String, DataReader<Raw, RawAdapter>)>,
     lifecycle: Vec<Lifecycle>,
+    /// The GUIDs of the bridge's own writers: a sample of theirs that a
+    /// reader takes (a map that reads `/diagnostics`) is not the robot's.
+    own: Vec<GUID>,
+}
+
+/// Whether a sample written by `writer` is the bridge's own: one of `own`,
+/// its publishers' GUIDs. Its readers ignore such a sample, whatever the
+/// map says: the bridge never feeds on what it writes.
+pub fn is_own(own: &[GUID], writer: GUID) -> bool {
+    own.contains(&writer)
 }
 
 /// The latched topics: a late subscriber (`ros2 topic echo`) gets the last one.
@@ -182,7 +195,8 @@ fn open(core: &Core, options: &Options) -> Result<Shell, DdsError> {
             patience: n.timeout,
         });
     }
-    Ok(Shell { _node: node, state, agents, diagnostics, readers, lifecycle })
+    let own = vec![state.guid(), agents.guid(), diagnostics.guid()];
+    Ok(Shell { _node: node, state, agents, diagnostics, readers, lifecycle, own })
 }
 
 impl Shell {
@@ -251,6 +265,7 @@ pub fn run(mut core: Core, options: &Options, bag: Option<Bag>) -> Result<Report
     let mut latencies = Vec::new();
     let mut busy = Duration::ZERO;
     let mut next_tick = Instant::now() + options.heartbeat;
+    let mut own_ignored = 0;
     loop {
         if options.stop.load(Ordering::Relaxed) || options.duration.is_some_and(|d| started.elapsed() >= d) {
             break;
@@ -277,6 +292,10 @@ pub fn run(mut core: Core, options: &Options, bag: Option<Bag>) -> Result<Report
                     }
                 };
                 for sample in samples {
+                    if is_own(&shell.own, sample.sample_info().writer_guid()) {
+                        own_ignored += 1;
+                        continue;
+                    }
                     let taken = Instant::now();
                     let bytes = sample.into_value().0;
                     let now = now_ns();
@@ -322,5 +341,38 @@ pub fn run(mut core: Core, options: &Options, bag: Option<Bag>) -> Result<Report
         busy,
         record_error: recording.error,
         get_state_sent,
+        own_ignored,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The GUID of writer `key` (entity kind 0x03) of participant `prefix`.
+    fn writer(prefix: u8, key: u8) -> GUID {
+        let mut bytes = [prefix; 16];
+        bytes[12..].copy_from_slice(&[0, 0, key, 0x03]);
+        GUID::from_bytes(bytes)
+    }
+
+    #[test]
+    fn only_the_bridges_own_writers_are_ignored() {
+        let own = [writer(1, 1), writer(1, 2), writer(1, 3)];
+        assert!(own.iter().all(|&w| is_own(&own, w)));
+        // Another writer of the same participant, or the same entity of another.
+        assert!(!is_own(&own, writer(1, 4)));
+        assert!(!is_own(&own, writer(2, 1)));
+        assert!(!is_own(&[], writer(1, 1)));
+    }
+
+    /// Why the map refuses relative topic names (E0415): ros2-client
+    /// resolves one from the bridge's node, in the root namespace, to a DDS
+    /// topic with an empty token, which no ROS 2 node writes.
+    #[test]
+    fn a_relative_name_would_read_nothing() {
+        let node = NodeName::new("/", "situ_bridge").unwrap();
+        assert_eq!(Name::parse("scan").unwrap().to_dds_name("rt", &node, ""), "rt//scan");
+        assert_eq!(Name::parse("/scan").unwrap().to_dds_name("rt", &node, ""), "rt/scan");
+    }
 }

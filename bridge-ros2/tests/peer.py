@@ -16,8 +16,12 @@ bridge's latched `/situ/state`. It prints one JSON line per thing seen:
   {"t": s, "step": WHAT}             the scenario's progress
   {"done": true} | {"failed": WHY}
 
-Scenarios: `mission` (goal, obstacle, clear, arrival) and `silent-planner`
-(the planner answers get_state but never change_state).
+Scenarios: `mission` (goal, obstacle, clear, arrival), `silent-planner`
+(the planner answers get_state but never change_state), and `heartbeat`
+(the rules of tests/ros2/heartbeat.situ read `/diagnostics`, where the
+bridge writes its own status: they must not move until this peer reports
+a fault there). With `heartbeat` it also prints
+  {"t": s, "step": "own status ignored", "statuses": N}
 Run by tests/ros2_bridge.rs; exits 3 when cyclonedds is missing.
 """
 
@@ -43,7 +47,7 @@ except ImportError as err:
     print(f"cyclonedds is not installed ({err}): python3 -m pip install -r examples/python/requirements.txt", file=sys.stderr)
     sys.exit(3)
 
-from cdr_samples import Bool, DiagnosticArray, Header, LaserScan, Point, Pose, PoseStamped, Quaternion, State
+from cdr_samples import Bool, DiagnosticArray, DiagnosticStatus, Header, LaserScan, Point, Pose, PoseStamped, Quaternion, State
 from cdr_samples import String as StringMsg
 
 
@@ -147,7 +151,10 @@ class Peer:
         self.goal = DataWriter(dp, Topic(dp, "rt/goal_pose", PoseStamped), qos=RELIABLE)
         self.scan = DataWriter(dp, Topic(dp, "rt/scan", LaserScan), qos=Qos(Policy.Reliability.BestEffort))
         self.reached = DataWriter(dp, Topic(dp, "rt/goal_reached", Bool), qos=RELIABLE)
-        self.diagnostics = DataReader(dp, Topic(dp, "rt/diagnostics", DiagnosticArray), qos=RELIABLE)
+        self.diagnostics_topic = Topic(dp, "rt/diagnostics", DiagnosticArray)
+        self.diagnostics = DataReader(dp, self.diagnostics_topic, qos=RELIABLE)
+        # The bridge's own statuses seen on /diagnostics (`situ: bridge`).
+        self.bridge_statuses = 0
         self.agents = DataReader(dp, Topic(dp, "rt/situ/agents", DiagnosticArray), qos=LATCHED)
         self.state_reader = None
         self.state = None
@@ -170,6 +177,8 @@ class Peer:
                 for status in getattr(a, "status", []):
                     if status.level == 2:
                         say(error=status.message)
+                    if status.name == "situ: bridge":
+                        self.bridge_statuses += 1
             for a in self.agents.take(16):
                 if hasattr(a, "status"):
                     seen = {}
@@ -252,14 +261,41 @@ def silent_planner(peer: Peer):
     say(step="fault")
 
 
+def heartbeat(peer: Peer):
+    """The rules post a fault for any status on /diagnostics at all. The
+    bridge's own status, once a second there, must not be one: the rules
+    stay in RUNNING for three of them; then this peer's own report of a
+    fault (level 2) takes them to FAULT."""
+    peer.follow_state()
+    need(peer.spin(10, lambda: peer.state == "RUNNING"), f"no latched RUNNING on /situ/state: {peer.state}")
+    seen = peer.bridge_statuses
+    peer.spin(10, lambda: peer.bridge_statuses >= seen + 3 or peer.state != "RUNNING")
+    # The bridge's reader gets each status about when this peer does: a
+    # little longer for the state it would cause to come back.
+    peer.spin(0.5, lambda: peer.state != "RUNNING")
+    need(peer.state == "RUNNING", f"the bridge's own status moved the rules to {peer.state}")
+    need(peer.bridge_statuses >= seen + 3, f"only {peer.bridge_statuses - seen} statuses of the bridge in 10 s")
+    say(step="own status ignored", statuses=peer.bridge_statuses - seen)
+    writer = DataWriter(peer.dp, peer.diagnostics_topic, qos=RELIABLE)
+    fault = DiagnosticStatus(level=2, name="base: motors", message="motor driver overheated", hardware_id="base")
+    # Repeated until heard (a new writer may not be matched yet).
+    for _ in range(50):
+        writer.write(DiagnosticArray(header=Header(frame_id=""), status=[fault]))
+        if peer.spin(0.1, lambda: peer.state == "FAULT"):
+            break
+    need(peer.state == "FAULT", f"the peer's fault report did not move the rules: {peer.state}")
+    say(step="fault")
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("scenario", choices=["mission", "silent-planner"])
+    ap.add_argument("scenario", choices=["mission", "silent-planner", "heartbeat"])
     ap.add_argument("--domain", type=int, default=0)
     args = ap.parse_args()
     peer = Peer(args.domain, "/planner" if args.scenario == "silent-planner" else None)
     say(step="ready")
-    (mission if args.scenario == "mission" else silent_planner)(peer)
+    scenarios = {"mission": mission, "silent-planner": silent_planner, "heartbeat": heartbeat}
+    scenarios[args.scenario](peer)
     print(json.dumps({"done": True}), flush=True)
 
 

@@ -106,6 +106,11 @@ codes! {
     ROS2_TWO_NODES = "E0412", Error, "agent played by two lifecycle nodes";
     ROS2_TOPIC_TYPES = "E0413", Error, "topic read as two message types";
     ROS2_BAD_NODE = "E0414", Error, "lifecycle node entry the bridge cannot use";
+    ROS2_BAD_TOPIC = "E0415", Error, "topic name that is not a fully qualified ROS 2 name";
+    ROS2_SHARED_NODE = "E0416", Error, "lifecycle node given to two agents";
+    ROS2_DUPLICATE_ENTRY = "W0417", Warning, "map entry that repeats another";
+    ROS2_BRIDGE_TOPIC = "E0418", Error, "map that reads the bridge's own `/situ` topics";
+    ROS2_BRIDGE_DIAGNOSTICS = "W0421", Warning, "map that reads `/diagnostics` without naming the reporter";
     VACUOUS_PROPERTY = "W0501", Warning, "property whose premise never holds";
     UNDECIDED_PROPERTY = "E0502", Error, "property neither proved nor violated";
     VIOLATED_PROPERTY = "E0503", Error, "property broken by a run";

@@ -1,6 +1,7 @@
 //! The static check of a map against the rules: one function per check,
 //! each returning all its findings; [`check_map`] runs them all.
 
+use crate::check_names;
 use crate::map::{self, EventEntry, Map};
 use crate::msgs;
 use crate::types::{type_of, Ty};
@@ -24,7 +25,7 @@ pub fn check_map(model: &Model, text: &str, file: FileId) -> Vec<Diagnostic> {
 
 /// [`check_map`] on a map already parsed (from `file`).
 pub fn check_parsed(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
-    let checks: [Check; 13] = [
+    let checks: [Check; 18] = [
         unknown_types,
         unknown_names,
         foreign_events,
@@ -38,6 +39,11 @@ pub fn check_parsed(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
         two_nodes,
         topic_types,
         bad_nodes,
+        check_names::bad_topics,
+        check_names::shared_nodes,
+        check_names::duplicates,
+        check_names::own_topics,
+        check_names::bridge_diagnostics,
     ];
     let mut out: Vec<Diagnostic> = checks.iter().flat_map(|c| c(model, map, file)).collect();
     out.sort_by_key(|d| (d.primary.span.start, d.code));
@@ -362,11 +368,17 @@ pub fn unmapped_events(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic
 pub fn two_nodes(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for (i, n) in map.nodes.iter().enumerate() {
-        if let Some(first) = map.nodes[..i].iter().find(|m| m.agent.value == n.agent.value) {
+        // An entry that repeats another exactly is W0417.
+        let other = |m: &&map::NodeEntry| m.agent.value == n.agent.value && !check_names::same_node(m, n);
+        if let Some(first) = map.nodes[..i].iter().find(other) {
             out.push(
                 Diagnostic::error(
                     codes::ROS2_TWO_NODES,
-                    format!("`{}` is played by `{}` and by `{}`", n.agent.value, first.node.value, n.node.value),
+                    if first.node.value == n.node.value {
+                        format!("`{}` has two `[[node]]` for `{}` that differ", n.agent.value, n.node.value)
+                    } else {
+                        format!("`{}` is played by `{}` and by `{}`", n.agent.value, first.node.value, n.node.value)
+                    },
                     file,
                     n.agent.span,
                     "second node for this agent",
@@ -458,12 +470,17 @@ pub fn bad_nodes(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
             }
         }
         if let (Some(t), Err(reason)) = (&n.timeout, n.timeout()) {
-            out.push(bad(
-                t,
-                reason.to_string(),
-                "not a timeout",
-                "write a whole number of `ms` or `s`, e.g. `timeout = \"500ms\"`",
-            ));
+            let help = match reason.meant() {
+                Some(meant) => format!("write `timeout = \"{meant}\"`: a number and its unit with no space"),
+                None => "write a number and a unit with no space, as the rules do: `timeout = \"500ms\"`, \
+                         `\"1.5s\"` (units `ns`, `us`, `ms`, `s`, `min`; more than 0, at most an hour)"
+                    .to_string(),
+            };
+            let mut d = bad(t, reason.to_string(), "not a timeout", &help);
+            if let (Some(meant), Some(_)) = (reason.meant(), t.inner) {
+                d = d.with_fix(format!("write `{meant}`"), file, t.sub(0, t.value.len()), meant);
+            }
+            out.push(d);
         }
     }
     out

@@ -325,7 +325,7 @@ fn two_nodes_for_one_agent() {
         codes::ROS2_TWO_NODES,
         [
             &(node("Planner", "/a") + &node("Planner", "/b")),
-            &(node("Planner", "/a") + &node("Planner", "/a")),
+            &(node("Planner", "/a") + &node("Planner", "/a") + "timeout = \"2s\"\n"),
             &(node("Base", "/a") + &node("Planner", "/b") + &node("Base", "/c")),
         ],
     );
@@ -333,8 +333,9 @@ fn two_nodes_for_one_agent() {
         codes::ROS2_TWO_NODES,
         [
             &node("Planner", "/a"),
-            &(node("Planner", "/a") + &node("Base", "/a")),
             &(node("Planner", "/a") + &node("Base", "/b")),
+            // The same entry twice is W0417.
+            &(node("Planner", "/a") + &node("Planner", "/a")),
         ],
     );
 }
@@ -483,4 +484,199 @@ mod no_panic {
             let _ = check_map(&checked.model, &map, FileId(1));
         }
     }
+}
+
+/// The findings of `code` in `map`.
+fn findings(map: &str, code: &str) -> Vec<Diagnostic> {
+    let checked = check_source("rules.situ", RULES);
+    check_map(&checked.model, map, FileId(1)).into_iter().filter(|d| d.code == code).collect()
+}
+
+/// The text of the map at a finding's place.
+fn at(map: &str, span: situ_grammar::ast::Span) -> &str {
+    &map[span.start..span.end]
+}
+
+#[test]
+fn bad_topic_names() {
+    let topic = |t: &str| ev("Lidar", "CLEAR", t, "sensor_msgs/LaserScan", "");
+    for bad in
+        ["", "/wrist-range", "/e stop", "/2pick", "scan", "~/range", "/{robot}/scan", "/", "/a/", "/a//b", "/a__b"]
+    {
+        raises(codes::ROS2_BAD_TOPIC, [&topic(bad), &topic(bad), &topic(bad)]);
+    }
+    spares(codes::ROS2_BAD_TOPIC, [&topic("/scan"), &topic("/robot_1/arm/pick_2"), &topic("/_hidden/Scan9")]);
+
+    // The place is the character at fault, the help and the fix the corrected name.
+    let map = topic("/wrist-range");
+    let d = &findings(&map, codes::ROS2_BAD_TOPIC)[0];
+    assert_eq!(at(&map, d.primary.span), "-");
+    assert!(d.help.as_deref().is_some_and(|h| h.contains("`topic = \"/wrist_range\"`")), "{d:?}");
+    assert_eq!(d.fixes[0].edits[0].text, "/wrist_range");
+    assert_eq!(at(&map, d.fixes[0].edits[0].span), "/wrist-range");
+    let map = topic("scan");
+    let d = &findings(&map, codes::ROS2_BAD_TOPIC)[0];
+    assert!(d.message.contains("relative"), "{d:?}");
+    assert!(d.help.as_deref().is_some_and(|h| h.contains("`topic = \"/scan\"`")), "{d:?}");
+    let map = topic("/2pick");
+    let d = &findings(&map, codes::ROS2_BAD_TOPIC)[0];
+    assert_eq!(at(&map, d.primary.span), "2pick");
+    assert!(d.help.as_deref().is_some_and(|h| h.contains("ros2 topic list")) && d.fixes.is_empty(), "{d:?}");
+    // An empty name points at its quotes.
+    let map = topic("");
+    assert_eq!(at(&map, findings(&map, codes::ROS2_BAD_TOPIC)[0].primary.span), "\"\"");
+}
+
+#[test]
+fn one_node_for_two_agents() {
+    let n = |agent: &str, name: &str| node(agent, name, "");
+    raises(
+        codes::ROS2_SHARED_NODE,
+        [
+            &(n("Planner", "/a") + &n("Base", "/a")),
+            &(n("Planner", "/nav/a") + &n("Base", "/b") + &n("Lidar", "/nav/a")),
+            &(n("Planner", "/a") + &node("Base", "/a", "timeout = \"2s\"")),
+        ],
+    );
+    spares(
+        codes::ROS2_SHARED_NODE,
+        [
+            &(n("Planner", "/a") + &n("Base", "/b")),
+            &(n("Planner", "/a") + &n("Planner", "/a")),
+            // A misspelt agent is E0405, not a second agent.
+            &(n("Planner", "/a") + &n("Planer", "/a")),
+        ],
+    );
+    // Both places are labelled.
+    let map = n("Planner", "/a") + &n("Base", "/a");
+    let d = &findings(&map, codes::ROS2_SHARED_NODE)[0];
+    assert_eq!(d.message, "`/a` plays `Planner` and `Base`");
+    assert_eq!(
+        (d.primary.span.start, d.secondary[0].span.start),
+        (map.rfind("\"/a\"").unwrap(), map.find("\"/a\"").unwrap())
+    );
+    assert!(d.help.as_deref().is_some_and(|h| h.contains("remove one `[[node]]`")), "{d:?}");
+}
+
+#[test]
+fn repeated_entries() {
+    let obstacle = |ty: &str, when: &str, dist: &str| {
+        ev("Lidar", "OBSTACLE", "/scan", ty, &format!("when = \"{when}\"\n[event.payload]\ndistance = \"{dist}\""))
+    };
+    let first = obstacle("sensor_msgs/msg/LaserScan", "min(ranges) < 0.5", "min(ranges)");
+    raises(
+        codes::ROS2_DUPLICATE_ENTRY,
+        [
+            &(first.clone() + &first),
+            // The short form of the type, the expressions without their spaces.
+            &(first.clone() + &obstacle("sensor_msgs/LaserScan", "min(ranges)<0.5", " min( ranges )")),
+            // Two payloads for one message.
+            &(first.clone() + &obstacle("sensor_msgs/LaserScan", "min(ranges) < 0.5", "range_max")),
+        ],
+    );
+    spares(
+        codes::ROS2_DUPLICATE_ENTRY,
+        [
+            &(first.clone() + &obstacle("sensor_msgs/LaserScan", "min(ranges) < 0.4", "min(ranges)")),
+            &(first.clone()
+                + &ev(
+                    "Lidar",
+                    "OBSTACLE",
+                    "/front_scan",
+                    "sensor_msgs/LaserScan",
+                    &format!("when = \"min(ranges) < 0.5\"\n{DIST}"),
+                )),
+            &(scan("CLEAR", "") + &scan("CLEAR", "when = \"min(ranges) > 1\"")),
+        ],
+    );
+    raises(
+        codes::ROS2_DUPLICATE_ENTRY,
+        [
+            &(scan("CLEAR", "") + &scan("CLEAR", "")),
+            &(node("Planner", "/p", "") + &node("Planner", "/p", "")),
+            &(node("Planner", "/p", "timeout = \"1s\"") + &node("Planner", "/p", "timeout = \"1s\"")),
+        ],
+    );
+    spares(
+        codes::ROS2_DUPLICATE_ENTRY,
+        [
+            &(node("Planner", "/p", "") + &node("Planner", "/p", "timeout = \"2s\"")),
+            &(node("Planner", "/p", "") + &node("Base", "/p", "")),
+            &(scan("CLEAR", "") + &odom("STOPPED", "")),
+        ],
+    );
+    // A warning, both entries labelled; the help says to remove one.
+    let map = first.clone() + &first;
+    let d = &findings(&map, codes::ROS2_DUPLICATE_ENTRY)[0];
+    assert_eq!(d.severity, situ_grammar::diag::Severity::Warning);
+    assert!(d.primary.span.start > d.secondary[0].span.start, "{d:?}");
+    assert_eq!((at(&map, d.primary.span), at(&map, d.secondary[0].span)), ("\"OBSTACLE\"", "\"OBSTACLE\""));
+    assert!(d.message.contains("posts `OBSTACLE` twice"), "{d:?}");
+    assert!(d.help.as_deref().is_some_and(|h| h.contains("remove one")), "{d:?}");
+}
+
+#[test]
+fn the_bridges_own_topics() {
+    let read = |topic: &str| ev("Base", "STOPPED", topic, "std_msgs/msg/String", "when = \"data == 'IDLE'\"");
+    raises(codes::ROS2_BRIDGE_TOPIC, [&read("/situ/state"), &read("/situ/agents"), &read("/situ")]);
+    spares(codes::ROS2_BRIDGE_TOPIC, [&read("/situation"), &read("/robot/situ/state"), &read("/state")]);
+
+    let diag = |topic: &str, when: &str| {
+        ev(
+            "Diag",
+            "FAULT",
+            topic,
+            "diagnostic_msgs/msg/DiagnosticArray",
+            &format!("when = \"{when}\"\n[event.payload]\nlevel = \"'error'\"\npresent = \"true\""),
+        )
+    };
+    raises(
+        codes::ROS2_BRIDGE_DIAGNOSTICS,
+        [
+            &diag("/diagnostics", "len(status) > 0 and status[0].level >= 0"),
+            &diag("/diagnostics", "status[0].level >= 2 or status[0].hardware_id == 'base'"),
+            &diag("/diagnostics", "status[0].level >= 2 and status[0].hardware_id == 'situ'"),
+        ],
+    );
+    spares(
+        codes::ROS2_BRIDGE_DIAGNOSTICS,
+        [
+            &diag("/diagnostics", "status[0].level >= 2 and status[0].hardware_id == 'base'"),
+            &diag("/diagnostics", "status[0].level >= 2 and status[0].hardware_id != 'situ'"),
+            &diag("/diagnostics_agg", "len(status) > 0 and status[0].level >= 0"),
+        ],
+    );
+    let map = diag("/diagnostics", "status[0].level >= 0");
+    let d = &findings(&map, codes::ROS2_BRIDGE_DIAGNOSTICS)[0];
+    assert_eq!(d.severity, situ_grammar::diag::Severity::Warning);
+    assert_eq!(at(&map, d.primary.span), "\"/diagnostics\"");
+    assert!(d.help.as_deref().is_some_and(|h| h.contains("ignores the messages of its own writers")), "{d:?}");
+}
+
+#[test]
+fn timeouts_are_written_as_the_rules_write_durations() {
+    raises(
+        codes::ROS2_BAD_NODE,
+        [
+            &node("Planner", "/p", "timeout = \"500 ms\""),
+            &node("Planner", "/p", "timeout = \"2 sec\""),
+            &node("Planner", "/p", "timeout = \"0s\""),
+        ],
+    );
+    spares(
+        codes::ROS2_BAD_NODE,
+        [
+            &node("Planner", "/p", "timeout = \"1.5s\""),
+            &node("Planner", "/p", "timeout = \"2min\""),
+            &node("Planner", "/p", "timeout = \"750us\""),
+        ],
+    );
+    let map = node("Planner", "/p", "timeout = \"500 ms\"");
+    let d = &findings(&map, codes::ROS2_BAD_NODE)[0];
+    assert_eq!(at(&map, d.primary.span), "\"500 ms\"");
+    assert!(d.help.as_deref().is_some_and(|h| h.contains("`timeout = \"500ms\"`")), "{d:?}");
+    assert_eq!(d.fixes[0].edits[0].text, "500ms");
+    let map = node("Planner", "/p", "timeout = \"soon\"");
+    let d = &findings(&map, codes::ROS2_BAD_NODE)[0];
+    assert!(d.help.as_deref().is_some_and(|h| h.contains("`\"1.5s\"`")) && d.fixes.is_empty(), "{d:?}");
 }

@@ -9,6 +9,7 @@
 //! - [`expr`]: the expressions of `when` and of payload fields.
 //! - [`types`]: the types of expressions against a message.
 //! - [`check`]: the checks, one function each; [`check_map`] runs them all.
+//! - [`check_names`]: the checks of topic and node names, repeated entries and the bridge's own topics.
 //! - [`cdr`]: decoding of the catalogue's messages from their CDR bytes.
 //! - [`eval`]: expressions on a decoded message; the [`Translator`] of messages to events.
 //! - [`lifecycle`]: the next `change_state` request the tables ask of the lifecycle nodes.
@@ -16,6 +17,7 @@
 
 pub mod cdr;
 pub mod check;
+pub mod check_names;
 pub mod eval;
 pub mod expr;
 pub mod lifecycle;

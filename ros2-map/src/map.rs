@@ -77,29 +77,97 @@ impl NodeEntry {
 /// Why a map's timeout is not a duration.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum DurationError {
-    #[error("`{0}` is not a duration: write a whole number and `ms` or `s`")]
-    NotADuration(String),
+    /// Not of the form of the rules' durations; with the form meant, when
+    /// it is plain (`500 ms` → `500ms`, `2 sec` → `2s`).
+    #[error("`{text}` is not a duration: write a number and a unit with no space (`500ms`, `1.5s`)")]
+    NotADuration { text: String, meant: Option<String> },
     #[error("`{0}` is out of range: a timeout is more than 0 and at most 1 hour")]
     OutOfRange(String),
 }
 
-/// A duration as the rules write one: a whole number and `ms` or `s`,
+impl DurationError {
+    /// The duration as it should have been written, when that is plain.
+    pub fn meant(&self) -> Option<&str> {
+        match self {
+            DurationError::NotADuration { meant, .. } => meant.as_deref(),
+            DurationError::OutOfRange(_) => None,
+        }
+    }
+}
+
+/// The longest timeout of a node, in nanoseconds: an hour.
+const MAX_TIMEOUT_NS: u64 = 3_600_000_000_000;
+
+/// The units of a duration, as the rules write them (`docs/language.md`
+/// 2.6), with their nanoseconds.
+const UNITS: [(&str, u64); 5] =
+    [("ns", 1), ("us", 1_000), ("ms", 1_000_000), ("min", 60_000_000_000), ("s", 1_000_000_000)];
+
+/// A duration as the rules write one: a number (`2`, `1.5`) immediately
+/// followed by `ns`, `us`, `ms`, `s` or `min`, no space and no sign;
 /// greater than zero and at most an hour.
 pub fn parse_duration(text: &str) -> Result<Duration, DurationError> {
-    let text = text.trim();
-    let (digits, unit) = match text.strip_suffix("ms") {
-        Some(d) => (d, 1u64),
-        None => match text.strip_suffix('s') {
-            Some(d) => (d, 1000u64),
-            None => return Err(DurationError::NotADuration(text.to_string())),
-        },
-    };
-    let n: u64 = digits.trim().parse().map_err(|_| DurationError::NotADuration(text.to_string()))?;
-    let ms = n.saturating_mul(unit);
-    if ms == 0 || ms > 3_600_000 {
-        return Err(DurationError::OutOfRange(text.to_string()));
+    let not_one = || DurationError::NotADuration { text: text.to_string(), meant: meant(text) };
+    let nanos = exact(text).ok_or_else(not_one)?;
+    match nanos {
+        Some(n) if n > 0 && n <= MAX_TIMEOUT_NS => Ok(Duration::from_nanos(n)),
+        _ => Err(DurationError::OutOfRange(text.to_string())),
     }
-    Ok(Duration::from_millis(ms))
+}
+
+/// The nanoseconds of `text` written exactly as the rules write a
+/// duration: `None` when it is not of that form, `Some(None)` when it is
+/// but its value does not fit (or is finer than a nanosecond).
+fn exact(text: &str) -> Option<Option<u64>> {
+    let split = text.find(|c: char| !(c.is_ascii_digit() || c == '.'))?;
+    let (number, unit) = text.split_at(split);
+    let scale = UNITS.iter().find(|(u, _)| *u == unit)?.1;
+    let (int, frac) = number.split_once('.').unwrap_or((number, ""));
+    let well_formed = !int.is_empty()
+        && int.bytes().all(|b| b.is_ascii_digit())
+        && (!number.contains('.') || (!frac.is_empty() && frac.bytes().all(|b| b.is_ascii_digit())));
+    if !well_formed {
+        return None;
+    }
+    Some(scaled(int, frac, scale))
+}
+
+/// `int.frac × scale` in integers, exactly; `None` when it overflows or
+/// has a non-zero digit finer than the unit `1`.
+fn scaled(int: &str, frac: &str, scale: u64) -> Option<u64> {
+    let mut total = int.parse::<u64>().ok()?.checked_mul(scale)?;
+    let mut unit = scale;
+    for d in frac.bytes() {
+        unit /= 10;
+        if unit == 0 {
+            if d != b'0' {
+                return None;
+            }
+            continue;
+        }
+        total = total.checked_add(u64::from(d - b'0') * unit)?;
+    }
+    Some(total)
+}
+
+/// What a timeout that is not a duration most likely meant: the same
+/// number and unit without spaces, a unit's long name (`sec`, `millis`,
+/// `seconds`) as its symbol, `,` as the decimal point.
+fn meant(text: &str) -> Option<String> {
+    let squeezed: String = text.chars().filter(|c| !c.is_whitespace()).collect::<String>().replace(',', ".");
+    let split = squeezed.find(|c: char| !(c.is_ascii_digit() || c == '.'))?;
+    let (number, unit) = squeezed.split_at(split);
+    let unit = match unit.to_ascii_lowercase().as_str() {
+        "ns" | "nsec" | "nanos" | "nanosecond" | "nanoseconds" => "ns",
+        "us" | "µs" | "usec" | "micros" | "microsecond" | "microseconds" => "us",
+        "ms" | "msec" | "msecs" | "millis" | "millisecond" | "milliseconds" => "ms",
+        "s" | "sec" | "secs" | "second" | "seconds" => "s",
+        "min" | "mins" | "minute" | "minutes" => "min",
+        _ => return None,
+    };
+    let candidate = format!("{number}{unit}");
+    let fits = matches!(exact(&candidate), Some(Some(n)) if n > 0 && n <= MAX_TIMEOUT_NS);
+    (candidate != text && fits).then_some(candidate)
 }
 
 /// A parsed map.
@@ -220,11 +288,36 @@ mod tests {
     }
 
     #[test]
-    fn timeouts_are_durations() {
+    fn timeouts_are_durations_as_the_rules_write_them() {
         assert_eq!(parse_duration("500ms"), Ok(Duration::from_millis(500)));
         assert_eq!(parse_duration("2s"), Ok(Duration::from_secs(2)));
-        for bad in ["", "0ms", "2", "1.5s", "-1s", "2h", "3601s", "99999999999999999999s"] {
-            assert!(parse_duration(bad).is_err(), "{bad:?}");
+        assert_eq!(parse_duration("1.5s"), Ok(Duration::from_millis(1500)));
+        assert_eq!(parse_duration("0.25s"), Ok(Duration::from_millis(250)));
+        assert_eq!(parse_duration("2min"), Ok(Duration::from_secs(120)));
+        assert_eq!(parse_duration("60min"), Ok(Duration::from_secs(3600)));
+        assert_eq!(parse_duration("750us"), Ok(Duration::from_micros(750)));
+        assert_eq!(parse_duration("100ns"), Ok(Duration::from_nanos(100)));
+        for bad in
+            ["", "2", "s", ".5s", "1.s", "1..5s", "-1s", "+1s", "2h", "1e3ms", "500 ms", " 500ms", "500ms ", "2 S"]
+        {
+            assert!(matches!(parse_duration(bad), Err(DurationError::NotADuration { .. })), "{bad:?}");
+        }
+        for out in ["0ms", "0.0s", "3601s", "61min", "99999999999999999999s", "0.0000000001s"] {
+            assert!(matches!(parse_duration(out), Err(DurationError::OutOfRange(_))), "{out:?}");
+        }
+    }
+
+    #[test]
+    fn a_timeout_that_is_not_a_duration_says_the_form_meant() {
+        let meant = |t: &str| parse_duration(t).unwrap_err().meant().map(str::to_string);
+        assert_eq!(meant("500 ms").as_deref(), Some("500ms"));
+        assert_eq!(meant(" 2s ").as_deref(), Some("2s"));
+        assert_eq!(meant("2 sec").as_deref(), Some("2s"));
+        assert_eq!(meant("1,5 seconds").as_deref(), Some("1.5s"));
+        assert_eq!(meant("250 millis").as_deref(), Some("250ms"));
+        assert_eq!(meant("2 S").as_deref(), Some("2s"));
+        for none in ["", "2", "2h", "fast", "-1s", "0 ms", "2 hours"] {
+            assert_eq!(meant(none), None, "{none:?}");
         }
     }
 

@@ -153,6 +153,12 @@ pub fn run(args: Args) -> Outcome {
                 "situ ros2: ended in {}; {} messages ({:.0}/s), {} refused, {} events, {} rejected, {} state changes, {} lifecycle requests, {} failures",
                 report.state, c.messages, report.rate, c.refused, c.events, c.rejected, c.changes, c.requests, c.failures
             );
+            if report.own_ignored > 0 {
+                eprintln!(
+                    "situ ros2: {} messages of its own writers ignored (the map reads a topic the bridge publishes)",
+                    report.own_ignored
+                );
+            }
             if let Some(e) = &report.record_error {
                 eprintln!("error: the recording stopped: {e}");
             } else if let Some(dir) = &args.record {
