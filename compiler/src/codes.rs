@@ -106,6 +106,8 @@ codes! {
     ROS2_TWO_NODES = "E0412", Error, "agent played by two lifecycle nodes";
     ROS2_TOPIC_TYPES = "E0413", Error, "topic read as two message types";
     ROS2_BAD_NODE = "E0414", Error, "lifecycle node entry the bridge cannot use";
+    ROS2_ZERO_DIVISION = "E0419", Error, "division by a constant zero in a map expression";
+    ROS2_BAD_INDEX = "E0420", Error, "array index in a map expression that is not an integer";
     VACUOUS_PROPERTY = "W0501", Warning, "property whose premise never holds";
     UNDECIDED_PROPERTY = "E0502", Error, "property neither proved nor violated";
     VIOLATED_PROPERTY = "E0503", Error, "property broken by a run";

@@ -24,7 +24,7 @@ pub fn check_map(model: &Model, text: &str, file: FileId) -> Vec<Diagnostic> {
 
 /// [`check_map`] on a map already parsed (from `file`).
 pub fn check_parsed(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
-    let checks: [Check; 13] = [
+    let checks: [Check; 15] = [
         unknown_types,
         unknown_names,
         foreign_events,
@@ -38,6 +38,8 @@ pub fn check_parsed(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
         two_nodes,
         topic_types,
         bad_nodes,
+        crate::expr_check::zero_divisions,
+        crate::expr_check::non_integer_indexes,
     ];
     let mut out: Vec<Diagnostic> = checks.iter().flat_map(|c| c(model, map, file)).collect();
     out.sort_by_key(|d| (d.primary.span.start, d.code));

@@ -140,7 +140,7 @@ fn bad_expression() {
         codes::ROS2_BAD_EXPRESSION,
         [
             &scan("CLEAR", "when = \"min(ranges) >\""),
-            &scan("CLEAR", "when = \"ranges[-1] > 2\""),
+            &scan("CLEAR", "when = \"ranges[1] = 2\""),
             &scan("OBSTACLE", "[event.payload]\ndistance = \"median(ranges)\""),
         ],
     );

@@ -8,6 +8,7 @@
 //! - [`msgs`]: the message catalogue, as data.
 //! - [`expr`]: the expressions of `when` and of payload fields.
 //! - [`types`]: the types of expressions against a message.
+//! - [`expr_check`]: the checks of expressions beyond fields and types (E0419, E0420).
 //! - [`check`]: the checks, one function each; [`check_map`] runs them all.
 //! - [`cdr`]: decoding of the catalogue's messages from their CDR bytes.
 //! - [`eval`]: expressions on a decoded message; the [`Translator`] of messages to events.
@@ -18,6 +19,7 @@ pub mod cdr;
 pub mod check;
 pub mod eval;
 pub mod expr;
+pub mod expr_check;
 pub mod lifecycle;
 pub mod map;
 pub mod msgs;
