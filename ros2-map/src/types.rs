@@ -566,3 +566,7 @@ impl Cx<'_> {
         }
     }
 }
+
+#[cfg(test)]
+#[path = "types_tests.rs"]
+mod tests;

@@ -130,3 +130,235 @@ fn a_map_with_errors_is_refused() {
     let errors = Translator::new(&checked.model, &bad, FileId(1)).unwrap_err();
     assert!(errors.iter().any(|d| d.code == codes::ROS2_UNKNOWN_FIELD));
 }
+
+/// A value out of the message's borrow, for comparisons.
+#[derive(Debug, PartialEq)]
+enum Out {
+    Int(i64),
+    Float(f64),
+    Bool(bool),
+    Str(String),
+    Node,
+}
+
+/// A robot's messages in one: `/diagnostics`' `status`, a `JointState`'s
+/// parallel arrays, a `GoalStatusArray`'s `status_list`, a quaternion and a
+/// vector.
+fn robot() -> M {
+    let kv = |k: &str, v: &str| M::Msg(vec![("key", M::Str(k.into())), ("value", M::Str(v.into()))]);
+    let status = |level: i64, name: &str, values: Vec<M>| {
+        M::Msg(vec![("level", M::Int(level)), ("name", M::Str(name.into())), ("values", M::Array(values))])
+    };
+    let goal = |status: i64, id: i64| {
+        M::Msg(vec![("goal_info", M::Msg(vec![("id", M::Int(id))])), ("status", M::Int(status))])
+    };
+    let floats = |xs: &[f64]| M::Array(xs.iter().map(|x| M::Float(*x)).collect());
+    let strings = |xs: &[&str]| M::Array(xs.iter().map(|x| M::Str(x.to_string())).collect());
+    let half = std::f64::consts::FRAC_1_SQRT_2;
+    M::Msg(vec![
+        (
+            "status",
+            M::Array(vec![
+                status(0, "lidar", vec![kv("rate", "10")]),
+                status(2, "motor", vec![kv("temp", "90"), kv("fault", "overheat")]),
+                status(1, "battery", vec![]),
+            ]),
+        ),
+        ("quiet", M::Array(vec![])),
+        ("name", strings(&["shoulder", "elbow", "wrist"])),
+        ("position", floats(&[0.5, -1.25, 2.0])),
+        ("velocity", floats(&[0.0, f64::NAN, 1.0])),
+        ("status_list", M::Array(vec![goal(4, 7), goal(2, 8)])),
+        ("levels", M::Array(vec![M::Int(3), M::Int(-7), M::Int(5)])),
+        // A yaw of 90°: (0, 0, sin 45°, cos 45°).
+        ("q", M::Msg(vec![("x", M::Float(0.0)), ("y", M::Float(0.0)), ("z", M::Float(half)), ("w", M::Float(half))])),
+        ("zero", M::Msg(vec![("x", M::Float(0.0)), ("y", M::Float(0.0)), ("z", M::Float(0.0)), ("w", M::Float(0.0))])),
+        ("v", M::Msg(vec![("x", M::Float(3.0)), ("y", M::Float(0.0)), ("z", M::Float(-4.0))])),
+        ("min_int", M::Int(i64::MIN)),
+    ])
+}
+
+fn on(text: &str) -> Result<Out, String> {
+    let m = robot();
+    let src = Source { expr: expr::parse(text).unwrap_or_else(|e| panic!("{text}: {e:?}")), text: text.to_string() };
+    src.eval(&m).map(|v| match v {
+        Val::Int(i) => Out::Int(i),
+        Val::Float(f) => Out::Float(f),
+        Val::Bool(b) => Out::Bool(b),
+        Val::Str(s) => Out::Str(s.to_string()),
+        Val::Node(_) => Out::Node,
+    })
+}
+
+fn near(text: &str, want: f64) {
+    match on(text) {
+        Ok(Out::Float(x)) => assert!((x - want).abs() < 1e-12, "{text}: {x} is not {want}"),
+        other => panic!("{text}: {other:?}"),
+    }
+}
+
+#[test]
+fn functions_over_elements() {
+    assert_eq!(on("any(status, level >= 2)"), Ok(Out::Bool(true)));
+    assert_eq!(on("any(status, level > 2)"), Ok(Out::Bool(false)));
+    assert_eq!(on("all(status, level <= 2)"), Ok(Out::Bool(true)));
+    assert_eq!(on("all(status, level == 0)"), Ok(Out::Bool(false)));
+    assert_eq!(on("count(status, level >= 1)"), Ok(Out::Int(2)));
+    assert_eq!(on("max(status, level)"), Ok(Out::Int(2)));
+    assert_eq!(on("min(status, level)"), Ok(Out::Int(0)));
+    assert_eq!(on("min(status, level - 0.5)"), Ok(Out::Float(-0.5)));
+    assert_eq!(on("mean(status, level)"), Ok(Out::Float(1.0)));
+    assert_eq!(on("find(status, name == 'motor').level"), Ok(Out::Int(2)));
+    assert_eq!(on("find(status, level == 1).name"), Ok(Out::Str("battery".into())));
+    assert_eq!(on("find(status, level == 1)"), Ok(Out::Node));
+    assert_eq!(on("find(position, it < 0)"), Ok(Out::Float(-1.25)));
+    assert_eq!(on("count(position, it > 0)"), Ok(Out::Int(2)));
+    assert_eq!(on("any(status, it.name == 'lidar')"), Ok(Out::Bool(true)));
+    // Empty arrays: any is false, all is true, count is 0.
+    assert_eq!(on("any(quiet, level > 0)"), Ok(Out::Bool(false)));
+    assert_eq!(on("all(quiet, level > 0)"), Ok(Out::Bool(true)));
+    assert_eq!(on("count(quiet, level > 0)"), Ok(Out::Int(0)));
+}
+
+#[test]
+fn nested_scopes() {
+    assert_eq!(on("any(status, any(values, key == 'fault'))"), Ok(Out::Bool(true)));
+    assert_eq!(on("count(status, any(values, key == 'fault' or key == 'rate'))"), Ok(Out::Int(2)));
+    assert_eq!(on("all(status, all(values, value != ''))"), Ok(Out::Bool(true)));
+    assert_eq!(on("find(status, len(values) == 2).values[-1].value"), Ok(Out::Str("overheat".into())));
+    assert_eq!(on("max(status, count(values, it.key != ''))"), Ok(Out::Int(2)));
+}
+
+#[test]
+fn any_and_all_stop_at_the_first_answer() {
+    // The second element's `values[5]` is missing, but the first decides.
+    assert_eq!(on("any(status, level == 0 or values[5].key == 'x')"), Ok(Out::Bool(true)));
+    assert_eq!(on("all(status, level == 1 and values[5].key == 'x')"), Ok(Out::Bool(false)));
+}
+
+#[test]
+fn indexes_by_value_and_from_the_end() {
+    assert_eq!(on("position[index(name, 'elbow')]"), Ok(Out::Float(-1.25)));
+    assert_eq!(on("index(name, 'wrist')"), Ok(Out::Int(2)));
+    assert_eq!(on("index(levels, 5)"), Ok(Out::Int(2)));
+    assert_eq!(on("index(levels, 5.0)"), Ok(Out::Int(2)));
+    assert_eq!(on("index(position, 2)"), Ok(Out::Int(2)));
+    assert_eq!(on("status_list[-1].status"), Ok(Out::Int(2)));
+    assert_eq!(on("status_list[-2].goal_info.id"), Ok(Out::Int(7)));
+    assert_eq!(on("status_list[len(status_list) - 1].goal_info.id"), Ok(Out::Int(8)));
+    assert_eq!(on("name[-3]"), Ok(Out::Str("shoulder".into())));
+    assert_eq!(on("levels[1 + 1]"), Ok(Out::Int(5)));
+}
+
+#[test]
+fn functions_of_numbers_and_vectors() {
+    assert_eq!(on("abs(levels[1])"), Ok(Out::Int(7)));
+    assert_eq!(on("abs(position[1])"), Ok(Out::Float(1.25)));
+    assert_eq!(on("sqrt(levels[0] + 1)"), Ok(Out::Float(2.0)));
+    assert_eq!(on("hypot(3, 4)"), Ok(Out::Float(5.0)));
+    assert_eq!(on("norm(v)"), Ok(Out::Float(5.0)));
+    near("norm(q)", 1.0);
+    near("norm(position)", (0.25f64 + 1.5625 + 4.0).sqrt());
+    near("yaw(q)", std::f64::consts::FRAC_PI_2);
+    near("pitch(q)", 0.0);
+    near("roll(q)", 0.0);
+}
+
+#[test]
+fn euler_angles_match_a_rotation() {
+    // Roll 0.3, pitch -0.2, yaw 1.1 (Z-Y-X), as a quaternion, then back.
+    let (r, p, y) = (0.3f64, -0.2f64, 1.1f64);
+    let (cr, sr, cp, sp, cy, sy) = ((r / 2.0).cos(), (r / 2.0).sin(), (p / 2.0).cos(), (p / 2.0).sin(), (y / 2.0).cos(), (y / 2.0).sin());
+    let q = [sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy];
+    // A quaternion of any length gives the same angles.
+    let m = M::Msg(vec![(
+        "q",
+        M::Msg(vec![("x", M::Float(2.0 * q[0])), ("y", M::Float(2.0 * q[1])), ("z", M::Float(2.0 * q[2])), ("w", M::Float(2.0 * q[3]))]),
+    )]);
+    for (f, want) in [("roll", r), ("pitch", p), ("yaw", y)] {
+        let e = expr::parse(&format!("{f}(q)")).unwrap();
+        match eval(&e, &m) {
+            Ok(Val::Float(x)) => assert!((x - want).abs() < 1e-12, "{f}: {x} is not {want}"),
+            other => panic!("{f}: {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn missing_values_are_said_alike() {
+    let err = |t: &str| on(t).unwrap_err();
+    assert_eq!(err("find(status, name == 'gps').level"), "`find(status, name == 'gps')` is missing: no element of the 3 matches");
+    assert_eq!(err("position[index(name, 'knee')]"), "`index(name, 'knee')` is missing: no element of the 3 equals 'knee'");
+    assert_eq!(err("max(quiet, level)"), "`max(quiet, level)` is missing: `max` of an array that is empty");
+    assert_eq!(err("status_list[-3].status"), "`status_list[-3]` is missing: index -3 is before the start of an array of 2");
+    assert_eq!(err("status_list[2].status"), "`status_list[2]` is missing: index 2 is past the end of an array of 2");
+    assert_eq!(err("status_list[1 + 1].status"), "`status_list[1 + 1]` is missing: index 2 is past the end of an array of 2");
+    assert_eq!(err("quiet[-1]"), "`quiet[-1]` is missing: index -1 is before the start of an array of 0");
+    // A missing value inside an element makes the whole function missing.
+    assert!(err("count(status, values[0].key == 'rate')").contains("is missing: index 0 is past the end"));
+    // What is wrong, not missing, says so.
+    assert_eq!(err("max(velocity, it)"), "`it` is NaN");
+    assert_eq!(err("abs(min_int)"), "`abs(min_int)` overflows an integer");
+    assert_eq!(err("sqrt(position[1])"), "`sqrt(position[1])` `sqrt` of a negative number (-1.25)");
+    assert_eq!(err("yaw(zero)"), "`yaw(zero)` is of a zero quaternion, which has no angles");
+    assert_eq!(
+        err("levels[min_int]"),
+        "`levels[min_int]` is missing: index -9223372036854775808 is before the start of an array of 3"
+    );
+}
+
+/// A hand-made rules and map on `/diagnostics` with the new forms: each
+/// missing value is one problem of its entry, and no event.
+#[test]
+fn a_missing_value_is_a_problem_of_the_entry() {
+    let rules = "states { RUN initial HOT final }\nagent Diag sensor { event HOT_MOTOR { level: i64 } }\n\
+                 rule hot { when state == RUN and HOT_MOTOR then HOT }\n";
+    let map = "[[event]]\nagent = \"Diag\"\nevent = \"HOT_MOTOR\"\ntopic = \"/diagnostics\"\n\
+               type = \"diagnostic_msgs/msg/DiagnosticArray\"\n\
+               when = \"any(status, name == 'motor' and any(values, key == 'fault'))\"\n\
+               [event.payload]\nlevel = \"find(status, level >= 2).level\"\n";
+    let checked = situ_compiler::check_source("diag.situ", rules);
+    let mut t = Translator::new(&checked.model, map, FileId(1)).unwrap_or_else(|e| panic!("{e:?}"));
+    // A DiagnosticArray: header (stamp, frame_id ""), then `status`.
+    let array = |statuses: &[(u8, &str, &[(&str, &str)])]| {
+        let mut b = vec![0u8, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0];
+        let string = |b: &mut Vec<u8>, s: &str| {
+            while b.len() % 4 != 0 {
+                b.push(0);
+            }
+            b.extend((s.len() as u32 + 1).to_le_bytes());
+            b.extend(s.as_bytes());
+            b.push(0);
+        };
+        b.extend((statuses.len() as u32).to_le_bytes());
+        for (level, name, values) in statuses {
+            b.push(*level);
+            string(&mut b, name);
+            string(&mut b, "");
+            string(&mut b, "");
+            while b.len() % 4 != 0 {
+                b.push(0);
+            }
+            b.extend((values.len() as u32).to_le_bytes());
+            for (k, v) in *values {
+                string(&mut b, k);
+                string(&mut b, v);
+            }
+        }
+        b
+    };
+    let hot = array(&[(0, "lidar", &[]), (2, "motor", &[("fault", "overheat")])]);
+    let out = t.on_message("/diagnostics", &hot);
+    assert!(out.problems.is_empty(), "{:?}", out.problems);
+    assert_eq!(out.produced[0].payload, vec![Value::I64(2)]);
+    // No fault: the condition is false, no problem.
+    let out = t.on_message("/diagnostics", &array(&[(1, "motor", &[])]));
+    assert_eq!((out.produced.len(), out.problems.len()), (0, 0));
+    assert_eq!(t.stats().failed, 0);
+    // A fault at level 1: the condition holds, the payload is missing.
+    let out = t.on_message("/diagnostics", &array(&[(1, "motor", &[("fault", "x")])]));
+    assert!(out.produced.is_empty());
+    assert_eq!(out.problems[0].event.as_deref(), Some("HOT_MOTOR"));
+    assert_eq!(out.problems[0].message, "level: `find(status, level >= 2)` is missing: no element of the 1 matches");
+    assert_eq!(t.stats().failed, 1);
+}
