@@ -178,9 +178,11 @@ pub fn constant(e: &Expr) -> Option<f64> {
 }
 
 impl Cx<'_> {
-    fn mismatch(&mut self, range: expr::Range, message: String, label: String) -> Option<Ty> {
+    fn mismatch(&mut self, range: expr::Range, message: String, label: String, help: &str) -> Option<Ty> {
         let span = self.text.sub(range.0, range.1);
-        self.out.mismatches.push(Diagnostic::error(codes::ROS2_TYPE_MISMATCH, message, self.file, span, label));
+        self.out
+            .mismatches
+            .push(Diagnostic::error(codes::ROS2_TYPE_MISMATCH, message, self.file, span, label).with_help(help));
         None
     }
 
@@ -213,7 +215,12 @@ impl Cx<'_> {
             Expr::Path(steps, _) => self.path(steps),
             Expr::Neg(inner, r) => match self.ty(inner)? {
                 t if t.is_numeric() => Some(t),
-                t => self.mismatch(*r, format!("`-` needs a number, found {}", t.describe()), "not a number".into()),
+                t => self.mismatch(
+                    *r,
+                    format!("`-` needs a number, found {}", t.describe()),
+                    "not a number".into(),
+                    "`-` negates a number: apply it to a numeric field",
+                ),
             },
             Expr::Not(inner, r) => match self.ty(inner)? {
                 Ty::Bool => Some(Ty::Bool),
@@ -221,6 +228,7 @@ impl Cx<'_> {
                     *r,
                     format!("`not` needs a condition, found {}", t.describe()),
                     "not a condition".into(),
+                    "`not` negates a condition: compare the value first, e.g. `not (x > 1)`",
                 ),
             },
             Expr::Reduce(red, arg, r) => {
@@ -244,6 +252,8 @@ impl Cx<'_> {
                             t.describe()
                         ),
                         format!("`{name}` of {}", t.describe()),
+                        "`len(array)` counts the elements; `min max mean` take an array of numbers, or an array \
+                         and a number of its element: `max(status, level)`",
                     ),
                 }
             }
@@ -280,10 +290,21 @@ impl Cx<'_> {
                     return Some(Ty::Bool);
                 }
                 let o = op.text();
+                let help = match op {
+                    BinOp::Add | BinOp::Sub | BinOp::Mul | BinOp::Div => "`+ - * /` take two numbers",
+                    BinOp::Lt | BinOp::Le | BinOp::Gt | BinOp::Ge => {
+                        "`< <= > >=` compare two numbers; strings and booleans compare with `==` and `!=`"
+                    }
+                    BinOp::Eq | BinOp::Ne => "`==` and `!=` compare two numbers, two strings or two booleans",
+                    BinOp::And | BinOp::Or => {
+                        "`and` and `or` join conditions: compare the values first, e.g. `x > 0 and y > 0`"
+                    }
+                };
                 self.mismatch(
                     *range,
                     format!("`{o}` does not apply to {} and {}", lt.describe(), rt.describe()),
                     format!("{} {o} {}", lt.describe(), rt.describe()),
+                    help,
                 )
             }
         }
@@ -365,37 +386,53 @@ impl Cx<'_> {
                 (Step::Index(i, r), Ty::Array(el, size)) => {
                     if let Some(n) = size.filter(|n| usize::try_from(*i).map_or(true, |i| i >= *n)) {
                         let span = self.text.sub(r.0, r.1);
-                        self.out.paths.push(Diagnostic::error(
-                            codes::ROS2_UNKNOWN_FIELD,
-                            format!("index {i} is out of the array of {n}"),
-                            self.file,
-                            span,
-                            format!("the array has {n} elements"),
-                        ));
+                        self.out.paths.push(
+                            Diagnostic::error(
+                                codes::ROS2_UNKNOWN_FIELD,
+                                format!("index {i} is out of the array of {n}"),
+                                self.file,
+                                span,
+                                format!("the array has {n} elements"),
+                            )
+                            .with_help(format!(
+                                "an index of this array is from 0 to {} (or -{n} to -1)",
+                                n.saturating_sub(1)
+                            )),
+                        );
                         return None;
                     }
                     Ty::of(el)
                 }
                 (Step::Field(name, r), t) => {
                     let span = self.text.sub(r.0, r.1);
-                    self.out.paths.push(Diagnostic::error(
-                        codes::ROS2_UNKNOWN_FIELD,
-                        format!("`.{name}` of {}, which has no fields", t.describe()),
-                        self.file,
-                        span,
-                        "no such field",
-                    ));
+                    let help = match t {
+                        Ty::Array(..) => format!("pick an element first: `[0]`, `[-1]`, or `find(array, …).{name}`"),
+                        _ => format!("remove `.{name}`: only messages have fields"),
+                    };
+                    self.out.paths.push(
+                        Diagnostic::error(
+                            codes::ROS2_UNKNOWN_FIELD,
+                            format!("`.{name}` of {}, which has no fields", t.describe()),
+                            self.file,
+                            span,
+                            "no such field",
+                        )
+                        .with_help(help),
+                    );
                     return None;
                 }
                 (Step::Index(_, r), t) => {
                     let span = self.text.sub(r.0, r.1);
-                    self.out.paths.push(Diagnostic::error(
-                        codes::ROS2_UNKNOWN_FIELD,
-                        format!("an index on {}, which is not an array", t.describe()),
-                        self.file,
-                        span,
-                        "not an array",
-                    ));
+                    self.out.paths.push(
+                        Diagnostic::error(
+                            codes::ROS2_UNKNOWN_FIELD,
+                            format!("an index on {}, which is not an array", t.describe()),
+                            self.file,
+                            span,
+                            "not an array",
+                        )
+                        .with_help("index an array field: `status[0]`, `status_list[-1]`"),
+                    );
                     return None;
                 }
             };
@@ -485,7 +522,7 @@ impl Cx<'_> {
                         span,
                         format!("the array has {n} elements"),
                     )
-                    .with_help(format!("an index of this array is from 0 to {} (or -{n} to -1)", n - 1)),
+                    .with_help(format!("an index of this array is from 0 to {} (or -{n} to -1)", n.saturating_sub(1))),
                 );
                 return None;
             }

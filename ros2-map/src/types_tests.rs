@@ -15,7 +15,8 @@ fn typed(text: &str, msg: &'static str) -> Typed {
 
 fn ty(text: &str, msg: &'static str) -> Ty {
     let t = typed(text, msg);
-    let all: Vec<_> = [&t.syntax, &t.paths, &t.mismatches, &t.zero_divisions, &t.indexes].into_iter().flatten().collect();
+    let all: Vec<_> =
+        [&t.syntax, &t.paths, &t.mismatches, &t.zero_divisions, &t.indexes].into_iter().flatten().collect();
     assert!(all.is_empty(), "{text}: {all:?}");
     t.ty.unwrap_or_else(|| panic!("{text}: no type"))
 }
@@ -123,7 +124,9 @@ fn the_element_scope_has_only_the_element() {
 
 #[test]
 fn division_by_a_constant_zero() {
-    for (text, at) in [("range_max / 0", "0"), ("range_max / (1 - 1)", "1 - 1"), ("1 / -0.0", "-0.0"), ("abs(1 / (2 * 0))", "2 * 0")] {
+    for (text, at) in
+        [("range_max / 0", "0"), ("range_max / (1 - 1)", "1 - 1"), ("1 / -0.0", "-0.0"), ("abs(1 / (2 * 0))", "2 * 0")]
+    {
         let (code, found, d) = finding(text, SCAN);
         assert_eq!((code, found.as_str()), (codes::ROS2_ZERO_DIVISION, at), "{text}");
         assert_eq!(d.primary.text, "this is 0");

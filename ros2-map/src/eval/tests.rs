@@ -268,12 +268,23 @@ fn functions_of_numbers_and_vectors() {
 fn euler_angles_match_a_rotation() {
     // Roll 0.3, pitch -0.2, yaw 1.1 (Z-Y-X), as a quaternion, then back.
     let (r, p, y) = (0.3f64, -0.2f64, 1.1f64);
-    let (cr, sr, cp, sp, cy, sy) = ((r / 2.0).cos(), (r / 2.0).sin(), (p / 2.0).cos(), (p / 2.0).sin(), (y / 2.0).cos(), (y / 2.0).sin());
-    let q = [sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy];
+    let (cr, sr, cp, sp, cy, sy) =
+        ((r / 2.0).cos(), (r / 2.0).sin(), (p / 2.0).cos(), (p / 2.0).sin(), (y / 2.0).cos(), (y / 2.0).sin());
+    let q = [
+        sr * cp * cy - cr * sp * sy,
+        cr * sp * cy + sr * cp * sy,
+        cr * cp * sy - sr * sp * cy,
+        cr * cp * cy + sr * sp * sy,
+    ];
     // A quaternion of any length gives the same angles.
     let m = M::Msg(vec![(
         "q",
-        M::Msg(vec![("x", M::Float(2.0 * q[0])), ("y", M::Float(2.0 * q[1])), ("z", M::Float(2.0 * q[2])), ("w", M::Float(2.0 * q[3]))]),
+        M::Msg(vec![
+            ("x", M::Float(2.0 * q[0])),
+            ("y", M::Float(2.0 * q[1])),
+            ("z", M::Float(2.0 * q[2])),
+            ("w", M::Float(2.0 * q[3])),
+        ]),
     )]);
     for (f, want) in [("roll", r), ("pitch", p), ("yaw", y)] {
         let e = expr::parse(&format!("{f}(q)")).unwrap();
@@ -287,12 +298,24 @@ fn euler_angles_match_a_rotation() {
 #[test]
 fn missing_values_are_said_alike() {
     let err = |t: &str| on(t).unwrap_err();
-    assert_eq!(err("find(status, name == 'gps').level"), "`find(status, name == 'gps')` is missing: no element of the 3 matches");
-    assert_eq!(err("position[index(name, 'knee')]"), "`index(name, 'knee')` is missing: no element of the 3 equals 'knee'");
+    assert_eq!(
+        err("find(status, name == 'gps').level"),
+        "`find(status, name == 'gps')` is missing: no element of the 3 matches"
+    );
+    assert_eq!(
+        err("position[index(name, 'knee')]"),
+        "`index(name, 'knee')` is missing: no element of the 3 equals 'knee'"
+    );
     assert_eq!(err("max(quiet, level)"), "`max(quiet, level)` is missing: `max` of an array that is empty");
-    assert_eq!(err("status_list[-3].status"), "`status_list[-3]` is missing: index -3 is before the start of an array of 2");
+    assert_eq!(
+        err("status_list[-3].status"),
+        "`status_list[-3]` is missing: index -3 is before the start of an array of 2"
+    );
     assert_eq!(err("status_list[2].status"), "`status_list[2]` is missing: index 2 is past the end of an array of 2");
-    assert_eq!(err("status_list[1 + 1].status"), "`status_list[1 + 1]` is missing: index 2 is past the end of an array of 2");
+    assert_eq!(
+        err("status_list[1 + 1].status"),
+        "`status_list[1 + 1]` is missing: index 2 is past the end of an array of 2"
+    );
     assert_eq!(err("quiet[-1]"), "`quiet[-1]` is missing: index -1 is before the start of an array of 0");
     // A missing value inside an element makes the whole function missing.
     assert!(err("count(status, values[0].key == 'rate')").contains("is missing: index 0 is past the end"));
@@ -319,34 +342,7 @@ fn a_missing_value_is_a_problem_of_the_entry() {
                [event.payload]\nlevel = \"find(status, level >= 2).level\"\n";
     let checked = situ_compiler::check_source("diag.situ", rules);
     let mut t = Translator::new(&checked.model, map, FileId(1)).unwrap_or_else(|e| panic!("{e:?}"));
-    // A DiagnosticArray: header (stamp, frame_id ""), then `status`.
-    let array = |statuses: &[(u8, &str, &[(&str, &str)])]| {
-        let mut b = vec![0u8, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0];
-        let string = |b: &mut Vec<u8>, s: &str| {
-            while b.len() % 4 != 0 {
-                b.push(0);
-            }
-            b.extend((s.len() as u32 + 1).to_le_bytes());
-            b.extend(s.as_bytes());
-            b.push(0);
-        };
-        b.extend((statuses.len() as u32).to_le_bytes());
-        for (level, name, values) in statuses {
-            b.push(*level);
-            string(&mut b, name);
-            string(&mut b, "");
-            string(&mut b, "");
-            while b.len() % 4 != 0 {
-                b.push(0);
-            }
-            b.extend((values.len() as u32).to_le_bytes());
-            for (k, v) in *values {
-                string(&mut b, k);
-                string(&mut b, v);
-            }
-        }
-        b
-    };
+    let array = diagnostic_array;
     let hot = array(&[(0, "lidar", &[]), (2, "motor", &[("fault", "overheat")])]);
     let out = t.on_message("/diagnostics", &hot);
     assert!(out.problems.is_empty(), "{:?}", out.problems);
@@ -361,4 +357,228 @@ fn a_missing_value_is_a_problem_of_the_entry() {
     assert_eq!(out.problems[0].event.as_deref(), Some("HOT_MOTOR"));
     assert_eq!(out.problems[0].message, "level: `find(status, level >= 2)` is missing: no element of the 1 matches");
     assert_eq!(t.stats().failed, 1);
+}
+
+/// The CDR of a DiagnosticArray (header with an empty frame id, then
+/// `status`), each status its level, name and key-value pairs.
+fn diagnostic_array(statuses: &[(u8, &str, &[(&str, &str)])]) -> Vec<u8> {
+    let mut b = vec![0u8, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0];
+    let string = |b: &mut Vec<u8>, s: &str| {
+        while b.len() % 4 != 0 {
+            b.push(0);
+        }
+        b.extend((s.len() as u32 + 1).to_le_bytes());
+        b.extend(s.as_bytes());
+        b.push(0);
+    };
+    b.extend((statuses.len() as u32).to_le_bytes());
+    for (level, name, values) in statuses {
+        b.push(*level);
+        string(&mut b, name);
+        string(&mut b, "");
+        string(&mut b, "");
+        while b.len() % 4 != 0 {
+            b.push(0);
+        }
+        b.extend((values.len() as u32).to_le_bytes());
+        for (k, v) in *values {
+            string(&mut b, k);
+            string(&mut b, v);
+        }
+    }
+    b
+}
+
+mod props {
+    use super::*;
+    use crate::types::{type_of, Ty};
+    use proptest::prelude::*;
+    use situ_grammar::ast::Span;
+
+    const TOKENS: &[&str] = &[
+        "any(", "all(", "count(", "find(", "index(", "min(", "max(", "mean(", "len(", "abs(", "norm(", "yaw(", "sqrt(",
+        "hypot(", "status", "values", "level", "name", "key", "value", "it", "header", "frame_id", "stamp", "sec", ",",
+        ",", ")", ")", "[", "]", "-1", "0", "1", "2", ".", "+", "-", "*", "/", "==", "!=", "<", ">=", "and", "or",
+        "not", "'motor'", "'fault'", "0.5", "true", "(", "=", "&&", "0.0",
+    ];
+
+    /// Whether a value is of the type typing gave.
+    fn fits(v: &Val<'_>, ty: &Ty) -> bool {
+        match (ty, v) {
+            (Ty::Int, Val::Int(_)) | (Ty::Bool, Val::Bool(_)) | (Ty::Str, Val::Str(_)) => true,
+            (Ty::Float, Val::Float(_)) => true,
+            (Ty::Msg(_), Val::Node(cdr::Value::Msg(_))) => true,
+            (Ty::Array(..), Val::Node(cdr::Value::Array(_))) => true,
+            _ => false,
+        }
+    }
+
+    /// What may go wrong on a message with an expression that checks clean.
+    const AT_RUN_TIME: &[&str] =
+        &["is missing: ", "is NaN", "overflows", "division by zero", "of a negative number", "zero quaternion"];
+
+    /// Where a generated expression is read: a DiagnosticArray, one of its
+    /// `status` or one of a status' `values`.
+    #[derive(Clone, Copy, PartialEq)]
+    enum At {
+        Top,
+        Status,
+        Value,
+    }
+
+    /// Builds well-typed expressions of a DiagnosticArray from random choices.
+    struct Gen {
+        choices: Vec<u8>,
+        next: usize,
+    }
+
+    impl Gen {
+        fn pick(&mut self, n: usize) -> usize {
+            let c = self.choices.get(self.next).copied().unwrap_or(0);
+            self.next += 1;
+            c as usize % n
+        }
+
+        /// An array of statuses (at the top) or of key-values (in a status).
+        fn array(&mut self, at: At, d: usize) -> Option<(String, At)> {
+            Some(match (at, self.pick(if d == 0 { 1 } else { 3 })) {
+                (At::Top, 0) => ("status".into(), At::Status),
+                (At::Top, 1) => (format!("find(status, {}).values", self.cond(At::Status, d - 1)), At::Value),
+                (At::Top, _) => (format!("status[{}].values", self.int(At::Top, d - 1)), At::Value),
+                (At::Status, _) => ("values".into(), At::Value),
+                (At::Value, _) => return None,
+            })
+        }
+
+        fn cond(&mut self, at: At, d: usize) -> String {
+            match self.pick(if d == 0 { 1 } else { 7 }) {
+                0 => "true".into(),
+                1 => {
+                    format!("{} {} {}", self.num(at, d - 1), ["<", ">=", "==", "!="][self.pick(4)], self.num(at, d - 1))
+                }
+                2 => format!("{} {} {}", self.string(at, d - 1), ["==", "!="][self.pick(2)], self.string(at, d - 1)),
+                3 => format!("({} {} {})", self.cond(at, d - 1), ["and", "or"][self.pick(2)], self.cond(at, d - 1)),
+                4 => format!("not {}", self.cond(at, d - 1)),
+                _ => match self.array(at, d - 1) {
+                    Some((arr, el)) => format!("{}({arr}, {})", ["any", "all"][self.pick(2)], self.cond(el, d - 1)),
+                    None => "false".into(),
+                },
+            }
+        }
+
+        fn int(&mut self, at: At, d: usize) -> String {
+            match (self.pick(if d == 0 { 1 } else { 5 }), at) {
+                (0, _) => ["0", "1", "-1", "2"][self.pick(4)].into(),
+                (1, At::Status) => "level".into(),
+                (1, _) => "header.stamp.sec".into(),
+                (2, _) => match self.array(at, d - 1) {
+                    Some((arr, el)) => format!("count({arr}, {})", self.cond(el, d - 1)),
+                    None => "3".into(),
+                },
+                (3, _) => match self.array(at, d - 1) {
+                    Some((arr, _)) => format!("len({arr}) - {}", self.int(at, d - 1)),
+                    None => "0".into(),
+                },
+                _ => format!("abs({})", self.int(at, d - 1)),
+            }
+        }
+
+        fn num(&mut self, at: At, d: usize) -> String {
+            match self.pick(if d == 0 { 1 } else { 6 }) {
+                0 => ["0.5", "2.5", "-1.5"][self.pick(3)].into(),
+                1 => self.int(at, d - 1),
+                2 => {
+                    format!("({} {} {})", self.num(at, d - 1), ["+", "-", "*", "/"][self.pick(4)], self.num(at, d - 1))
+                }
+                3 => format!("{}({})", ["abs", "sqrt"][self.pick(2)], self.num(at, d - 1)),
+                4 => format!("hypot({}, {})", self.num(at, d - 1), self.num(at, d - 1)),
+                _ => match self.array(at, d - 1) {
+                    Some((arr, At::Status)) => {
+                        format!("{}({arr}, {})", ["min", "max", "mean"][self.pick(3)], self.num(At::Status, d - 1))
+                    }
+                    _ => "1".into(),
+                },
+            }
+        }
+
+        fn string(&mut self, at: At, d: usize) -> String {
+            match (self.pick(if d == 0 { 1 } else { 4 }), at) {
+                (0, _) => ["'motor'", "'fault'", "'hot'"][self.pick(3)].into(),
+                (1, At::Status) => "name".into(),
+                (1, At::Value) => ["key", "value", "it.key"][self.pick(3)].into(),
+                (1, At::Top) => "header.frame_id".into(),
+                (2, At::Top) => format!("find(status, {}).name", self.cond(At::Status, d - 1)),
+                (2, At::Status) => format!("values[{}].key", self.int(At::Status, d - 1)),
+                _ => match self.array(at, d - 1) {
+                    Some((arr, At::Value)) => format!("find({arr}, {}).value", self.cond(At::Value, d - 1)),
+                    Some((arr, _)) => format!("{arr}[{}].name", self.int(at, d - 1)),
+                    None => "'x'".into(),
+                },
+            }
+        }
+    }
+
+    /// Well-typed expressions of a DiagnosticArray, to the depth of 4.
+    fn expression() -> impl Strategy<Value = String> {
+        proptest::collection::vec(any::<u8>(), 64).prop_map(|choices| {
+            let mut g = Gen { choices, next: 0 };
+            match g.pick(3) {
+                0 => g.cond(At::Top, 4),
+                1 => g.num(At::Top, 4),
+                _ => g.string(At::Top, 4),
+            }
+        })
+    }
+
+    fn agree(text: &str) -> Result<(), TestCaseError> {
+        let s = map::Str { value: text.to_string(), span: Span::new(0, text.len()), inner: Some(0) };
+        let typed = type_of(&s, "diagnostic_msgs/msg/DiagnosticArray", FileId(1));
+        let findings = || {
+            typed
+                .syntax
+                .iter()
+                .chain(&typed.paths)
+                .chain(&typed.mismatches)
+                .chain(&typed.zero_divisions)
+                .chain(&typed.indexes)
+        };
+        for d in findings() {
+            prop_assert!(d.primary.span.end <= text.len() && d.help.is_some(), "{text}: {d:?}");
+        }
+        let (Some(e), Some(ty), 0) = (&typed.expr, &typed.ty, findings().count()) else { return Ok(()) };
+        let decoder = cdr::Decoder::new("diagnostic_msgs/msg/DiagnosticArray").unwrap();
+        for msg in [
+            diagnostic_array(&[(0, "lidar", &[("rate", "10")]), (2, "motor", &[("fault", "hot")])]),
+            diagnostic_array(&[(1, "motor", &[])]),
+            diagnostic_array(&[]),
+        ] {
+            let m = decoder.decode(&msg).unwrap();
+            match eval(e, &m) {
+                Ok(v) => prop_assert!(fits(&v, ty), "{text}: {v:?} is not {ty:?}"),
+                Err(err) => prop_assert!(
+                    AT_RUN_TIME.iter().any(|w| err.message.contains(w)),
+                    "{text}: a clean expression failed: {err:?}"
+                ),
+            }
+        }
+        Ok(())
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(1000))]
+
+        /// Any sequence of the expressions' tokens parses or fails without a
+        /// panic, and its findings have places and helps.
+        #[test]
+        fn token_soup(toks in proptest::collection::vec(proptest::sample::select(TOKENS), 1..16)) {
+            agree(&toks.join(" "))?;
+        }
+
+        /// An expression that checks clean evaluates to a value of its type,
+        /// or fails only for what the message holds (a missing value, NaN…).
+        #[test]
+        fn typing_and_evaluation_agree(text in expression()) {
+            agree(&text)?;
+        }
+    }
 }
