@@ -155,7 +155,7 @@ impl Func {
             Func::Count => "`count(array, condition)`, e.g. `count(ranges, it < 0.5)`",
             Func::Min => "`min(array)` or `min(array, number)`, e.g. `min(status, level)`",
             Func::Max => "`max(array)` or `max(array, number)`, e.g. `max(status, level)`",
-            Func::Mean => "`mean(array)` or `mean(array, number)`, e.g. `mean(cells, voltage)`",
+            Func::Mean => "`mean(array)` or `mean(array, number)`, e.g. `mean(status, level)`",
             Func::Find => "`find(array, condition)`, e.g. `find(status, name == 'motor').level`",
             Func::Index => "`index(array, value)`, e.g. `position[index(name, 'elbow')]`",
             Func::Abs => "`abs(number)`",
