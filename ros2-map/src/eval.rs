@@ -36,15 +36,32 @@ pub enum Val<'a> {
 pub struct EvalError {
     pub message: String,
     pub range: Range,
+    pub why: Why,
+}
+
+/// The kinds of [`EvalError`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Why {
+    /// A value the message does not have: an index outside its array, a
+    /// reducer of an empty array, `find` or `index` with no match.
+    Missing,
+    /// A NaN field or result.
+    NaN,
+    /// Anything else: a division by zero, an overflow, a wrong type.
+    Invalid,
 }
 
 fn fail<T>(range: Range, message: impl Into<String>) -> Result<T, EvalError> {
-    Err(EvalError { message: message.into(), range })
+    Err(EvalError { message: message.into(), range, why: Why::Invalid })
 }
 
 /// A value the message does not have: every such case says `is missing`.
 fn missing<T>(range: Range, why: impl std::fmt::Display) -> Result<T, EvalError> {
-    fail(range, format!("is missing: {why}"))
+    Err(EvalError { message: format!("is missing: {why}"), range, why: Why::Missing })
+}
+
+fn nan<T>(range: Range) -> Result<T, EvalError> {
+    Err(EvalError { message: "is NaN".into(), range, why: Why::NaN })
 }
 
 /// The largest integer a float holds exactly; whole literals up to it are integers.
@@ -64,7 +81,7 @@ fn describe(v: &Val<'_>) -> &'static str {
 fn leaf(v: &cdr::Value, range: Range) -> Result<Val<'_>, EvalError> {
     Ok(match v {
         cdr::Value::Int(i) => Val::Int(*i),
-        cdr::Value::Float(f) if f.is_nan() => return fail(range, "is NaN"),
+        cdr::Value::Float(f) if f.is_nan() => return nan(range),
         cdr::Value::Float(f) => Val::Float(*f),
         cdr::Value::Bool(b) => Val::Bool(*b),
         cdr::Value::Str(s) => Val::Str(s),
@@ -82,7 +99,7 @@ fn float(v: Val<'_>) -> Option<f64> {
 
 fn number(f: f64, range: Range) -> Result<Val<'static>, EvalError> {
     if f.is_nan() {
-        fail(range, "is NaN")
+        nan(range)
     } else {
         Ok(Val::Float(f))
     }

@@ -2,8 +2,12 @@
 //! of an array (`any all count min max mean find`, the second argument read
 //! in the scope of each element), `index`, and the functions of numbers and
 //! vectors (`abs sqrt hypot norm yaw pitch roll`).
+//!
+//! An element whose condition or number is NaN (a NaN reading, REP 117) is
+//! skipped, as `min(ranges)` skips it; a missing value in an element makes
+//! the whole function missing.
 
-use super::{ev, fail, float, leaf, missing, number, Acc, EvalError, Scope, Val};
+use super::{ev, fail, float, leaf, missing, number, Acc, EvalError, Scope, Val, Why};
 use crate::cdr;
 use crate::expr::{Expr, Func, Range, Reducer};
 
@@ -63,7 +67,10 @@ fn over<'a>(f: Func, items: &'a [cdr::Value], body: &'a Expr, r: Range) -> Resul
     if let Some(red) = red {
         let mut acc = Acc::new(red);
         for item in items {
-            let v = ev(body, Scope { value: item, element: true })?;
+            let v = match ev(body, Scope { value: item, element: true }) {
+                Err(e) if e.why == Why::NaN => continue,
+                v => v?,
+            };
             if !acc.add(v) {
                 return fail(body.range(), format!("is {}, not a number", super::describe(&v)));
             }
@@ -72,9 +79,11 @@ fn over<'a>(f: Func, items: &'a [cdr::Value], body: &'a Expr, r: Range) -> Resul
     }
     let mut count = 0i64;
     for item in items {
-        let holds = match ev(body, Scope { value: item, element: true })? {
-            Val::Bool(b) => b,
-            v => return fail(body.range(), format!("is {}, not a condition", super::describe(&v))),
+        let holds = match ev(body, Scope { value: item, element: true }) {
+            Err(e) if e.why == Why::NaN => continue,
+            Ok(Val::Bool(b)) => b,
+            Err(e) => return Err(e),
+            Ok(v) => return fail(body.range(), format!("is {}, not a condition", super::describe(&v))),
         };
         match (f, holds) {
             (Func::Any, true) => return Ok(Val::Bool(true)),

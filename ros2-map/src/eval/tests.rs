@@ -213,6 +213,12 @@ fn functions_over_elements() {
     assert_eq!(on("find(status, level == 1)"), Ok(Out::Node));
     assert_eq!(on("find(position, it < 0)"), Ok(Out::Float(-1.25)));
     assert_eq!(on("count(position, it > 0)"), Ok(Out::Int(2)));
+    // A NaN element (an invalid reading) is skipped, as `min(ranges)` does.
+    assert_eq!(on("count(velocity, it >= 0)"), Ok(Out::Int(2)));
+    assert_eq!(on("all(velocity, it >= 0)"), Ok(Out::Bool(true)));
+    assert_eq!(on("any(velocity, it < 0)"), Ok(Out::Bool(false)));
+    assert_eq!(on("max(velocity, it * 2)"), Ok(Out::Float(2.0)));
+    assert_eq!(on("find(velocity, it > 0.5)"), Ok(Out::Float(1.0)));
     assert_eq!(on("any(status, it.name == 'lidar')"), Ok(Out::Bool(true)));
     // Empty arrays: any is false, all is true, count is 0.
     assert_eq!(on("any(quiet, level > 0)"), Ok(Out::Bool(false)));
@@ -320,7 +326,7 @@ fn missing_values_are_said_alike() {
     // A missing value inside an element makes the whole function missing.
     assert!(err("count(status, values[0].key == 'rate')").contains("is missing: index 0 is past the end"));
     // What is wrong, not missing, says so.
-    assert_eq!(err("max(velocity, it)"), "`it` is NaN");
+    assert_eq!(err("velocity[1] > 0"), "`velocity[1]` is NaN");
     assert_eq!(err("abs(min_int)"), "`abs(min_int)` overflows an integer");
     assert_eq!(err("sqrt(position[1])"), "`sqrt(position[1])` `sqrt` of a negative number (-1.25)");
     assert_eq!(err("yaw(zero)"), "`yaw(zero)` is of a zero quaternion, which has no angles");
