@@ -465,7 +465,7 @@ impl Cx<'_> {
         let written = self.excerpt(r);
         let (found, help) = match index {
             Expr::Number(n, _) if !written.bytes().all(|b| b.is_ascii_digit()) => {
-                let whole = (n.fract() == 0.0).then(|| format!("write `[{n}]`; ")).unwrap_or_default();
+                let whole = if n.fract() == 0.0 { format!("write `[{n}]`; ") } else { String::new() };
                 (format!("`{written}`"), format!("{whole}an index is a whole number written with digits"))
             }
             _ => match self.ty(index)? {

@@ -367,10 +367,13 @@ fn a_missing_value_is_a_problem_of_the_entry() {
 
 /// The CDR of a DiagnosticArray (header with an empty frame id, then
 /// `status`), each status its level, name and key-value pairs.
-fn diagnostic_array(statuses: &[(u8, &str, &[(&str, &str)])]) -> Vec<u8> {
+/// A status of [`diagnostic_array`]: level, name, key-value pairs.
+type Status<'a> = (u8, &'a str, &'a [(&'a str, &'a str)]);
+
+fn diagnostic_array(statuses: &[Status<'_>]) -> Vec<u8> {
     let mut b = vec![0u8, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0];
     let string = |b: &mut Vec<u8>, s: &str| {
-        while b.len() % 4 != 0 {
+        while !b.len().is_multiple_of(4) {
             b.push(0);
         }
         b.extend((s.len() as u32 + 1).to_le_bytes());
@@ -383,7 +386,7 @@ fn diagnostic_array(statuses: &[(u8, &str, &[(&str, &str)])]) -> Vec<u8> {
         string(&mut b, name);
         string(&mut b, "");
         string(&mut b, "");
-        while b.len() % 4 != 0 {
+        while !b.len().is_multiple_of(4) {
             b.push(0);
         }
         b.extend((values.len() as u32).to_le_bytes());
@@ -410,13 +413,15 @@ mod props {
 
     /// Whether a value is of the type typing gave.
     fn fits(v: &Val<'_>, ty: &Ty) -> bool {
-        match (ty, v) {
-            (Ty::Int, Val::Int(_)) | (Ty::Bool, Val::Bool(_)) | (Ty::Str, Val::Str(_)) => true,
-            (Ty::Float, Val::Float(_)) => true,
-            (Ty::Msg(_), Val::Node(cdr::Value::Msg(_))) => true,
-            (Ty::Array(..), Val::Node(cdr::Value::Array(_))) => true,
-            _ => false,
-        }
+        matches!(
+            (ty, v),
+            (Ty::Int, Val::Int(_))
+                | (Ty::Bool, Val::Bool(_))
+                | (Ty::Str, Val::Str(_))
+                | (Ty::Float, Val::Float(_))
+                | (Ty::Msg(_), Val::Node(cdr::Value::Msg(_)))
+                | (Ty::Array(..), Val::Node(cdr::Value::Array(_)))
+        )
     }
 
     /// What may go wrong on a message with an expression that checks clean.
