@@ -476,7 +476,7 @@ mod no_panic {
 
         /// Any expression text parses or fails without a panic.
         #[test]
-        fn any_expression(text in "[a-z0-9_\\[\\]().'<>=!+*/ -]{0,80}") {
+        fn any_expression(text in "[a-z0-9_\\[\\]().,'<>=!&|+*/ -]{0,80}") {
             let _ = crate::expr::parse(&text);
             let map = scan("CLEAR", &format!("when = {text:?}"));
             let checked = check_source("rules.situ", RULES);
