@@ -65,6 +65,12 @@ fn indexes_and_index_of() {
     assert_eq!((code, at.as_str()), (codes::ROS2_UNKNOWN_FIELD, "-10"));
     let (code, at, _) = finding("orientation_covariance[3 * 3]", IMU);
     assert_eq!((code, at.as_str()), (codes::ROS2_UNKNOWN_FIELD, "3 * 3"));
+    let (code, at, d) = finding("status[-1].levle", DIAG);
+    assert_eq!((code, at.as_str()), (codes::ROS2_UNKNOWN_FIELD, "levle"));
+    assert!(d.help.as_deref().unwrap_or("").starts_with("did you mean `level`?"));
+    let (code, at, d) = finding("find(status, true).values.key", DIAG);
+    assert_eq!((code, at.as_str()), (codes::ROS2_UNKNOWN_FIELD, "key"));
+    assert!(d.help.as_deref().unwrap_or("").starts_with("pick an element first"));
     let (code, at, _) = finding("header[-1]", IMU);
     assert_eq!((code, at.as_str()), (codes::ROS2_UNKNOWN_FIELD, "-1"));
 }
