@@ -183,8 +183,18 @@ fn at<'a>(array: Val<'a>, index: Val<'_>, r: Range) -> Result<Val<'a>, EvalError
     let Val::Node(cdr::Value::Array(items)) = array else {
         return fail(r, format!("an index on {}", describe(&array)));
     };
-    let Val::Int(i) = index else { return fail(r, format!("an index that is {}", describe(&index))) };
     let n = items.len();
+    let i = match index {
+        Val::Int(i) => i,
+        // A whole literal too large for an integer: outside any array.
+        Val::Float(f) if f.fract() == 0.0 && f > 0.0 => {
+            return missing(r, format!("index {f} is past the end of an array of {n}"));
+        }
+        Val::Float(f) if f.fract() == 0.0 => {
+            return missing(r, format!("index {f} is before the start of an array of {n}"));
+        }
+        v => return fail(r, format!("an index that is {}", describe(&v))),
+    };
     let from = if i < 0 { i.checked_add(i64::try_from(n).unwrap_or(i64::MAX)) } else { Some(i) };
     match from.and_then(|k| usize::try_from(k).ok()).and_then(|k| items.get(k)) {
         Some(x) => leaf(x, r),

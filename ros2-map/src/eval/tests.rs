@@ -322,6 +322,10 @@ fn missing_values_are_said_alike() {
         err("status_list[1 + 1].status"),
         "`status_list[1 + 1]` is missing: index 2 is past the end of an array of 2"
     );
+    assert_eq!(
+        err("levels[100000000000000000000]"),
+        "`levels[100000000000000000000]` is missing: index 100000000000000000000 is past the end of an array of 3"
+    );
     assert_eq!(err("quiet[-1]"), "`quiet[-1]` is missing: index -1 is before the start of an array of 0");
     // A missing value inside an element makes the whole function missing.
     assert!(err("count(status, values[0].key == 'rate')").contains("is missing: index 0 is past the end"));
