@@ -264,7 +264,8 @@ impl Cx<'_> {
             }
             Expr::At(base, index, _) => {
                 let (bt, it) = (self.ty(base), self.index(index));
-                self.element(bt?, it?, index)
+                it?;
+                self.element(bt?, index)
             }
             Expr::Binary(op, l, r, range) => {
                 if *op == BinOp::Div && constant(r) == Some(0.0) {
@@ -463,8 +464,14 @@ impl Cx<'_> {
     fn index(&mut self, index: &Expr) -> Option<()> {
         let r = index.range();
         let written = self.excerpt(r);
-        let (found, help) = match index {
-            Expr::Number(n, _) if !written.bytes().all(|b| b.is_ascii_digit()) => {
+        // A literal written as a number (`0.0`, `-1.0`, `1e3`), even whole.
+        let literal = match index {
+            Expr::Neg(inner, _) => inner.as_ref(),
+            e => e,
+        };
+        let (found, help) = match literal {
+            Expr::Number(n, lr) if !self.excerpt(*lr).bytes().all(|b| b.is_ascii_digit()) => {
+                let n = if matches!(index, Expr::Neg(..)) { -n } else { *n };
                 let whole = if n.fract() == 0.0 { format!("write `[{n}]`; ") } else { String::new() };
                 (format!("`{written}`"), format!("{whole}an index is a whole number written with digits"))
             }
@@ -494,7 +501,7 @@ impl Cx<'_> {
     }
 
     /// The element of `array` at the integer `index` (`a[-1]`, `a[i]`).
-    fn element(&mut self, array: Ty, (): (), index: &Expr) -> Option<Ty> {
+    fn element(&mut self, array: Ty, index: &Expr) -> Option<Ty> {
         let r = index.range();
         let Ty::Array(el, size) = array else {
             let span = self.text.sub(r.0, r.1);

@@ -150,12 +150,15 @@ fn an_index_that_is_not_an_integer() {
         ("status[true].level", "true", "an index must be an integer, found a boolean"),
         ("status[len(status) / 2].level", "len(status) / 2", "an index must be an integer, found a number"),
         ("status[1e0].level", "1e0", "an index must be an integer, found `1e0`"),
+        ("status[-1.0].level", "-1.0", "an index must be an integer, found `-1.0`"),
     ] {
         let (code, place, d) = finding(text, DIAG);
         assert_eq!((code, place.as_str(), d.message.as_str()), (codes::ROS2_BAD_INDEX, at, found), "{text}");
     }
     let (_, _, d) = finding("status[0.0]", DIAG);
     assert!(d.help.unwrap().starts_with("write `[0]`"));
+    let (_, _, d) = finding("status[-2.0]", DIAG);
+    assert!(d.help.unwrap().starts_with("write `[-2]`"));
     let (_, _, d) = finding("status['motor']", DIAG);
     assert!(d.help.unwrap().contains("find(array, name == 'x')"));
 }
