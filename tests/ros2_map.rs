@@ -181,3 +181,33 @@ fn explain_prints_the_codes_of_the_map() {
         assert!(stdout(&o).contains("```toml") || stdout(&o).contains("[[event]]"), "{}", text(&o));
     }
 }
+
+#[test]
+fn expressions_over_arrays_check_clean() {
+    let o = check("arrays.toml", &["--deny-warnings"]);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+}
+
+#[test]
+fn mistakes_in_expressions_over_arrays_name_their_fix() {
+    let o = check("bad_expressions.toml", &["--format", "json"]);
+    assert_eq!(code(&o), 1, "{}", text(&o));
+    let found: Vec<serde_json::Value> =
+        stdout(&o).lines().map(|l| serde_json::from_str(l).expect("a JSON line")).collect();
+    for (code, line, column, help) in [
+        ("E0419", 10, 28, "divide by a number that is not zero"),
+        ("E0420", 17, 16, "find(array, name == 'x')"),
+        ("E0404", 27, 34, "the comparisons are `==`"),
+        ("E0403", 34, 30, "write `it` for the element"),
+    ] {
+        let d =
+            found.iter().find(|d| d["code"] == format!("situ::{code}")).unwrap_or_else(|| panic!("{code}: {found:?}"));
+        assert_eq!((d["line"].as_u64(), d["column"].as_u64()), (Some(line), Some(column)), "{d}");
+        assert!(d["help"].as_str().is_some_and(|h| h.contains(help)), "{d}");
+    }
+    for code_name in ["E0419", "E0420"] {
+        let o = situ(&["explain", code_name]);
+        assert_eq!(code(&o), 0, "{}", text(&o));
+        assert!(stdout(&o).contains("[[event]]"), "{}", text(&o));
+    }
+}

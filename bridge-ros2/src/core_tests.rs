@@ -210,6 +210,21 @@ fn bad_messages_are_counted_and_reported_once_a_second() {
 }
 
 #[test]
+fn a_missing_value_posts_no_event_and_says_why() {
+    let mut core = started();
+    let empty = cdr(&LaserScan { header: Header::default(), range_max: 10.0, ..LaserScan::default() });
+    assert!(states(&core.on_message("/scan", &empty, T0 + S)).is_empty());
+    // Both entries of `/scan` read `min(ranges)`: two refusals, no event.
+    assert_eq!((core.counters().refused, core.counters().events), (2, 0));
+    let out = core.on_tick(T0 + 2 * S);
+    let Some(Output::Diagnostics(a)) = out.iter().find(|o| matches!(o, Output::Diagnostics(_))) else {
+        panic!("no diagnostics in {out:?}")
+    };
+    let scan = a.status.iter().find(|s| s.name == "situ: /scan").expect("a status for /scan");
+    assert_eq!(scan.message, "CLEAR: when: `min(ranges)` is missing: `min` of an array that is empty");
+}
+
+#[test]
 fn a_sample_the_middleware_could_not_hand_over_is_counted_and_reported() {
     let mut core = started();
     core.on_unreadable("/scan", "not read: unknown representation id 00 0c");

@@ -25,7 +25,7 @@ pub fn check_map(model: &Model, text: &str, file: FileId) -> Vec<Diagnostic> {
 
 /// [`check_map`] on a map already parsed (from `file`).
 pub fn check_parsed(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
-    let checks: [Check; 18] = [
+    let checks: [Check; 20] = [
         unknown_types,
         unknown_names,
         foreign_events,
@@ -44,6 +44,8 @@ pub fn check_parsed(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
         check_names::duplicates,
         check_names::own_topics,
         check_names::bridge_diagnostics,
+        crate::expr_check::zero_divisions,
+        crate::expr_check::non_integer_indexes,
     ];
     let mut out: Vec<Diagnostic> = checks.iter().flat_map(|c| c(model, map, file)).collect();
     out.sort_by_key(|d| (d.primary.span.start, d.code));

@@ -3,7 +3,7 @@
 //! (E0416), entries that repeat each other (W0417), and the bridge's own
 //! topics read back (E0418 for `/situ/…`, W0421 for `/diagnostics`).
 
-use crate::expr::{self, BinOp, Expr, Step};
+use crate::expr::{self, BinOp, Expr, Func, Step};
 use crate::map::{EventEntry, Map, NodeEntry, Str};
 use crate::msgs;
 use situ_compiler::codes;
@@ -332,14 +332,20 @@ pub fn own_topics(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
 /// Whether a `when` names the reporter of a status so that no status the
 /// bridge writes can match it: one of its `and`-ed conditions is
 /// `….hardware_id == 'x'` or `….name == 'x'` with `x` not the bridge's, or
-/// `….hardware_id != 'situ'`.
+/// `….hardware_id != 'situ'`, or `any(status, c)` where `c` does, or an
+/// `or` of which each side does.
 pub fn names_its_reporter(when: &str) -> bool {
-    let Ok(e) = expr::parse(when) else { return false };
-    let mut conjuncts = vec![&e];
+    expr::parse(when).is_ok_and(|e| names_reporter(&e))
+}
+
+fn names_reporter(e: &Expr) -> bool {
+    let mut conjuncts = vec![e];
     let mut found = false;
     while let Some(c) = conjuncts.pop() {
         match c {
             Expr::Binary(BinOp::And, l, r, _) => conjuncts.extend([l.as_ref(), r.as_ref()]),
+            Expr::Binary(BinOp::Or, l, r, _) => found |= names_reporter(l) && names_reporter(r),
+            Expr::Call(Func::Any, args, _) => found |= args.get(1).is_some_and(names_reporter),
             Expr::Binary(op @ (BinOp::Eq | BinOp::Ne), l, r, _) => {
                 let (path, lit) = match (l.as_ref(), r.as_ref()) {
                     (Expr::Path(p, _), Expr::Str(s, _)) | (Expr::Str(s, _), Expr::Path(p, _)) => (p, s),
@@ -384,8 +390,8 @@ pub fn bridge_diagnostics(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic>
             )
             .with_help(
                 "the bridge ignores the messages of its own writers, but not another situ bridge's on the \
-                 domain: name the reporter in `when`, e.g. `and status[0].hardware_id == 'base'` or \
-                 `and status[0].hardware_id != 'situ'`, or read the aggregator's `/diagnostics_agg`",
+                 domain: name the reporter in `when`, e.g. `any(status, level >= 2 and hardware_id != 'situ')` \
+                 or `and status[0].hardware_id == 'base'`, or read the aggregator's `/diagnostics_agg`",
             ),
         );
     }
@@ -463,6 +469,9 @@ mod tests {
             "len(status) > 0 and status[0].level >= 1 and status[0].hardware_id == 'base'",
             "'lidar' == status[0].name and status[0].level >= 2",
             "status[0].level >= 0 and status[0].hardware_id != 'situ'",
+            "any(status, level >= 2 and hardware_id != 'situ')",
+            "any(status, hardware_id == 'arm' and (level >= 2 or any(values, key == 'fault')))",
+            "any(status, name == 'motor' or name == 'lidar') and len(status) > 0",
         ] {
             assert!(names_its_reporter(named), "{named}");
         }
@@ -474,6 +483,10 @@ mod tests {
             "not (status[0].hardware_id == 'base')",
             "status[0].hardware_id != 'base'",
             "status[0].level >=",
+            "any(status, level >= 2)",
+            "any(status, level >= 2 or hardware_id == 'arm')",
+            "all(status, hardware_id == 'arm')",
+            "not any(status, hardware_id == 'arm')",
         ] {
             assert!(!names_its_reporter(unnamed), "{unnamed}");
         }

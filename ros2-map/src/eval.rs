@@ -3,10 +3,13 @@
 //! each message of a topic into the events the map's entries produce, with
 //! their payloads as the runtime takes them.
 //!
-//! Nothing here panics on a message: a message that does not decode, an
-//! index past the end of an array, `min` of an empty array, a division by
-//! zero, a NaN or an integer overflow is a [`Problem`] of the outcome, and
-//! the entry produces no event for that message.
+//! Nothing here panics on a message. A value that is missing (an index
+//! outside its array, `min` of an empty array, `find` or `index` with no
+//! match), a message that does not decode, a division by zero, a NaN or an
+//! integer overflow is a [`Problem`] of the outcome, and the entry produces
+//! no event for that message.
+
+mod funcs;
 
 use crate::cdr::{self, Decoder};
 use crate::check::check_parsed;
@@ -33,10 +36,32 @@ pub enum Val<'a> {
 pub struct EvalError {
     pub message: String,
     pub range: Range,
+    pub why: Why,
+}
+
+/// The kinds of [`EvalError`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Why {
+    /// A value the message does not have: an index outside its array, a
+    /// reducer of an empty array, `find` or `index` with no match.
+    Missing,
+    /// A NaN field or result.
+    NaN,
+    /// Anything else: a division by zero, an overflow, a wrong type.
+    Invalid,
 }
 
 fn fail<T>(range: Range, message: impl Into<String>) -> Result<T, EvalError> {
-    Err(EvalError { message: message.into(), range })
+    Err(EvalError { message: message.into(), range, why: Why::Invalid })
+}
+
+/// A value the message does not have: every such case says `is missing`.
+fn missing<T>(range: Range, why: impl std::fmt::Display) -> Result<T, EvalError> {
+    Err(EvalError { message: format!("is missing: {why}"), range, why: Why::Missing })
+}
+
+fn nan<T>(range: Range) -> Result<T, EvalError> {
+    Err(EvalError { message: "is NaN".into(), range, why: Why::NaN })
 }
 
 /// The largest integer a float holds exactly; whole literals up to it are integers.
@@ -56,7 +81,7 @@ fn describe(v: &Val<'_>) -> &'static str {
 fn leaf(v: &cdr::Value, range: Range) -> Result<Val<'_>, EvalError> {
     Ok(match v {
         cdr::Value::Int(i) => Val::Int(*i),
-        cdr::Value::Float(f) if f.is_nan() => return fail(range, "is NaN"),
+        cdr::Value::Float(f) if f.is_nan() => return nan(range),
         cdr::Value::Float(f) => Val::Float(*f),
         cdr::Value::Bool(b) => Val::Bool(*b),
         cdr::Value::Str(s) => Val::Str(s),
@@ -74,36 +99,66 @@ fn float(v: Val<'_>) -> Option<f64> {
 
 fn number(f: f64, range: Range) -> Result<Val<'static>, EvalError> {
     if f.is_nan() {
-        fail(range, "is NaN")
+        nan(range)
     } else {
         Ok(Val::Float(f))
     }
 }
 
+/// Where the names of an expression are read: the message, or one element
+/// of an array inside `any(array, …)` and the other functions over elements.
+#[derive(Debug, Clone, Copy)]
+struct Scope<'a> {
+    value: &'a cdr::Value,
+    /// Inside a function over elements: `it` is the element.
+    element: bool,
+}
+
 /// The value of `e` on the decoded message `msg`.
 pub fn eval<'a>(e: &'a Expr, msg: &'a cdr::Value) -> Result<Val<'a>, EvalError> {
+    ev(e, Scope { value: msg, element: false })
+}
+
+fn ev<'a>(e: &'a Expr, sc: Scope<'a>) -> Result<Val<'a>, EvalError> {
     match e {
         Expr::Number(n, _) if n.fract() == 0.0 && n.abs() <= EXACT => Ok(Val::Int(*n as i64)),
         Expr::Number(n, _) => Ok(Val::Float(*n)),
         Expr::Str(s, _) => Ok(Val::Str(s)),
         Expr::Bool(b, _) => Ok(Val::Bool(*b)),
-        Expr::Path(steps, range) => path(steps, msg, *range),
-        Expr::Neg(inner, r) => match eval(inner, msg)? {
+        Expr::Path(steps, range) => path(steps, sc, *range),
+        Expr::Neg(inner, r) => match ev(inner, sc)? {
             Val::Int(i) => i.checked_neg().map(Val::Int).map_or_else(|| fail(*r, "overflows an integer"), Ok),
             Val::Float(f) => Ok(Val::Float(-f)),
             v => fail(*r, format!("`-` of {}", describe(&v))),
         },
-        Expr::Not(inner, r) => match eval(inner, msg)? {
+        Expr::Not(inner, r) => match ev(inner, sc)? {
             Val::Bool(b) => Ok(Val::Bool(!b)),
             v => fail(*r, format!("`not` of {}", describe(&v))),
         },
-        Expr::Reduce(red, arg, r) => reduce(*red, eval(arg, msg)?, *r),
-        Expr::Binary(op, l, r, range) => binary(*op, l, r, msg, *range),
+        Expr::Reduce(red, arg, r) => reduce(*red, ev(arg, sc)?, *r),
+        Expr::Binary(op, l, r, range) => binary(*op, l, r, sc, *range),
+        Expr::Call(f, args, r) => funcs::call(*f, args, sc, *r),
+        Expr::Member(base, name, _, r) => match ev(base, sc)? {
+            Val::Node(v) => match v.field(name) {
+                Some(f) => leaf(f, *r),
+                None => fail(*r, format!("the message has no field `{name}`")),
+            },
+            v => fail(*r, format!("`.{name}` of {}", describe(&v))),
+        },
+        Expr::At(base, index, r) => {
+            let array = ev(base, sc)?;
+            at(array, ev(index, sc)?, *r)
+        }
     }
 }
 
-fn path<'a>(steps: &'a [Step], msg: &'a cdr::Value, range: Range) -> Result<Val<'a>, EvalError> {
-    let mut v = msg;
+fn path<'a>(steps: &'a [Step], sc: Scope<'a>, range: Range) -> Result<Val<'a>, EvalError> {
+    let steps = match steps.split_first() {
+        // `it`: the element itself, unless the element has a field `it`.
+        Some((Step::Field(name, _), rest)) if sc.element && name == "it" && sc.value.field("it").is_none() => rest,
+        _ => steps,
+    };
+    let mut v = sc.value;
     for step in steps {
         v = match step {
             Step::Field(name, r) => match v.field(name) {
@@ -114,13 +169,89 @@ fn path<'a>(steps: &'a [Step], msg: &'a cdr::Value, range: Range) -> Result<Val<
                 (Some(x), _) => x,
                 (None, cdr::Value::Array(items)) => {
                     let n = items.len();
-                    return fail((range.0, r.1), format!("index {i} is past the end of an array of {n}"));
+                    return missing((range.0, r.1), format!("index {i} is past the end of an array of {n}"));
                 }
                 (None, _) => return fail((range.0, r.1), "an index on a value that is not an array"),
             },
         };
     }
     leaf(v, range)
+}
+
+/// `array[index]` with an integer index; a negative one counts from the end.
+fn at<'a>(array: Val<'a>, index: Val<'_>, r: Range) -> Result<Val<'a>, EvalError> {
+    let Val::Node(cdr::Value::Array(items)) = array else {
+        return fail(r, format!("an index on {}", describe(&array)));
+    };
+    let n = items.len();
+    let i = match index {
+        Val::Int(i) => i,
+        // A whole literal too large for an integer: outside any array.
+        Val::Float(f) if f.fract() == 0.0 && f > 0.0 => {
+            return missing(r, format!("index {f} is past the end of an array of {n}"));
+        }
+        Val::Float(f) if f.fract() == 0.0 => {
+            return missing(r, format!("index {f} is before the start of an array of {n}"));
+        }
+        v => return fail(r, format!("an index that is {}", describe(&v))),
+    };
+    let from = if i < 0 { i.checked_add(i64::try_from(n).unwrap_or(i64::MAX)) } else { Some(i) };
+    match from.and_then(|k| usize::try_from(k).ok()).and_then(|k| items.get(k)) {
+        Some(x) => leaf(x, r),
+        None if i < 0 => missing(r, format!("index {i} is before the start of an array of {n}")),
+        None => missing(r, format!("index {i} is past the end of an array of {n}")),
+    }
+}
+
+/// The running `min`, `max` or `mean` of numbers.
+struct Acc {
+    red: Reducer,
+    count: usize,
+    sum: f64,
+    best_int: Option<i64>,
+    best: Option<f64>,
+    floats: bool,
+}
+
+impl Acc {
+    fn new(red: Reducer) -> Acc {
+        Acc { red, count: 0, sum: 0.0, best_int: None, best: None, floats: false }
+    }
+
+    /// One more number; `false` for a value that is not a number. NaN is skipped.
+    fn add(&mut self, v: Val<'_>) -> bool {
+        let max = self.red == Reducer::Max;
+        let x = match v {
+            Val::Int(i) => {
+                self.best_int = Some(self.best_int.map_or(i, |a| if max { a.max(i) } else { a.min(i) }));
+                i as f64
+            }
+            Val::Float(f) if f.is_nan() => return true,
+            Val::Float(f) => {
+                self.floats = true;
+                f
+            }
+            _ => return false,
+        };
+        self.best = Some(self.best.map_or(x, |a| if max { a.max(x) } else { a.min(x) }));
+        self.count += 1;
+        self.sum += x;
+        true
+    }
+
+    /// The result over `n` values; missing when none was a number.
+    fn finish(self, n: usize, r: Range) -> Result<Val<'static>, EvalError> {
+        let name = self.red.name();
+        match (self.red, self.best_int, self.best) {
+            (_, _, None) => {
+                let why = if n == 0 { "empty".to_string() } else { format!("all {n} NaN") };
+                missing(r, format!("`{name}` of an array that is {why}"))
+            }
+            (Reducer::Mean, _, Some(_)) => number(self.sum / self.count as f64, r),
+            (_, Some(i), Some(_)) if !self.floats => Ok(Val::Int(i)),
+            (_, _, Some(f)) => number(f, r),
+        }
+    }
 }
 
 fn reduce(red: Reducer, arg: Val<'_>, r: Range) -> Result<Val<'static>, EvalError> {
@@ -130,53 +261,34 @@ fn reduce(red: Reducer, arg: Val<'_>, r: Range) -> Result<Val<'static>, EvalErro
     if red == Reducer::Len {
         return Ok(Val::Int(i64::try_from(items.len()).unwrap_or(i64::MAX)));
     }
-    let name = match red {
-        Reducer::Min => "min",
-        Reducer::Max => "max",
-        _ => "mean",
-    };
     // NaN elements are invalid readings (REP 117): they are skipped.
-    let (mut count, mut sum) = (0usize, 0f64);
-    let (mut best_int, mut best) = (None::<i64>, None::<f64>);
+    let mut acc = Acc::new(red);
     for item in items {
-        let x = match item {
-            cdr::Value::Int(i) => {
-                best_int = Some(best_int.map_or(*i, |a| if red == Reducer::Max { a.max(*i) } else { a.min(*i) }));
-                *i as f64
-            }
-            cdr::Value::Float(f) if f.is_nan() => continue,
-            cdr::Value::Float(f) => *f,
-            _ => return fail(r, format!("`{name}` of an array that holds other things than numbers")),
+        let v = match item {
+            cdr::Value::Int(i) => Val::Int(*i),
+            cdr::Value::Float(f) => Val::Float(*f),
+            _ => Val::Bool(false),
         };
-        best = Some(best.map_or(x, |a| if red == Reducer::Max { a.max(x) } else { a.min(x) }));
-        count += 1;
-        sum += x;
-    }
-    match (red, best_int, best) {
-        (_, _, None) => {
-            let why = if items.is_empty() { "empty".to_string() } else { format!("all {} NaN", items.len()) };
-            fail(r, format!("`{name}` of an array that is {why}"))
+        if !acc.add(v) {
+            return fail(r, format!("`{}` of an array that holds other things than numbers", red.name()));
         }
-        (Reducer::Mean, _, Some(_)) => number(sum / count as f64, r),
-        // An array of integers (the catalogue's arrays are of one type).
-        (_, Some(i), Some(_)) => Ok(Val::Int(i)),
-        (_, None, Some(f)) => number(f, r),
     }
+    acc.finish(items.len(), r)
 }
 
-fn binary<'a>(op: BinOp, l: &'a Expr, r: &'a Expr, msg: &'a cdr::Value, range: Range) -> Result<Val<'a>, EvalError> {
-    let lv = eval(l, msg)?;
+fn binary<'a>(op: BinOp, l: &'a Expr, r: &'a Expr, sc: Scope<'a>, range: Range) -> Result<Val<'a>, EvalError> {
+    let lv = ev(l, sc)?;
     if let (BinOp::And | BinOp::Or, Val::Bool(a)) = (op, lv) {
         // Short-circuit: `len(status) > 0 and status[0].level >= 1`.
         if a == (op == BinOp::Or) {
             return Ok(Val::Bool(a));
         }
-        return match eval(r, msg)? {
+        return match ev(r, sc)? {
             Val::Bool(b) => Ok(Val::Bool(b)),
             v => fail(range, format!("`{}` of a boolean and {}", op.text(), describe(&v))),
         };
     }
-    let rv = eval(r, msg)?;
+    let rv = ev(r, sc)?;
     let mismatch = || fail(range, format!("`{}` of {} and {}", op.text(), describe(&lv), describe(&rv)));
     match op {
         BinOp::And | BinOp::Or => mismatch(),
@@ -478,135 +590,4 @@ fn entry(model: &Model, e: &map::EventEntry) -> Option<Entry> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::cdr::Value as M;
-
-    fn msg() -> M {
-        let status = |level: i64, hw: &str| {
-            M::Msg(vec![("level", M::Int(level)), ("hardware_id", M::Str(hw.into())), ("values", M::Array(vec![]))])
-        };
-        M::Msg(vec![
-            ("ranges", M::Array(vec![M::Float(f64::NAN), M::Float(0.25), M::Float(f64::INFINITY)])),
-            ("empty", M::Array(vec![])),
-            ("nans", M::Array(vec![M::Float(f64::NAN)])),
-            ("ints", M::Array(vec![M::Int(3), M::Int(-2)])),
-            ("x", M::Float(2.0)),
-            ("n", M::Int(i64::MAX)),
-            ("nan", M::Float(f64::NAN)),
-            ("ok", M::Bool(true)),
-            ("status", M::Array(vec![status(2, "base")])),
-            ("none", M::Array(vec![])),
-        ])
-    }
-
-    fn run(text: &str) -> Result<Val<'static>, String> {
-        let e = expr::parse(text).unwrap();
-        let m = msg();
-        let src = Source { expr: e, text: text.to_string() };
-        src.eval(&m).map(|v| match v {
-            Val::Int(i) => Val::Int(i),
-            Val::Float(f) => Val::Float(f),
-            Val::Bool(b) => Val::Bool(b),
-            Val::Str(s) => Val::Str(if s == "base" { "base" } else { "?" }),
-            Val::Node(_) => Val::Str("node"),
-        })
-    }
-
-    #[test]
-    fn values() {
-        assert_eq!(run("min(ranges)"), Ok(Val::Float(0.25)));
-        assert_eq!(run("max(ranges)"), Ok(Val::Float(f64::INFINITY)));
-        assert_eq!(run("min(ints) * 2"), Ok(Val::Int(-4)));
-        assert_eq!(run("max(ints)"), Ok(Val::Int(3)));
-        assert_eq!(run("mean(ints)"), Ok(Val::Float(0.5)));
-        assert_eq!(run("len(ranges) + len(empty)"), Ok(Val::Int(3)));
-        assert_eq!(run("x * 3.6 - 1"), Ok(Val::Float(6.2)));
-        assert_eq!(run("x / 4"), Ok(Val::Float(0.5)));
-        assert_eq!(run("-x < 0 and not (ok == false)"), Ok(Val::Bool(true)));
-        assert_eq!(run("status[0].hardware_id == 'base' and status[0].level >= 1"), Ok(Val::Bool(true)));
-        assert_eq!(run("status[0].hardware_id"), Ok(Val::Str("base")));
-        assert_eq!(run("len(status) > 1 or x > 1"), Ok(Val::Bool(true)));
-    }
-
-    #[test]
-    fn short_circuit_guards_an_index() {
-        assert_eq!(run("len(none) > 0 and none[0].level > 1"), Ok(Val::Bool(false)));
-        assert_eq!(run("len(none) == 0 or none[0].level > 1"), Ok(Val::Bool(true)));
-    }
-
-    #[test]
-    fn errors_are_values() {
-        let err = |t: &str| run(t).unwrap_err();
-        assert_eq!(err("min(empty)"), "`min(empty)` `min` of an array that is empty");
-        assert_eq!(err("mean(nans) > 1"), "`mean(nans)` `mean` of an array that is all 1 NaN");
-        assert_eq!(err("x / (x - 2)"), "`x / (x - 2)` division by zero");
-        assert_eq!(err("nan + 1"), "`nan` is NaN");
-        assert_eq!(err("n + 1"), "`n + 1` overflows an integer");
-        assert_eq!(err("-n - 2"), "`-n - 2` overflows an integer");
-        assert_eq!(err("none[0].level"), "`none[0]` index 0 is past the end of an array of 0");
-        assert_eq!(err("max(ranges) - max(ranges) > 0"), "`max(ranges) - max(ranges)` is NaN");
-        assert!(err("missing > 1").contains("no field `missing`"));
-        assert!(err("ok + 1").contains("`+` of a boolean and an integer"));
-    }
-
-    #[test]
-    fn payload_values() {
-        let sym = Type::Symbols(vec!["warn".into(), "error".into()]);
-        assert_eq!(to_payload(Val::Str("error"), &sym), Ok(Value::Symbol(1)));
-        assert_eq!(to_payload(Val::Str("fatal"), &sym).unwrap_err().to_string(), "`fatal` is not one of warn, error");
-        assert_eq!(to_payload(Val::Int(3), &Type::F64), Ok(Value::F64(3.0)));
-        assert_eq!(to_payload(Val::Int(3), &Type::I64), Ok(Value::I64(3)));
-        assert_eq!(to_payload(Val::Bool(true), &Type::Bool), Ok(Value::Bool(true)));
-        assert!(to_payload(Val::Float(f64::INFINITY), &Type::F64).unwrap_err().to_string().contains("inf"));
-        assert!(to_payload(Val::Float(0.5), &Type::I64).is_err());
-    }
-
-    const RULES: &str = include_str!("../../tests/ros2/delivery.situ");
-    const MAP: &str = include_str!("../../tests/ros2/delivery.toml");
-
-    /// A LaserScan of `ranges`, written by hand (little-endian).
-    fn scan(ranges: &[f32]) -> Vec<u8> {
-        let mut b = vec![0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0];
-        b.extend([0u8; 28]);
-        b.extend((ranges.len() as u32).to_le_bytes());
-        ranges.iter().for_each(|r| b.extend(r.to_le_bytes()));
-        b.extend([0u8; 4]);
-        b
-    }
-
-    #[test]
-    fn delivery_scan_by_hand() {
-        let checked = situ_compiler::check_source("delivery.situ", RULES);
-        let mut t = Translator::new(&checked.model, MAP, FileId(1)).unwrap();
-        let topics: Vec<_> = t.topics().collect();
-        assert_eq!(topics[0], ("/scan", "sensor_msgs/msg/LaserScan"));
-        let (lidar, obstacle, clear) = (
-            checked.model.agent_id("Lidar").unwrap().0,
-            checked.model.event_id("OBSTACLE").unwrap().0,
-            checked.model.event_id("CLEAR").unwrap().0,
-        );
-        let out = t.on_message("/scan", &scan(&[1.0, 0.25, f32::NAN]));
-        assert_eq!(out.produced, vec![Produced { agent: lidar, event: obstacle, payload: vec![Value::F64(0.25)] }]);
-        let out = t.on_message("/scan", &scan(&[1.0, f32::INFINITY]));
-        assert_eq!(out.produced, vec![Produced { agent: lidar, event: clear, payload: vec![] }]);
-        let out = t.on_message("/scan", &scan(&[]));
-        assert!(out.produced.is_empty());
-        assert_eq!(out.problems.len(), 2, "{:?}", out.problems);
-        assert_eq!(out.problems[0].event.as_deref(), Some("OBSTACLE"));
-        assert_eq!(out.problems[0].message, "when: `min(ranges)` `min` of an array that is empty");
-        let out = t.on_message("/scan", &scan(&[1.0])[..20]);
-        assert_eq!(out.problems[0].event, None);
-        assert!(out.problems[0].message.starts_with("LaserScan: "), "{:?}", out.problems);
-        assert_eq!(t.on_message("/nowhere", &[]).problems[0].message, "the map reads no topic `/nowhere`");
-        assert_eq!(t.stats(), Stats { messages: 5, refused: 2, failed: 2, produced: 2 });
-    }
-
-    #[test]
-    fn a_map_with_errors_is_refused() {
-        let checked = situ_compiler::check_source("delivery.situ", RULES);
-        let bad = MAP.replace("min(ranges) < 0.5", "min(rangez) < 0.5");
-        let errors = Translator::new(&checked.model, &bad, FileId(1)).unwrap_err();
-        assert!(errors.iter().any(|d| d.code == codes::ROS2_UNKNOWN_FIELD));
-    }
-}
+mod tests;

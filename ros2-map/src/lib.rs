@@ -8,6 +8,7 @@
 //! - [`msgs`]: the message catalogue, as data.
 //! - [`expr`]: the expressions of `when` and of payload fields.
 //! - [`types`]: the types of expressions against a message.
+//! - [`expr_check`]: the checks of expressions beyond fields and types (E0419, E0420).
 //! - [`check`]: the checks, one function each; [`check_map`] runs them all.
 //! - [`check_names`]: the checks of topic and node names, repeated entries and the bridge's own topics.
 //! - [`cdr`]: decoding of the catalogue's messages from their CDR bytes.
@@ -20,6 +21,7 @@ pub mod check;
 pub mod check_names;
 pub mod eval;
 pub mod expr;
+pub mod expr_check;
 pub mod lifecycle;
 pub mod map;
 pub mod msgs;

@@ -215,8 +215,10 @@ pub fn parse(text: &str, file: FileId) -> Result<Map, Box<Diagnostic>> {
         let span = err.span().map_or(Span::new(0, 0), |r| Span::new(r.start, r.end));
         let message = err.message().trim().to_string();
         let label = message.lines().next().unwrap_or("here").to_string();
-        let help = "see `docs/ros2.md`: `[[event]]` needs `agent`, `event`, `topic` and `type`; \
-                    `[[node]]` needs `agent` and `node`";
+        let help = quote_help(text, span.start).unwrap_or(
+            "see `docs/ros2.md`: `[[event]]` needs `agent`, `event`, `topic` and `type`; \
+             `[[node]]` needs `agent` and `node`",
+        );
         let d =
             Diagnostic::error(codes::ROS2_BAD_MAP, format!("the map is not a valid map: {label}"), file, span, label);
         Box::new(d.with_help(help))
@@ -246,6 +248,28 @@ pub fn parse(text: &str, file: FileId) -> Result<Map, Box<Diagnostic>> {
         .map(|n| NodeEntry { agent: s(n.agent), node: s(n.node), failed: n.failed.map(s), timeout: n.timeout.map(s) })
         .collect();
     Ok(Map { events, nodes })
+}
+
+/// The help of a TOML error on a line whose string a quote of the same kind
+/// closed early (`when = "name == "motor""`).
+fn quote_help(text: &str, at: usize) -> Option<&'static str> {
+    let start = text.get(..at)?.rfind('\n').map_or(0, |i| i + 1);
+    let end = text.get(at..)?.find('\n').map_or(text.len(), |i| at + i);
+    let line = text.get(start..end)?;
+    if line.matches('"').count() >= 3 {
+        Some(
+            "a `\"` inside a TOML string `\"…\"` ends it: write the expression's strings in single quotes \
+             (`when = \"name == 'motor'\"`), or the whole expression as a TOML literal string \
+             (`when = 'name == \"motor\"'`)",
+        )
+    } else if line.matches('\'').count() >= 3 {
+        Some(
+            "a `'` inside a TOML literal string `'…'` ends it: write the expression in double quotes and its \
+             strings in single quotes (`when = \"name == 'motor'\"`)",
+        )
+    } else {
+        None
+    }
 }
 
 fn str_of(text: &str, v: Spanned<String>) -> Str {
@@ -319,6 +343,20 @@ mod tests {
         for none in ["", "2", "2h", "fast", "-1s", "0 ms", "2 hours"] {
             assert_eq!(meant(none), None, "{none:?}");
         }
+    }
+
+    #[test]
+    fn a_quote_that_ends_the_string_early_is_named() {
+        for (text, fix) in [
+            ("[[event]]\nwhen = \"find(status, name == \"motor\").level > 1\"\n", "single quotes"),
+            ("[[event]]\nwhen = 'name == 'motor''\n", "in double quotes"),
+        ] {
+            let d = parse(text, FileId(0)).unwrap_err();
+            assert_eq!(d.code, codes::ROS2_BAD_MAP);
+            assert!(d.help.as_deref().is_some_and(|h| h.contains(fix)), "{text}: {d:?}");
+        }
+        let d = parse("[[event]\n", FileId(0)).unwrap_err();
+        assert!(d.help.as_deref().is_some_and(|h| h.starts_with("see `docs/ros2.md`")), "{d:?}");
     }
 
     #[test]
