@@ -106,6 +106,8 @@ codes! {
     ROS2_TWO_NODES = "E0412", Error, "agent played by two lifecycle nodes";
     ROS2_TOPIC_TYPES = "E0413", Error, "topic read as two message types";
     ROS2_BAD_NODE = "E0414", Error, "lifecycle node entry the bridge cannot use";
+    ROS2_BAD_DEFINITION = "E0422", Error, "ROS 2 message definition that does not load";
+    ROS2_BAD_MSG_PATH = "E0423", Error, "`msg_path` folder that is not a folder";
     VACUOUS_PROPERTY = "W0501", Warning, "property whose premise never holds";
     UNDECIDED_PROPERTY = "E0502", Error, "property neither proved nor violated";
     VIOLATED_PROPERTY = "E0503", Error, "property broken by a run";

@@ -12,6 +12,8 @@ use crate::cdr::{self, Decoder};
 use crate::check::check_parsed;
 use crate::expr::{self, BinOp, Expr, Range, Reducer, Step};
 use crate::map;
+use crate::msgs::idl::ConstValue;
+use crate::msgs::Registry;
 use situ_compiler::bundle::Value;
 use situ_compiler::codes;
 use situ_compiler::model::{Model, Type};
@@ -373,28 +375,29 @@ pub struct Translator {
 
 impl Translator {
     /// The translator of the map `text` (file `file`) for the rules'
-    /// `model`; the map's error findings when it has any (warnings pass).
-    pub fn new(model: &Model, text: &str, file: FileId) -> Result<Translator, Vec<Diagnostic>> {
+    /// `model`, its messages as `msgs` defines them; the map's error
+    /// findings when it has any (warnings pass).
+    pub fn new(model: &Model, text: &str, msgs: &Registry, file: FileId) -> Result<Translator, Vec<Diagnostic>> {
         let parsed = map::parse(text, file).map_err(|d| vec![*d])?;
-        Translator::of(model, &parsed, file)
+        Translator::of(model, &parsed, msgs, file)
     }
 
     /// [`Translator::new`] of a map already parsed (from `file`).
-    pub fn of(model: &Model, parsed: &map::Map, file: FileId) -> Result<Translator, Vec<Diagnostic>> {
+    pub fn of(model: &Model, parsed: &map::Map, msgs: &Registry, file: FileId) -> Result<Translator, Vec<Diagnostic>> {
         let errors: Vec<Diagnostic> =
-            check_parsed(model, parsed, file).into_iter().filter(|d| d.severity == Severity::Error).collect();
+            check_parsed(model, parsed, msgs, file).into_iter().filter(|d| d.severity == Severity::Error).collect();
         if !errors.is_empty() {
             return Err(errors);
         }
         let mut topics: Vec<Topic> = Vec::new();
         for e in &parsed.events {
-            let entry = entry(model, e).ok_or_else(|| {
+            let entry = entry(model, e, msgs).ok_or_else(|| {
                 vec![Diagnostic::error(codes::ROS2_BAD_MAP, "entry not translatable", file, e.span, "")]
             })?;
             match topics.iter_mut().find(|t| t.name == e.topic.value) {
                 Some(t) => t.entries.push(entry),
                 None => {
-                    let Some(decoder) = Decoder::new(&e.ty.value) else {
+                    let Some(decoder) = Decoder::new(msgs, &e.ty.value) else {
                         let d = Diagnostic::error(codes::ROS2_UNKNOWN_TYPE, "unknown type", file, e.ty.span, "");
                         return Err(vec![d]);
                     };
@@ -452,13 +455,48 @@ impl Translator {
     }
 }
 
-fn source(s: &map::Str) -> Option<Source> {
-    Some(Source { expr: expr::parse(&s.value).ok()?, text: s.value.clone() })
+/// The expression of `s` on messages of type `msg`, the paths that name a
+/// constant of the message replaced by its value.
+fn source(s: &map::Str, msg: &str, msgs: &Registry) -> Option<Source> {
+    let mut expr = expr::parse(&s.value).ok()?;
+    constants(&mut expr, msg, msgs);
+    Some(Source { expr, text: s.value.clone() })
+}
+
+/// Replaces each path of `e` that names a constant (`POWER_SUPPLY_STATUS_CHARGING`,
+/// `DiagnosticStatus.ERROR`, see [`Registry::path_constant`]) by its value.
+fn constants(e: &mut Expr, msg: &str, msgs: &Registry) {
+    match e {
+        Expr::Path(steps, range) => {
+            let names: Option<Vec<&str>> = steps
+                .iter()
+                .map(|s| match s {
+                    Step::Field(n, _) => Some(n.as_str()),
+                    Step::Index(..) => None,
+                })
+                .collect();
+            let Some(c) = names.and_then(|n| msgs.path_constant(msg, &n)) else { return };
+            *e = match &c.value {
+                ConstValue::Bool(b) => Expr::Bool(*b, *range),
+                ConstValue::Int(i) => Expr::Number(*i as f64, *range),
+                ConstValue::Float(f) => Expr::Number(*f, *range),
+                ConstValue::Str(s) => Expr::Str(s.clone(), *range),
+            };
+        }
+        Expr::Number(..) | Expr::Str(..) | Expr::Bool(..) => {}
+        Expr::Neg(inner, _) | Expr::Not(inner, _) | Expr::Reduce(_, inner, _) => constants(inner, msg, msgs),
+        Expr::Binary(_, l, r, _) => {
+            constants(l, msg, msgs);
+            constants(r, msg, msgs);
+        }
+    }
 }
 
 /// The entry of a checked map's `[[event]]`; `None` only for a map that
 /// did not pass the check.
-fn entry(model: &Model, e: &map::EventEntry) -> Option<Entry> {
+fn entry(model: &Model, e: &map::EventEntry, msgs: &Registry) -> Option<Entry> {
+    let msg = msgs.lookup(&e.ty.value)?;
+    let source = |s: &map::Str| source(s, msg, msgs);
     let agent = model.agent_id(&e.agent.value)?;
     let event = model.event_id(&e.event.value)?;
     let def = model.event(event);
@@ -578,7 +616,7 @@ mod tests {
     #[test]
     fn delivery_scan_by_hand() {
         let checked = situ_compiler::check_source("delivery.situ", RULES);
-        let mut t = Translator::new(&checked.model, MAP, FileId(1)).unwrap();
+        let mut t = Translator::new(&checked.model, MAP, &Registry::carried(), FileId(1)).unwrap();
         let topics: Vec<_> = t.topics().collect();
         assert_eq!(topics[0], ("/scan", "sensor_msgs/msg/LaserScan"));
         let (lidar, obstacle, clear) = (
@@ -606,7 +644,7 @@ mod tests {
     fn a_map_with_errors_is_refused() {
         let checked = situ_compiler::check_source("delivery.situ", RULES);
         let bad = MAP.replace("min(ranges) < 0.5", "min(rangez) < 0.5");
-        let errors = Translator::new(&checked.model, &bad, FileId(1)).unwrap_err();
+        let errors = Translator::new(&checked.model, &bad, &Registry::carried(), FileId(1)).unwrap_err();
         assert!(errors.iter().any(|d| d.code == codes::ROS2_UNKNOWN_FIELD));
     }
 }

@@ -5,11 +5,13 @@
 //! will reuse this crate.
 //!
 //! - [`map`]: the map file (TOML), parsed with the place of every value.
-//! - [`msgs`]: the message catalogue, as data.
+//! - [`msgs`]: the message definitions, as data: the `.msg`/`.srv`/`.action`
+//!   parser, the search path, the [`msgs::Registry`] everything shares.
+//! - [`load`]: the search path and registry of a map, and its whole check.
 //! - [`expr`]: the expressions of `when` and of payload fields.
 //! - [`types`]: the types of expressions against a message.
 //! - [`check`]: the checks, one function each; [`check_map`] runs them all.
-//! - [`cdr`]: decoding of the catalogue's messages from their CDR bytes.
+//! - [`cdr`]: decoding of messages from their CDR bytes.
 //! - [`eval`]: expressions on a decoded message; the [`Translator`] of messages to events.
 //! - [`lifecycle`]: the next `change_state` request the tables ask of the lifecycle nodes.
 //! - [`skeleton`]: the part of a model a map needs, from a bundle.
@@ -19,6 +21,7 @@ pub mod check;
 pub mod eval;
 pub mod expr;
 pub mod lifecycle;
+pub mod load;
 pub mod map;
 pub mod msgs;
 pub mod skeleton;
@@ -26,3 +29,4 @@ pub mod types;
 
 pub use check::{check_map, check_parsed};
 pub use eval::Translator;
+pub use msgs::Registry;

@@ -105,6 +105,8 @@ pub fn parse_duration(text: &str) -> Result<Duration, DurationError> {
 /// A parsed map.
 #[derive(Debug, Clone, Default)]
 pub struct Map {
+    /// `msg_path`: folders of message definitions, relative to the map file.
+    pub msg_path: Vec<Str>,
     pub events: Vec<EventEntry>,
     pub nodes: Vec<NodeEntry>,
 }
@@ -112,6 +114,8 @@ pub struct Map {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawMap {
+    #[serde(default)]
+    msg_path: Vec<Spanned<String>>,
     #[serde(default)]
     event: Vec<RawEvent>,
     #[serde(default)]
@@ -177,7 +181,7 @@ pub fn parse(text: &str, file: FileId) -> Result<Map, Box<Diagnostic>> {
         .into_iter()
         .map(|n| NodeEntry { agent: s(n.agent), node: s(n.node), failed: n.failed.map(s), timeout: n.timeout.map(s) })
         .collect();
-    Ok(Map { events, nodes })
+    Ok(Map { msg_path: raw.msg_path.into_iter().map(s).collect(), events, nodes })
 }
 
 fn str_of(text: &str, v: Spanned<String>) -> Str {

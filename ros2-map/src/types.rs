@@ -4,7 +4,8 @@
 
 use crate::expr::{self, BinOp, Expr, Reducer, Step};
 use crate::map::Str;
-use crate::msgs::{self, FieldType, Prim};
+use crate::msgs::idl::{self, ConstValue};
+use crate::msgs::{FieldType, Prim, Registry};
 use situ_compiler::codes;
 use situ_compiler::suggest::suggest;
 use situ_grammar::diag::{Diagnostic, FileId};
@@ -76,8 +77,9 @@ pub struct Typed {
     pub expr: Option<Expr>,
 }
 
-/// Parses and types `text` (a `when` or a payload value) on message `msg`.
-pub fn type_of(text: &Str, msg: &'static str, file: FileId) -> Typed {
+/// Parses and types `text` (a `when` or a payload value) on message `msg`
+/// of the registry `reg`.
+pub fn type_of(text: &Str, msg: &'static str, reg: &Registry, file: FileId) -> Typed {
     let mut out = Typed::default();
     match expr::parse(&text.value) {
         Err(e) => {
@@ -91,7 +93,7 @@ pub fn type_of(text: &Str, msg: &'static str, file: FileId) -> Typed {
             ).with_help("an expression is made of field paths (`a.b[0]`), numbers, strings, `min max mean len`, `+ - * /`, comparisons, `and or not`"));
         }
         Ok(e) => {
-            let mut cx = Cx { text, msg, file, out: &mut out };
+            let mut cx = Cx { text, msg, reg, file, out: &mut out };
             let ty = cx.ty(&e);
             out.ty = ty;
             out.expr = Some(e);
@@ -103,6 +105,7 @@ pub fn type_of(text: &Str, msg: &'static str, file: FileId) -> Typed {
 struct Cx<'a> {
     text: &'a Str,
     msg: &'static str,
+    reg: &'a Registry,
     file: FileId,
     out: &'a mut Typed,
 }
@@ -187,19 +190,32 @@ impl Cx<'_> {
     }
 
     fn path(&mut self, steps: &[Step]) -> Option<Ty> {
+        if let Some(ty) = constant_type(self.reg, self.msg, steps) {
+            return Some(ty);
+        }
         let mut ty = Ty::Msg(self.msg);
         for step in steps {
             ty = match (step, &ty) {
-                (Step::Field(name, r), Ty::Msg(m)) => match msgs::field(m, name) {
+                (Step::Field(name, r), Ty::Msg(m)) => match self.reg.field(m, name) {
                     Some(t) => Ty::of(&t),
                     None => {
-                        let fields = msgs::fields(m);
-                        let near = suggest(name, fields.iter().map(|(n, _)| *n));
-                        let all: Vec<&str> = fields.iter().map(|(n, _)| *n).collect();
+                        let fields = self.reg.fields(m);
+                        let mut all: Vec<&str> = fields.iter().map(|(n, _)| *n).collect();
+                        let constants = self.reg.constants(m);
+                        all.extend(constants.iter().map(|c| c.name.as_str()));
+                        let near = suggest(name, all.iter().copied());
+                        let listed = match (fields.is_empty(), constants.is_empty()) {
+                            (true, true) => format!("`{m}` has no fields"),
+                            (_, true) => format!("`{m}` has: {}", all.join(", ")),
+                            (true, false) => format!("`{m}` has no fields; its constants: {}", all.join(", ")),
+                            (false, false) => {
+                                let (f, c) = all.split_at(fields.len());
+                                format!("`{m}` has: {}; its constants: {}", f.join(", "), c.join(", "))
+                            }
+                        };
                         let help = match near {
-                            Some(s) => format!("did you mean `{s}`? `{m}` has: {}", all.join(", ")),
-                            None if all.is_empty() => format!("`{m}` has no fields"),
-                            None => format!("`{m}` has: {}", all.join(", ")),
+                            Some(s) => format!("did you mean `{s}`? {listed}"),
+                            None => listed,
                         };
                         let span = self.text.sub(r.0, r.1);
                         self.out.paths.push(
@@ -255,4 +271,23 @@ impl Cx<'_> {
         }
         Some(ty)
     }
+}
+
+/// The type of the constant a path names on `msg`, if it names one (see
+/// [`Registry::path_constant`]).
+fn constant_type(reg: &Registry, msg: &str, steps: &[Step]) -> Option<Ty> {
+    let names: Vec<&str> = steps
+        .iter()
+        .map(|s| match s {
+            Step::Field(n, _) => Some(n.as_str()),
+            Step::Index(..) => None,
+        })
+        .collect::<Option<_>>()?;
+    let c = reg.path_constant(msg, &names)?;
+    Some(match (&c.value, c.ty) {
+        (ConstValue::Bool(_), _) => Ty::Bool,
+        (ConstValue::Str(_), _) => Ty::Str,
+        (_, p) if idl::Prim::is_float(p) => Ty::Float,
+        (ConstValue::Float(_), _) | (ConstValue::Int(_), _) => Ty::Int,
+    })
 }
