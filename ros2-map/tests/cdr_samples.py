@@ -203,6 +203,7 @@ class Range(IdlStruct, typename="sensor_msgs::msg::dds_::Range_"):
     min_range: f32 = 0.0
     max_range: f32 = 0.0
     range: f32 = 0.0
+    variance: f32 = 0.0  # since ROS 2 Jazzy
 
 
 @dataclass
@@ -356,7 +357,7 @@ def samples():
     yield "navsat_nofix", NavSatFix(header(frame="gps"), NavSatStatus(-1, 1), nan, nan, nan, [0.0] * 9, 0)
     yield "imu", Imu(header(frame="imu"), Quaternion(0.0, 0.0, 0.0, 1.0), [0.01, 0, 0, 0, 0.01, 0, 0, 0, 0.01],
                      Vector3(0.001, -0.002, 0.3), [-1.0] + [0.0] * 8, Vector3(0.0, 0.1, 9.81), [0.1] * 9)
-    yield "range", Range(header(frame="sonar"), 0, 0.5, 0.02, 4.0, 1.234)
+    yield "range", Range(header(frame="sonar"), 0, 0.5, 0.02, 4.0, 1.234, 0.0004)
     yield "pose_stamped", PoseStamped(header(frame="map"), Pose(Point(3.0, 4.0, 0.0), Quaternion()))
     yield "state", State(3, "active")
     yield "joint_state", JointState(header(frame=""), ["shoulder", "elbow", "wrist"], [0.1, -1.2, 3.0],
