@@ -489,3 +489,90 @@ mod no_panic {
         }
     }
 }
+
+#[test]
+fn an_unknown_type_raises_no_follow_on_topic_finding() {
+    spares(
+        codes::ROS2_TOPIC_TYPES,
+        [
+            &(scan("CLEAR", "") + &ev("Lidar", "OBSTACLE", "/scan", "sensor_msgs/LaserScna", "")),
+            &(ev("Lidar", "OBSTACLE", "/scan", "robot_msgs/Scan", "") + &scan("CLEAR", "")),
+            &(scan("CLEAR", "") + &ev("Lidar", "OBSTACLE", "/scan", "LaserScan", "")),
+        ],
+    );
+}
+
+fn help_of(map: &str, code: &str) -> String {
+    let checked = check_source("rules.situ", RULES);
+    let found = check_map(&checked.model, map, &Registry::carried(), FileId(1));
+    let d = found.iter().find(|d| d.code == code).unwrap_or_else(|| panic!("no {code} in {found:?}"));
+    d.help.clone().unwrap_or_default()
+}
+
+#[test]
+fn an_unknown_type_lists_the_types_of_its_package_or_where_situ_looked() {
+    let help = help_of(&ev("Lidar", "CLEAR", "/scan", "sensor_msgs/msg/LaserScn", ""), codes::ROS2_UNKNOWN_TYPE);
+    assert!(help.starts_with("did you mean `sensor_msgs/msg/LaserScan`? `sensor_msgs` has: BatteryState, "), "{help}");
+    assert!(help.contains(", JointState, "), "{help}");
+    let help = help_of(&ev("Lidar", "CLEAR", "/scan", "sensor_msgs/Zzz", ""), codes::ROS2_UNKNOWN_TYPE);
+    assert!(help.starts_with("`sensor_msgs` has: BatteryState, "), "{help}");
+    let help = help_of(&ev("Lidar", "CLEAR", "/scan", "robot_msgs/Scan", ""), codes::ROS2_UNKNOWN_TYPE);
+    assert!(help.starts_with("no package `robot_msgs` in: the definitions situ carries; "), "{help}");
+    let help = help_of(&ev("Lidar", "CLEAR", "/scan", "Scan", ""), codes::ROS2_UNKNOWN_TYPE);
+    assert_eq!(help, "write the type as `package/msg/Name` or `package/Name`");
+}
+
+fn battery(when: &str) -> String {
+    ev("Battery", "LOW", "/battery", "sensor_msgs/BatteryState", &format!("when = \"{when}\""))
+}
+
+fn diag(when: &str) -> String {
+    ev("Diag", "FAULT", "/diagnostics", "diagnostic_msgs/DiagnosticArray", &format!("when = \"{when}\""))
+}
+
+#[test]
+fn constants_by_name() {
+    let fine = [
+        battery("power_supply_status == POWER_SUPPLY_STATUS_CHARGING"),
+        diag("len(status) > 0 and status[0].level >= DiagnosticStatus.ERROR"),
+        ev("Lidar", "CLEAR", "/fix", "sensor_msgs/NavSatFix", "when = \"status.status == NavSatStatus.STATUS_FIX\""),
+    ];
+    for code in [codes::ROS2_UNKNOWN_FIELD, codes::ROS2_TYPE_MISMATCH, codes::ROS2_WHEN_NOT_BOOL] {
+        spares(code, [&fine[0], &fine[1], &fine[2]]);
+    }
+    raises(
+        codes::ROS2_TYPE_MISMATCH,
+        [
+            &battery("present == POWER_SUPPLY_STATUS_CHARGING"),
+            &battery("POWER_SUPPLY_STATUS_CHARGING and present"),
+            &diag("status[0].name == DiagnosticStatus.WARN"),
+        ],
+    );
+    raises(
+        codes::ROS2_UNKNOWN_FIELD,
+        [
+            &battery("power_supply_status == POWER_SUPPLY_STATUS_CHARGNG"),
+            // KeyValue has no constants; Imu is not a type of DiagnosticArray's fields.
+            &diag("status[0].level == KeyValue.ERROR"),
+            &diag("status[0].level == Imu.ERROR"),
+        ],
+    );
+    let help = help_of(&battery("power_supply_status == CHARGING"), codes::ROS2_UNKNOWN_FIELD);
+    assert!(help.contains("; its constants: POWER_SUPPLY_STATUS_UNKNOWN, POWER_SUPPLY_STATUS_CHARGING, "), "{help}");
+}
+
+#[test]
+fn constants_type_as_their_type() {
+    let reg = Registry::carried();
+    let ty = |msg: &'static str, text: &str| {
+        let s = map::Str { value: text.to_string(), span: situ_grammar::ast::Span::new(0, 0), inner: None };
+        type_of(&s, msg, &reg, FileId(0)).ty
+    };
+    assert_eq!(ty("sensor_msgs/msg/BatteryState", "POWER_SUPPLY_STATUS_FULL"), Some(Ty::Int));
+    assert_eq!(ty("diagnostic_msgs/msg/DiagnosticArray", "DiagnosticStatus.STALE"), Some(Ty::Int));
+    assert_eq!(ty("diagnostic_msgs/msg/DiagnosticStatus", "DiagnosticStatus.OK"), Some(Ty::Int));
+    assert_eq!(ty("std_msgs/msg/Bool", "data"), Some(Ty::Bool));
+    // A field of the name wins over a type of the name.
+    assert_eq!(ty("sensor_msgs/msg/NavSatFix", "status.status"), Some(Ty::Int));
+    assert_eq!(ty("sensor_msgs/msg/BatteryState", "NOPE"), None);
+}

@@ -589,6 +589,25 @@ mod tests {
     }
 
     #[test]
+    fn constants_evaluate_to_their_values() {
+        let reg = Registry::carried();
+        let m = M::Msg(vec![("power_supply_status", M::Int(1)), ("present", M::Bool(true))]);
+        let run = |msg: &str, text: &str| {
+            let mut e = expr::parse(text).unwrap();
+            constants(&mut e, msg, &reg);
+            eval(&e, &m).map(|v| format!("{v:?}")).map_err(|e| e.message)
+        };
+        let battery = "sensor_msgs/msg/BatteryState";
+        assert_eq!(run(battery, "power_supply_status == POWER_SUPPLY_STATUS_CHARGING"), Ok("Bool(true)".into()));
+        assert_eq!(run(battery, "present and POWER_SUPPLY_STATUS_FULL - 1 > 2"), Ok("Bool(true)".into()));
+        assert_eq!(run("diagnostic_msgs/msg/DiagnosticArray", "DiagnosticStatus.STALE"), Ok("Int(3)".into()));
+        assert_eq!(run("action_msgs/msg/GoalStatusArray", "GoalStatus.STATUS_ABORTED"), Ok("Int(6)".into()));
+        // A field of the name is the field, not a constant.
+        assert_eq!(run(battery, "power_supply_status"), Ok("Int(1)".into()));
+        assert_eq!(run(battery, "NOPE"), Err("the message has no field `NOPE`".into()));
+    }
+
+    #[test]
     fn payload_values() {
         let sym = Type::Symbols(vec!["warn".into(), "error".into()]);
         assert_eq!(to_payload(Val::Str("error"), &sym), Ok(Value::Symbol(1)));
