@@ -141,7 +141,8 @@ fn check_env(rules: &str, map: &str, extra: &[&str], ament: Option<&std::path::P
         c.env("AMENT_PREFIX_PATH", a);
     }
     let o = c.output().expect("the binary runs");
-    let found = stdout(&o).lines().map(|l| serde_json::from_str(l).unwrap_or_else(|_| panic!("{}", text(&o)))).collect();
+    let found =
+        stdout(&o).lines().map(|l| serde_json::from_str(l).unwrap_or_else(|_| panic!("{}", text(&o)))).collect();
     (code(&o), found)
 }
 
@@ -241,7 +242,9 @@ fn a_definition_that_does_not_parse_is_a_finding() {
     let (_, found) = check_env(ARM, "tests/ros2/arm.toml", &["--msg-path", root.to_str().expect("UTF-8")], None);
     let e = of(&found, "E0422");
     assert!(
-        e[0].3.contains(":2: field `fingers` of `arm_msgs/msg/Gripper` is of type `arm_msgs/msg/Finger`, which is not found"),
+        e[0].3.contains(
+            ":2: field `fingers` of `arm_msgs/msg/Gripper` is of type `arm_msgs/msg/Finger`, which is not found"
+        ),
         "{}",
         e[0].3
     );
@@ -264,7 +267,10 @@ fn an_unknown_type_lists_its_package_and_raises_nothing_after_it() {
     let e = of(&found, "E0402");
     assert_eq!((e[0].0, e[0].1), (16, 8), "{found:?}");
     let help = &e[0].3;
-    assert!(help.starts_with("did you mean `sensor_msgs/msg/LaserScan`? `sensor_msgs` has: BatteryState, CameraInfo, "), "{help}");
+    assert!(
+        help.starts_with("did you mean `sensor_msgs/msg/LaserScan`? `sensor_msgs` has: BatteryState, CameraInfo, "),
+        "{help}"
+    );
     assert!(help.contains(", JointState, "), "{help}");
     assert!(of(&found, "E0413").is_empty(), "{found:?}");
 }

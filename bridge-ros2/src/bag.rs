@@ -97,7 +97,8 @@ impl Bag {
         let schema = match self.schemas.get(ty) {
             Some(&id) => id,
             None => {
-                let text = ros2msg(&self.msgs, ty).ok_or_else(|| io::Error::other(format!("no definition of `{ty}`")))?;
+                let text =
+                    ros2msg(&self.msgs, ty).ok_or_else(|| io::Error::other(format!("no definition of `{ty}`")))?;
                 let id = w.add_schema(ty, "ros2msg", text.as_bytes()).map_err(mcap_err)?;
                 self.schemas.insert(ty.to_string(), id);
                 id

@@ -532,8 +532,7 @@ mod tests {
 
     #[test]
     fn laser_scan_by_hand() {
-        let v =
-            decoder("sensor_msgs/msg/LaserScan").unwrap().decode(&scan_le(&[0.25, 2.0, f32::INFINITY])).unwrap();
+        let v = decoder("sensor_msgs/msg/LaserScan").unwrap().decode(&scan_le(&[0.25, 2.0, f32::INFINITY])).unwrap();
         assert_eq!(v.at("header.stamp.sec"), Some(&Value::Int(7)));
         assert_eq!(v.at("header.stamp.nanosec"), Some(&Value::Int(9)));
         assert_eq!(v.at("header.frame_id"), Some(&Value::Str("laser".into())));

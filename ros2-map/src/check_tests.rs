@@ -438,8 +438,10 @@ fn the_examples_of_the_codes_are_real() {
             assert!(!rules.is_empty() && !maps.is_empty(), "{}: {heading} needs rules and a map", c.code);
             let checked = check_source("rules.situ", rules[0]);
             assert_eq!(checked.errors(), 0, "{}: {heading}: the rules have errors", c.code);
-            let found: Vec<_> =
-                check_map(&checked.model, maps[0], &Registry::carried(), FileId(1)).into_iter().map(|d| d.code).collect();
+            let found: Vec<_> = check_map(&checked.model, maps[0], &Registry::carried(), FileId(1))
+                .into_iter()
+                .map(|d| d.code)
+                .collect();
             assert_eq!(found.contains(&c.code), raised, "{}: {heading}: found {found:?}", c.code);
         }
     }

@@ -31,7 +31,9 @@ pub fn search_path(map: &Map, map_dir: &Path, user: &[PathBuf], file: FileId) ->
                     entry.span,
                     format!("{} is not a folder", dir.display()),
                 )
-                .with_help("write the path from the map's folder to a package, a folder of packages or a prefix with `share/`"),
+                .with_help(
+                    "write the path from the map's folder to a package, a folder of packages or a prefix with `share/`",
+                ),
             );
         }
     }

@@ -48,7 +48,18 @@ const NO_BRIDGE: &str = "this situ was built without the ROS 2 bridge: `cargo bu
 
 #[cfg(not(feature = "ros2"))]
 pub fn run(args: Args) -> Outcome {
-    let _ = (&args.file, &args.map, &args.msg_path, args.domain, args.rmw, args.duration, &args.record, &args.trust.trust, OK, FAILED);
+    let _ = (
+        &args.file,
+        &args.map,
+        &args.msg_path,
+        args.domain,
+        args.rmw,
+        args.duration,
+        &args.record,
+        &args.trust.trust,
+        OK,
+        FAILED,
+    );
     Err(CliError::Usage(NO_BRIDGE.into()))
 }
 

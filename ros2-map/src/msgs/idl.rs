@@ -269,7 +269,12 @@ pub fn parse_file(file: &str, pkg: &str, name: &str, kind: Kind, text: &str) -> 
         let want = names.len() - 1;
         return Err(err(
             parts.last().map_or(0, |p| p.0),
-            format!("a .{} has {want} `---` separator{}, this one has {}", kind.folder(), plural(want), parts.len() - 1),
+            format!(
+                "a .{} has {want} `---` separator{}, this one has {}",
+                kind.folder(),
+                plural(want),
+                parts.len() - 1
+            ),
         ));
     }
     let mut out = Vec::new();
@@ -373,7 +378,11 @@ fn parse_msg(file: &str, pkg: &str, full: &str, first: usize, lines: &[&str]) ->
         if let Some(value) = after.strip_prefix('=') {
             let prim = match (&ty.base, ty.array) {
                 (Base::Prim(p), Array::Not) => *p,
-                _ => return Err(err(format!("constant `{name}`: a constant is of a primitive type, not an array or a message"))),
+                _ => {
+                    return Err(err(format!(
+                        "constant `{name}`: a constant is of a primitive type, not an array or a message"
+                    )))
+                }
             };
             if !is_constant_name(name) {
                 return Err(err(format!("`{name}` is not a constant name (upper case letters, digits and `_`)")));
@@ -485,9 +494,7 @@ fn constant(prim: Prim, text: &str) -> Result<ConstValue, String> {
             "false" | "False" | "0" => Ok(ConstValue::Bool(false)),
             _ => Err(format!("`{t}` is not a bool (true or false)")),
         },
-        Prim::F32 | Prim::F64 => {
-            t.parse::<f64>().map(ConstValue::Float).map_err(|_| format!("`{t}` is not a number"))
-        }
+        Prim::F32 | Prim::F64 => t.parse::<f64>().map(ConstValue::Float).map_err(|_| format!("`{t}` is not a number")),
         p => {
             let (lo, hi) = p.int_range().ok_or_else(|| format!("a constant of type {p}"))?;
             let v = parse_int(t).ok_or_else(|| format!("`{t}` is not an integer"))?;

@@ -59,7 +59,10 @@ fn real_messages_are_exact() {
         r.field("unique_identifier_msgs/msg/UUID", "uuid"),
         Some(FieldType::Array(Box::new(FieldType::Prim(Prim::Int)), Some(16)))
     );
-    assert_eq!(r.constant("action_msgs/msg/GoalStatus", "STATUS_ABORTED").map(|c| &c.value), Some(&idl::ConstValue::Int(6)));
+    assert_eq!(
+        r.constant("action_msgs/msg/GoalStatus", "STATUS_ABORTED").map(|c| &c.value),
+        Some(&idl::ConstValue::Int(6))
+    );
     assert_eq!(
         names(&r, "control_msgs/msg/JointTrajectoryControllerState"),
         [
@@ -82,7 +85,10 @@ fn real_messages_are_exact() {
         Some(FieldType::Msg("trajectory_msgs/msg/JointTrajectoryPoint"))
     );
     assert_eq!(names(&r, "diagnostic_msgs/msg/DiagnosticArray"), ["header", "status"]);
-    assert_eq!(names(&r, "diagnostic_msgs/msg/DiagnosticStatus"), ["level", "name", "message", "hardware_id", "values"]);
+    assert_eq!(
+        names(&r, "diagnostic_msgs/msg/DiagnosticStatus"),
+        ["level", "name", "message", "hardware_id", "values"]
+    );
     let c: Vec<&str> = r.constants("diagnostic_msgs/msg/DiagnosticStatus").iter().map(|c| c.name.as_str()).collect();
     assert_eq!(c, ["OK", "WARN", "ERROR", "STALE"]);
     // The action of control_msgs, and what ROS 2 generates of it.
@@ -161,7 +167,7 @@ fn broken_definitions_are_errors_of_their_types() {
     write(&root.join("robot_msgs/msg/UsesBad.msg"), "Bad b\n");
     write(&root.join("robot_msgs/msg/Missing.msg"), "# doc\nNowhere n\n");
     write(&root.join("robot_msgs/msg/Good.msg"), "bool ok\n");
-    let r = Registry::load(&SearchPath::with_ament(&[root.clone()], None));
+    let r = Registry::load(&SearchPath::with_ament(std::slice::from_ref(&root), None));
     assert!(r.lookup("robot_msgs/Good").is_some());
     for (ty, line, what) in [
         ("robot_msgs/Bad", 2, "`float65` is not a type"),
