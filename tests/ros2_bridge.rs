@@ -232,6 +232,35 @@ fn a_bad_map_is_refused_with_its_findings() {
 }
 
 #[test]
+fn the_bridge_reads_the_robots_own_packages() {
+    let dir = tempfile::tempdir().unwrap();
+    let (rules, map) = (root().join("tests/ros2/arm.situ"), root().join("tests/ros2/arm.toml"));
+    let msgs = root().join("tests/ros2/msgs");
+    let run = |extra: &[&str]| {
+        let mut args = vec!["ros2", rules.to_str().unwrap(), "--map", map.to_str().unwrap()];
+        args.extend(["--domain", "46", "--duration", "0.3"]);
+        args.extend(extra);
+        Command::new(env!("CARGO_BIN_EXE_situ"))
+            .current_dir(dir.path())
+            .args(&args)
+            .env_remove("AMENT_PREFIX_PATH")
+            .output()
+            .expect("the situ binary")
+    };
+    // Without its package the map is refused: its type is unknown.
+    let o = run(&[]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("E0402"), "{}", String::from_utf8_lossy(&o.stdout));
+    // With it the bridge runs and reads the topic.
+    let o = run(&["--msg-path", msgs.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+    assert!(stderr.contains("reading /arm/status"), "{stderr}");
+    let o = run(&["--msg-path", "nowhere"]);
+    assert_eq!(o.status.code(), Some(2));
+}
+
+#[test]
 fn a_signed_bundle_runs_and_an_unsigned_one_is_refused_under_trust() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path();
