@@ -260,6 +260,43 @@ fn the_bridge_reads_the_robots_own_packages() {
     assert_eq!(o.status.code(), Some(2));
 }
 
+/// The bridge reads an action's feedback (a type ROS 2 generates from an
+/// `.action`), an action's status and JointState, all from the definitions
+/// situ carries, and a constant by name (`GoalStatus.STATUS_ABORTED`).
+#[test]
+fn the_bridge_reads_actions_and_joint_states() {
+    let domain = "47";
+    let mut bridge = Command::new(env!("CARGO_BIN_EXE_situ"))
+        .current_dir(root())
+        .args(["ros2", "tests/ros2/actions.situ", "--map", "tests/ros2/actions.toml", "--domain", domain])
+        .args(["--duration", "60"])
+        .env_remove("AMENT_PREFIX_PATH")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the situ binary");
+    let peer = Command::new("python3")
+        .current_dir(root())
+        .args(["bridge-ros2/tests/action_peer.py", domain])
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run python3 ({e}): the test needs python3 with cyclonedds"));
+    // SAFETY: kill(2) on our own child's pid; SIGINT is what Ctrl-C sends.
+    unsafe { libc::kill(bridge.id() as i32, libc::SIGINT) };
+    let out = bridge.wait_with_output().expect("the bridge's output");
+    let (seen, stderr) = (String::from_utf8_lossy(&peer.stdout), String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        peer.status.code(),
+        Some(0),
+        "peer:\n{seen}{}\nbridge:\n{stderr}",
+        String::from_utf8_lossy(&peer.stderr)
+    );
+    let states: Vec<Json> = seen.lines().map(|l| serde_json::from_str(l).expect("a JSON line")).collect();
+    let states: Vec<&str> = states.iter().filter_map(|l| l["state"].as_str()).collect();
+    // IDLE may pass before the peer's reader matches.
+    assert!(states.ends_with(&["GRIPPING", "STALLED", "ABORTED"]), "{states:?} {stderr}");
+    assert!(stderr.contains("0 refused"), "{stderr}");
+}
+
 #[test]
 fn a_signed_bundle_runs_and_an_unsigned_one_is_refused_under_trust() {
     let dir = tempfile::tempdir().unwrap();
