@@ -561,6 +561,13 @@ fn constants_by_name() {
     );
     let help = help_of(&battery("power_supply_status == CHARGING"), codes::ROS2_UNKNOWN_FIELD);
     assert!(help.contains("; its constants: POWER_SUPPLY_STATUS_UNKNOWN, POWER_SUPPLY_STATUS_CHARGING, "), "{help}");
+    let help = help_of(&diag("status[0].level == DiagnosticStatus.EROR"), codes::ROS2_UNKNOWN_FIELD);
+    assert_eq!(
+        help,
+        "did you mean `DiagnosticStatus.ERROR`? `diagnostic_msgs/msg/DiagnosticStatus` has the constants: OK, WARN, ERROR, STALE"
+    );
+    let help = help_of(&diag("status[0].level == KeyValue.ERROR"), codes::ROS2_UNKNOWN_FIELD);
+    assert_eq!(help, "`diagnostic_msgs/msg/KeyValue` has no constants");
 }
 
 #[test]

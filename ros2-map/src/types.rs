@@ -189,9 +189,35 @@ impl Cx<'_> {
         }
     }
 
+    /// E0403 for `Type.NAME` where `Type` is the message or the type of one
+    /// of its fields but has no constant `NAME`.
+    fn missing_constant(&self, steps: &[Step]) -> Option<Diagnostic> {
+        let [Step::Field(ty, _), Step::Field(name, r)] = steps else { return None };
+        if self.reg.field(self.msg, ty).is_some() {
+            return None;
+        }
+        let def = self.reg.reachable(self.msg, ty).into_iter().next()?;
+        let names: Vec<&str> = def.constants.iter().map(|c| c.name.as_str()).collect();
+        let listed = match names.as_slice() {
+            [] => format!("`{}` has no constants", def.name),
+            _ => format!("`{}` has the constants: {}", def.name, names.join(", ")),
+        };
+        let help = match suggest(name, names.iter().copied()) {
+            Some(s) => format!("did you mean `{ty}.{s}`? {listed}"),
+            None => listed,
+        };
+        let message = format!("`{}` has no constant `{name}`", def.name);
+        let span = self.text.sub(r.0, r.1);
+        Some(Diagnostic::error(codes::ROS2_UNKNOWN_FIELD, message, self.file, span, "not a constant").with_help(help))
+    }
+
     fn path(&mut self, steps: &[Step]) -> Option<Ty> {
         if let Some(ty) = constant_type(self.reg, self.msg, steps) {
             return Some(ty);
+        }
+        if let Some(found) = self.missing_constant(steps) {
+            self.out.paths.push(found);
+            return None;
         }
         let mut ty = Ty::Msg(self.msg);
         for step in steps {

@@ -204,25 +204,29 @@ impl Registry {
         let root = self.def(msg)?;
         match path {
             [name] if root.field(name).is_none() => root.constant(name),
-            [ty, name] if root.field(ty).is_none() => {
-                let mut queue = vec![root.name.clone()];
-                let mut seen = BTreeSet::new();
-                while let Some(t) = queue.pop() {
-                    if !seen.insert(t.clone()) {
-                        continue;
-                    }
-                    let Some(def) = self.def(&t) else { continue };
-                    if t.rsplit('/').next() == Some(*ty) {
-                        if let Some(c) = def.constant(name) {
-                            return Some(c);
-                        }
-                    }
-                    queue.extend(deps(def));
-                }
-                None
-            }
+            [ty, name] if root.field(ty).is_none() => self.reachable(msg, ty).iter().find_map(|d| d.constant(name)),
             _ => None,
         }
+    }
+
+    /// The messages whose short name is `short` among `msg` and the types
+    /// of its fields, at any depth.
+    pub fn reachable(&self, msg: &str, short: &str) -> Vec<&MsgDef> {
+        let mut out = Vec::new();
+        let Some(root) = self.def(msg) else { return out };
+        let mut queue = vec![root.name.clone()];
+        let mut seen = BTreeSet::new();
+        while let Some(t) = queue.pop() {
+            if !seen.insert(t.clone()) {
+                continue;
+            }
+            let Some(def) = self.def(&t) else { continue };
+            if t.rsplit('/').next() == Some(short) {
+                out.push(def);
+            }
+            queue.extend(deps(def));
+        }
+        out
     }
 
     /// The `ros2msg` schema of a type as rosbag2 records it: its text, then
