@@ -266,7 +266,7 @@ fn the_bridge_reads_the_robots_own_packages() {
 #[test]
 fn the_bridge_reads_actions_and_joint_states() {
     let domain = "47";
-    let mut bridge = Command::new(env!("CARGO_BIN_EXE_situ"))
+    let bridge = Command::new(env!("CARGO_BIN_EXE_situ"))
         .current_dir(root())
         .args(["ros2", "tests/ros2/actions.situ", "--map", "tests/ros2/actions.toml", "--domain", domain])
         .args(["--duration", "60"])
