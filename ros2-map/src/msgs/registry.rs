@@ -16,11 +16,58 @@ pub struct Registry {
 
 #[derive(Debug)]
 struct Inner {
-    /// Every type by its full name: its definition, or why it has none.
-    types: BTreeMap<String, Result<Arc<MsgDef>, IdlError>>,
-    /// Every package and the place it was loaded from.
-    packages: BTreeMap<String, String>,
+    /// Every package, from the first place of the search path that has it.
+    packages: BTreeMap<String, Package>,
     search: SearchPath,
+}
+
+/// The types of a package by full name: a definition, or why it has none.
+type Types = BTreeMap<String, Result<Arc<MsgDef>, IdlError>>;
+
+/// One package: its files, read and parsed the first time one of its types
+/// is looked up.
+#[derive(Debug)]
+struct Package {
+    place: String,
+    files: Vec<search::Found>,
+    types: OnceLock<Types>,
+}
+
+impl Package {
+    fn types(&self) -> &Types {
+        self.types.get_or_init(|| {
+            let mut types = Types::new();
+            for f in &self.files {
+                let parsed = match f.text() {
+                    Ok(text) => idl::parse_file(&f.file, &f.package, &f.name, f.kind, &text),
+                    Err(e) => Err(IdlError { file: f.file.clone(), line: 0, message: e }),
+                };
+                match parsed {
+                    Ok(defs) => {
+                        for d in defs {
+                            types.insert(d.name.clone(), Ok(Arc::new(d)));
+                        }
+                    }
+                    Err(e) => {
+                        // The types the file would define, so that naming one says why it is missing.
+                        let base = format!("{}/{}/{}", f.package, f.kind.folder(), f.name);
+                        let names: Vec<String> = match f.kind {
+                            idl::Kind::Msg => vec![base],
+                            idl::Kind::Srv => vec![format!("{base}_Request"), format!("{base}_Response")],
+                            idl::Kind::Action => ["_Goal", "_Result", "_Feedback", "_FeedbackMessage"]
+                                .iter()
+                                .map(|s| format!("{base}{s}"))
+                                .collect(),
+                        };
+                        for n in names {
+                            types.insert(n, Err(e.clone()));
+                        }
+                    }
+                }
+            }
+            types
+        })
+    }
 }
 
 /// Why a type named by the map cannot be used.
@@ -44,48 +91,28 @@ impl Registry {
         CARRIED.get_or_init(|| Registry::load(&SearchPath::carried())).clone()
     }
 
-    /// Every definition of `search`, the first place of a package winning.
-    /// Files that do not read or parse are kept as errors of their types.
+    /// The definitions of `search`, the first place of a package winning.
+    /// Only the folders are listed here; a package's files are read and
+    /// parsed when one of its types is first looked up, and the files that
+    /// do not read or parse are kept as errors of their types.
     pub fn load(search: &SearchPath) -> Registry {
-        let mut types = BTreeMap::new();
         let mut packages = BTreeMap::new();
         for place in &search.places {
             for (package, files) in search::packages(place) {
-                if packages.contains_key(&package) {
-                    continue;
-                }
-                packages.insert(package.clone(), place.to_string());
-                for f in files {
-                    let parsed = match &f.text {
-                        Ok(text) => idl::parse_file(&f.file, &f.package, &f.name, f.kind, text),
-                        Err(e) => Err(IdlError { file: f.file.clone(), line: 0, message: e.clone() }),
-                    };
-                    match parsed {
-                        Ok(defs) => {
-                            for d in defs {
-                                types.insert(d.name.clone(), Ok(Arc::new(d)));
-                            }
-                        }
-                        Err(e) => {
-                            // The types the file would define, so that naming one says why it is missing.
-                            let base = format!("{}/{}/{}", f.package, f.kind.folder(), f.name);
-                            let names: Vec<String> = match f.kind {
-                                idl::Kind::Msg => vec![base],
-                                idl::Kind::Srv => vec![format!("{base}_Request"), format!("{base}_Response")],
-                                idl::Kind::Action => ["_Goal", "_Result", "_Feedback", "_FeedbackMessage"]
-                                    .iter()
-                                    .map(|s| format!("{base}{s}"))
-                                    .collect(),
-                            };
-                            for n in names {
-                                types.insert(n, Err(e.clone()));
-                            }
-                        }
-                    }
-                }
+                packages.entry(package).or_insert_with(|| Package {
+                    place: place.to_string(),
+                    files,
+                    types: OnceLock::new(),
+                });
             }
         }
-        Registry { inner: Arc::new(Inner { types, packages, search: search.clone() }) }
+        Registry { inner: Arc::new(Inner { packages, search: search.clone() }) }
+    }
+
+    /// The entry of a type by its full name, its package loaded.
+    fn entry(&self, full: &str) -> Option<&Result<Arc<MsgDef>, IdlError>> {
+        let package = full.split('/').next()?;
+        self.inner.packages.get(package)?.types().get(full)
     }
 
     /// The search path it was loaded from.
@@ -97,7 +124,7 @@ impl Registry {
     /// name of a service or action part), if it parsed.
     pub fn def(&self, name: &str) -> Option<&MsgDef> {
         let full = if name.split('/').count() == 3 { name.to_string() } else { full_name(name)? };
-        self.inner.types.get(&full)?.as_ref().ok().map(|d| &**d)
+        self.entry(&full)?.as_ref().ok().map(|d| &**d)
     }
 
     /// The full name of a type whose definition and every definition it
@@ -108,7 +135,7 @@ impl Registry {
         } else {
             full_name(name).ok_or(TypeError::Malformed)?
         };
-        if !self.inner.types.contains_key(&full) {
+        if self.entry(&full).is_none() {
             let package = full.split('/').next().unwrap_or("").to_string();
             if !self.inner.packages.contains_key(&package) {
                 return Err(TypeError::UnknownPackage { package });
@@ -125,14 +152,14 @@ impl Registry {
         if !seen.insert(full.to_string()) {
             return Ok(());
         }
-        let def = match self.inner.types.get(full) {
+        let def = match self.entry(full) {
             Some(Ok(d)) => d.clone(),
             Some(Err(e)) => return Err(e.clone()),
             None => return Ok(()),
         };
         for f in &def.fields {
             let Base::Msg(dep) = &f.ty.base else { continue };
-            match self.inner.types.get(dep) {
+            match self.entry(dep) {
                 Some(_) => self.check_deps(dep, seen)?,
                 None => {
                     let file = self.file_of(full);
@@ -150,7 +177,7 @@ impl Registry {
     /// The file a type was loaded from, as errors name it.
     fn file_of(&self, full: &str) -> String {
         let package = full.split('/').next().unwrap_or("");
-        let place = self.inner.packages.get(package).map_or("?", String::as_str);
+        let place = self.inner.packages.get(package).map_or("?", |p| p.place.as_str());
         format!("{full} (from {place})")
     }
 
@@ -159,20 +186,21 @@ impl Registry {
         self.resolve(name).ok()
     }
 
-    /// Every type that parsed, by full name.
+    /// Every type that parsed, by full name (every package is read).
     pub fn names(&self) -> impl Iterator<Item = &str> {
-        self.inner.types.iter().filter(|(_, d)| d.is_ok()).map(|(n, _)| n.as_str())
+        self.inner.packages.values().flat_map(|p| p.types().iter()).filter(|(_, d)| d.is_ok()).map(|(n, _)| n.as_str())
     }
 
     /// Every known package and the place it comes from.
     pub fn packages(&self) -> impl Iterator<Item = (&str, &str)> {
-        self.inner.packages.iter().map(|(n, p)| (n.as_str(), p.as_str()))
+        self.inner.packages.iter().map(|(n, p)| (n.as_str(), p.place.as_str()))
     }
 
     /// The short names of the messages of `package` (`msg` only), sorted.
     pub fn package_types(&self, package: &str) -> Vec<String> {
         let prefix = format!("{package}/msg/");
-        self.inner.types.keys().filter_map(|n| n.strip_prefix(&prefix)).map(str::to_string).collect()
+        let Some(p) = self.inner.packages.get(package) else { return Vec::new() };
+        p.types().keys().filter_map(|n| n.strip_prefix(&prefix)).map(str::to_string).collect()
     }
 
     /// The fields of a message, in order, with their types as expressions see them.

@@ -17,7 +17,7 @@ fn names(r: &Registry, msg: &str) -> Vec<&'static str> {
 fn every_carried_definition_parses_and_resolves() {
     let r = carried();
     let mut count = 0;
-    for (name, entry) in &r.inner.types {
+    for (name, entry) in r.inner.packages.values().flat_map(|p| p.types().iter()) {
         let def = entry.as_ref().unwrap_or_else(|e| panic!("{name}: {e}"));
         r.resolve(name).unwrap_or_else(|e| panic!("{name}: {e:?}"));
         assert_eq!(r.fields(name).len(), def.fields.len(), "{name}");
@@ -138,6 +138,22 @@ fn the_three_forms_of_a_user_folder() {
     assert_eq!(names(&r, "grip_msgs/srv/Close_Response"), ["ok"]);
     assert_eq!(names(&r, "base_msgs/Base"), ["mode"]);
     assert!(r.lookup("std_msgs/Header").is_some(), "the carried ones come last");
+    let _ = fs::remove_dir_all(root);
+}
+
+#[test]
+fn a_package_is_read_when_one_of_its_types_is_looked_up() {
+    let root = temp("lazy");
+    write(&root.join("a_msgs/msg/A.msg"), "bool ok\n");
+    write(&root.join("b_msgs/msg/B.msg"), "bool ok\n");
+    let r = Registry::load(&SearchPath::with_ament(std::slice::from_ref(&root), None));
+    let loaded = |p: &str| r.inner.packages[p].types.get().is_some();
+    assert!(!loaded("a_msgs") && !loaded("b_msgs") && !loaded("std_msgs"));
+    assert!(r.lookup("a_msgs/A").is_some());
+    assert!(loaded("a_msgs") && !loaded("b_msgs") && !loaded("std_msgs"));
+    // A file removed after the listing is an error of its type, not a crash.
+    fs::remove_file(root.join("b_msgs/msg/B.msg")).unwrap();
+    assert!(matches!(r.resolve("b_msgs/B"), Err(TypeError::Broken(e)) if e.line == 0));
     let _ = fs::remove_dir_all(root);
 }
 

@@ -87,8 +87,25 @@ pub struct Found {
     pub name: String,
     /// The file as errors name it.
     pub file: String,
-    /// Its text, or why it could not be read.
-    pub text: Result<String, String>,
+    source: Source,
+}
+
+/// Where the text of a definition is.
+#[derive(Debug, Clone)]
+enum Source {
+    Path(PathBuf),
+    Carried(&'static str),
+}
+
+impl Found {
+    /// Its text, or why it could not be read (read when asked: a package is
+    /// read when one of its types is looked up).
+    pub fn text(&self) -> Result<String, String> {
+        match &self.source {
+            Source::Path(p) => fs::read_to_string(p).map_err(|e| e.to_string()),
+            Source::Carried(text) => Ok(text.to_string()),
+        }
+    }
 }
 
 /// Every package of one place: its name and its definition files.
@@ -143,7 +160,7 @@ fn package_files(package: &str, dir: &Path) -> Vec<Found> {
                 kind,
                 name: stem.to_string(),
                 file: path.display().to_string(),
-                text: fs::read_to_string(&path).map_err(|e| e.to_string()),
+                source: Source::Path(path),
             });
         }
     }
@@ -160,7 +177,7 @@ fn carried_packages() -> Vec<(String, Vec<Found>)> {
             kind,
             name: stem.to_string(),
             file: format!("(carried) {package}/{folder}/{file}"),
-            text: Ok(text.to_string()),
+            source: Source::Carried(text),
         };
         match out.last_mut() {
             Some((p, files)) if p == package => files.push(found),
