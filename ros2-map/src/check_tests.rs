@@ -428,7 +428,7 @@ fn blocks<'a>(doc: &'a str, heading: &str, lang: &str) -> Vec<&'a str> {
 #[test]
 fn the_examples_of_the_codes_are_real() {
     // The examples of E0422 and E0423 need definition files and folders:
-    // `tests/ros2_map.rs` raises them through `situ check`.
+    // `the_examples_with_files_are_real` holds them to their codes.
     let with_files = [codes::ROS2_BAD_DEFINITION, codes::ROS2_BAD_MSG_PATH];
     let ros2 = |c: &&codes::Code| c.code.starts_with("E04") || c.code.starts_with("W04");
     for c in codes::ALL.iter().filter(ros2).filter(|c| !with_files.contains(&c.code)) {
@@ -445,6 +445,43 @@ fn the_examples_of_the_codes_are_real() {
             assert_eq!(found.contains(&c.code), raised, "{}: {heading}: found {found:?}", c.code);
         }
     }
+}
+
+/// The findings of `map` (rules `rules`) checked in folder `dir` with
+/// `--msg-path DIR/robot_msgs` when `msg_path` is set.
+fn codes_in(dir: &std::path::Path, rules: &str, map: &str, msg_path: bool) -> Vec<&'static str> {
+    let checked = check_source("rules.situ", rules);
+    assert_eq!(checked.errors(), 0, "{:?}", checked.diagnostics);
+    let user = if msg_path { vec![dir.join("robot_msgs")] } else { Vec::new() };
+    let (found, _) = crate::load::check_map_file(&checked.model, map, dir, &user, FileId(1));
+    found.into_iter().map(|d| d.code).collect()
+}
+
+#[test]
+fn the_examples_with_files_are_real() {
+    let dir = std::env::temp_dir().join(format!("situ-code-examples-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let msg = dir.join("robot_msgs/msg");
+    std::fs::create_dir_all(&msg).unwrap();
+    // E0422: Arm.msg of the Example, then Gripper.msg of Use instead.
+    let doc = codes::lookup("E0422").unwrap().explain;
+    let (example, fix) = (blocks(doc, "## Example", "text"), blocks(doc, "## Use instead", "text"));
+    std::fs::write(msg.join("Arm.msg"), example[0]).unwrap();
+    let (rules, map) = (blocks(doc, "## Example", "situ")[0], blocks(doc, "## Example", "toml")[0]);
+    assert!(codes_in(&dir, rules, map, true).contains(&codes::ROS2_BAD_DEFINITION));
+    std::fs::write(msg.join("Gripper.msg"), fix[0]).unwrap();
+    let (rules, map) = (blocks(doc, "## Use instead", "situ")[0], blocks(doc, "## Example", "toml")[0]);
+    assert!(!codes_in(&dir, rules, map, true).contains(&codes::ROS2_BAD_DEFINITION));
+    // E0423: the map in `dir/maps`, the package in `dir/robot_msgs`.
+    let doc = codes::lookup("E0423").unwrap().explain;
+    let maps = dir.join("maps");
+    std::fs::create_dir_all(&maps).unwrap();
+    let (rules, map) = (blocks(doc, "## Example", "situ")[0], blocks(doc, "## Example", "toml")[0]);
+    assert!(codes_in(&maps, rules, map, false).contains(&codes::ROS2_BAD_MSG_PATH));
+    let (rules, map) = (blocks(doc, "## Use instead", "situ")[0], blocks(doc, "## Use instead", "toml")[0]);
+    let found = codes_in(&maps, rules, map, false);
+    assert!(!found.contains(&codes::ROS2_BAD_MSG_PATH) && !found.contains(&codes::ROS2_UNKNOWN_TYPE), "{found:?}");
+    let _ = std::fs::remove_dir_all(dir);
 }
 
 #[test]
