@@ -88,7 +88,7 @@ impl Bag {
         Ok(bag)
     }
 
-    /// Adds a topic of type `ty` (`package/msg/Name`, of the catalogue).
+    /// Adds a topic of type `ty` (a full name the bag's registry defines).
     pub fn add_topic(&mut self, topic: &str, ty: &str) -> io::Result<()> {
         if self.channels.contains_key(topic) {
             return Ok(());

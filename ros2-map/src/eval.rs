@@ -160,7 +160,7 @@ fn reduce(red: Reducer, arg: Val<'_>, r: Range) -> Result<Val<'static>, EvalErro
             fail(r, format!("`{name}` of an array that is {why}"))
         }
         (Reducer::Mean, _, Some(_)) => number(sum / count as f64, r),
-        // An array of integers (the catalogue's arrays are of one type).
+        // An array of integers (an array's elements are of one type).
         (_, Some(i), Some(_)) => Ok(Val::Int(i)),
         (_, None, Some(f)) => number(f, r),
     }
