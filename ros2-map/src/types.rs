@@ -1,6 +1,7 @@
-//! Types of map expressions against a message: every field path is looked up
-//! (or constant) looked up in the registry of message definitions, every operator checked. The findings are sorted by kind
-//! so that each check of [`crate::check`] reports its own.
+//! Types of map expressions against a message: every field path (or
+//! constant) is looked up in the registry of message definitions, every
+//! operator checked. The findings are sorted by kind so that each check of
+//! [`crate::check`] reports its own.
 
 use crate::expr::{self, BinOp, Expr, Reducer, Step};
 use crate::map::Str;
