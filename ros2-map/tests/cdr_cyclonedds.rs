@@ -1,8 +1,9 @@
 //! The CDR decoder against an independent implementation: Eclipse Cyclone
 //! DDS (the `cyclonedds` Python package, one of ROS 2's middlewares)
 //! serializes messages of the carried definitions and of a package of the
-//! tests' own (`cdr_samples.py`), and every field decoded here must be the value it was given. Then the clean map of
-//! `tests/ros2/delivery.toml` is evaluated on those messages.
+//! tests' own (`cdr_samples.py`), and every field decoded here must be the
+//! value it was given. Then the clean map of `tests/ros2/delivery.toml`, and
+//! a map with constants on the tests' own package, are evaluated on them.
 //!
 //! A missing `python3` or `cyclonedds` fails the test: install the test
 //! requirements with `python3 -m pip install -r examples/python/requirements.txt`.
