@@ -23,6 +23,13 @@ fn root() -> &'static Path {
 
 /// The rules and the map of the AMR.
 const AMR: (&str, &str) = ("tests/ros2/amr.situ", "tests/ros2/amr.toml");
+/// The AMR's nodes and publishers, and the heartbeat scenario.
+const PEER: &str = "bridge-ros2/tests/peer.py";
+/// The recipe of docs/ros2.md, "A manipulator": its rules, its map (a
+/// package of the robot's own through `msg_path`), and its peer.
+const MANIPULATOR: (&str, &str) =
+    ("tests/ros2/manipulator/manipulator.situ", "tests/ros2/manipulator/manipulator.toml");
+const MANIPULATOR_PEER: &str = "bridge-ros2/tests/manipulator_peer.py";
 
 fn bridge((rules, map): (&str, &str), domain: u16, extra: &[&std::ffi::OsStr]) -> Child {
     Command::new(env!("CARGO_BIN_EXE_situ"))
@@ -39,12 +46,13 @@ fn bridge((rules, map): (&str, &str), domain: u16, extra: &[&std::ffi::OsStr]) -
 /// Runs the peer's scenario beside a bridge; the peer's lines, and the
 /// bridge's exit code and stderr after a Ctrl-C.
 fn scenario(name: &str, domain: u16, extra: &[&std::ffi::OsStr]) -> (Vec<Json>, i32, String) {
-    scenario_then(AMR, name, domain, extra, libc::SIGINT, Duration::ZERO)
+    scenario_then(AMR, PEER, name, domain, extra, libc::SIGINT, Duration::ZERO)
 }
 
 /// As [`scenario`], the bridge stopped by `signal` `after` the peer ended.
 fn scenario_then(
     files: (&str, &str),
+    peer: &str,
     name: &str,
     domain: u16,
     extra: &[&std::ffi::OsStr],
@@ -54,7 +62,7 @@ fn scenario_then(
     let mut bridge = bridge(files, domain, extra);
     let peer = Command::new("python3")
         .current_dir(root())
-        .args(["bridge-ros2/tests/peer.py", name, "--domain", &domain.to_string()])
+        .args([peer, name, "--domain", &domain.to_string()])
         .output()
         .unwrap_or_else(|e| panic!("cannot run python3 ({e}): the test needs python3 with cyclonedds"));
     std::thread::sleep(after);
@@ -197,6 +205,7 @@ fn a_killed_bridge_leaves_a_bag_that_reads_up_to_its_last_second() {
     // SIGKILL 1.5 s after the mission: no clean end, one flush (a second) since the last message.
     let (lines, code, _) = scenario_then(
         AMR,
+        PEER,
         "mission",
         43,
         &["--record".as_ref(), bag.as_os_str()],
@@ -229,7 +238,7 @@ fn a_node_that_never_answers_is_its_failure_event() {
 #[test]
 fn the_bridge_does_not_read_its_own_status() {
     let files = ("tests/ros2/heartbeat.situ", "tests/ros2/heartbeat.toml");
-    let (lines, code, stderr) = scenario_then(files, "heartbeat", 45, &[], libc::SIGINT, Duration::ZERO);
+    let (lines, code, stderr) = scenario_then(files, PEER, "heartbeat", 45, &[], libc::SIGINT, Duration::ZERO);
     assert_eq!(code, 0, "{stderr}");
     assert!(lines.iter().any(|l| l.get("done").is_some()), "{lines:?}\n{stderr}");
     assert_eq!(states(&lines), ["RUNNING", "FAULT"], "{stderr}");
@@ -243,6 +252,49 @@ fn the_bridge_does_not_read_its_own_status() {
         .unwrap_or_else(|| panic!("no count of ignored messages: {stderr}"));
     assert!(own >= 3, "{stderr}");
     assert!(stderr.contains("ended in FAULT") && stderr.contains("1 state changes"), "{stderr}");
+}
+
+/// A manipulator scenario (`manipulator_peer.py`): the states the peer saw
+/// on `/situ/state`, and the bridge's stderr.
+fn manipulator(name: &str, domain: u16) -> (Vec<String>, String) {
+    let (lines, code, stderr) =
+        scenario_then(MANIPULATOR, MANIPULATOR_PEER, name, domain, &[], libc::SIGINT, Duration::ZERO);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(lines.iter().any(|l| l.get("done").is_some()), "{lines:?}\n{stderr}");
+    (states(&lines).into_iter().map(str::to_string).collect(), stderr)
+}
+
+/// The recipe's pick: the last goal of the navigation's status list (not
+/// an older one) brings PICKING; the arm within 0.05 rad of its reference
+/// and the elbow far from its limit do not fault; the gripper's own
+/// message (`picker_msgs/GripperState`, its constant `HOLDING`) ends it.
+#[test]
+fn the_manipulator_picks_on_joint_states_goal_statuses_and_its_own_messages() {
+    let (states, stderr) = manipulator("pick", 50);
+    assert_eq!(states, ["IDLE", "DRIVING", "PICKING", "DONE"], "{stderr}");
+    assert!(stderr.contains("ended in DONE"), "{stderr}");
+}
+
+#[test]
+fn any_aborted_goal_of_the_status_list_faults_the_manipulator() {
+    let (states, stderr) = manipulator("aborted", 51);
+    assert_eq!(states, ["IDLE", "DRIVING", "FAULT"], "{stderr}");
+}
+
+/// The elbow is found by its name among the joints: the shoulder past the
+/// limit first changes nothing.
+#[test]
+fn the_elbow_found_by_name_past_its_limit_faults_the_manipulator() {
+    let (states, stderr) = manipulator("elbow", 52);
+    assert_eq!(states, ["IDLE", "DRIVING", "FAULT"], "{stderr}");
+}
+
+/// A joint 0.3 rad off the controller's reference (the largest `abs` of
+/// `error.positions`, one of them negative) faults the pick.
+#[test]
+fn the_arm_off_its_trajectory_faults_the_manipulator() {
+    let (states, stderr) = manipulator("arm", 53);
+    assert_eq!(states, ["IDLE", "DRIVING", "PICKING", "FAULT"], "{stderr}");
 }
 
 fn situ(dir: &Path, args: &[&str]) -> std::process::Output {
@@ -260,6 +312,72 @@ fn a_bad_map_is_refused_with_its_findings() {
     assert!(stdout.contains("E0414") && stdout.contains("bad.toml:3:8"), "{stdout}");
     let o = situ(dir.path(), &["ros2", rules.to_str().unwrap(), "--map", "missing.toml"]);
     assert_eq!(o.status.code(), Some(2));
+}
+
+#[test]
+fn the_bridge_reads_the_robots_own_packages() {
+    let dir = tempfile::tempdir().unwrap();
+    let (rules, map) = (root().join("tests/ros2/arm.situ"), root().join("tests/ros2/arm.toml"));
+    let msgs = root().join("tests/ros2/msgs");
+    let run = |extra: &[&str]| {
+        let mut args = vec!["ros2", rules.to_str().unwrap(), "--map", map.to_str().unwrap()];
+        args.extend(["--domain", "46", "--duration", "0.3"]);
+        args.extend(extra);
+        Command::new(env!("CARGO_BIN_EXE_situ"))
+            .current_dir(dir.path())
+            .args(&args)
+            .env_remove("AMENT_PREFIX_PATH")
+            .output()
+            .expect("the situ binary")
+    };
+    // Without its package the map is refused: its type is unknown.
+    let o = run(&[]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("E0402"), "{}", String::from_utf8_lossy(&o.stdout));
+    // With it the bridge runs and reads the topic.
+    let o = run(&["--msg-path", msgs.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+    assert!(stderr.contains("reading /arm/status"), "{stderr}");
+    let o = run(&["--msg-path", "nowhere"]);
+    assert_eq!(o.status.code(), Some(2));
+}
+
+/// The bridge reads an action's feedback (a type ROS 2 generates from an
+/// `.action`), an action's status and JointState, all from the definitions
+/// situ carries, and a constant by name (`GoalStatus.STATUS_ABORTED`).
+#[test]
+fn the_bridge_reads_actions_and_joint_states() {
+    let domain = "47";
+    let bridge = Command::new(env!("CARGO_BIN_EXE_situ"))
+        .current_dir(root())
+        .args(["ros2", "tests/ros2/actions.situ", "--map", "tests/ros2/actions.toml", "--domain", domain])
+        .args(["--duration", "60"])
+        .env_remove("AMENT_PREFIX_PATH")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the situ binary");
+    let peer = Command::new("python3")
+        .current_dir(root())
+        .args(["bridge-ros2/tests/action_peer.py", domain])
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run python3 ({e}): the test needs python3 with cyclonedds"));
+    // SAFETY: kill(2) on our own child's pid; SIGINT is what Ctrl-C sends.
+    unsafe { libc::kill(bridge.id() as i32, libc::SIGINT) };
+    let out = bridge.wait_with_output().expect("the bridge's output");
+    let (seen, stderr) = (String::from_utf8_lossy(&peer.stdout), String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        peer.status.code(),
+        Some(0),
+        "peer:\n{seen}{}\nbridge:\n{stderr}",
+        String::from_utf8_lossy(&peer.stderr)
+    );
+    let states: Vec<Json> = seen.lines().map(|l| serde_json::from_str(l).expect("a JSON line")).collect();
+    let states: Vec<&str> = states.iter().filter_map(|l| l["state"].as_str()).collect();
+    // IDLE may pass before the peer's reader matches.
+    assert!(states.ends_with(&["GRIPPING", "STALLED", "ABORTED"]), "{states:?} {stderr}");
+    assert!(stderr.contains("0 refused"), "{stderr}");
 }
 
 #[test]

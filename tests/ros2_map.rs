@@ -211,3 +211,178 @@ fn mistakes_in_expressions_over_arrays_name_their_fix() {
         assert!(stdout(&o).contains("[[event]]"), "{}", text(&o));
     }
 }
+
+/// `situ check --format json` of `rules` with `map` and `extra` arguments,
+/// without the `AMENT_PREFIX_PATH` of the machine (or with `ament`): the
+/// exit code and the findings.
+fn check_env(rules: &str, map: &str, extra: &[&str], ament: Option<&std::path::Path>) -> (i32, Vec<serde_json::Value>) {
+    let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_situ"));
+    c.args([&["check", rules, "--ros2-map", map, "--format", "json"], extra].concat());
+    c.env("NO_COLOR", "1").env_remove("AMENT_PREFIX_PATH");
+    if let Some(a) = ament {
+        c.env("AMENT_PREFIX_PATH", a);
+    }
+    let o = c.output().expect("the binary runs");
+    let found =
+        stdout(&o).lines().map(|l| serde_json::from_str(l).unwrap_or_else(|_| panic!("{}", text(&o)))).collect();
+    (code(&o), found)
+}
+
+/// The findings of `code`: (line, column, message, help).
+fn of(found: &[serde_json::Value], code: &str) -> Vec<(u64, u64, String, String)> {
+    found
+        .iter()
+        .filter(|d| d["code"] == format!("situ::{code}"))
+        .map(|d| {
+            let s = |k: &str| d[k].as_str().unwrap_or("").to_string();
+            (d["line"].as_u64().unwrap_or(0), d["column"].as_u64().unwrap_or(0), s("message"), s("help"))
+        })
+        .collect()
+}
+
+const ARM: &str = "tests/ros2/arm.situ";
+
+#[test]
+fn a_package_of_the_robot_with_msg_path() {
+    let (c, found) = check_env(ARM, "tests/ros2/arm.toml", &["--msg-path", "tests/ros2/msgs", "--deny-warnings"], None);
+    assert_eq!((c, found.len()), (0, 0), "{found:?}");
+    // A package folder itself, as well as a folder of packages.
+    let (c, found) = check_env(ARM, "tests/ros2/arm.toml", &["--msg-path", "tests/ros2/msgs/arm_msgs"], None);
+    assert_eq!((c, found.len()), (0, 0), "{found:?}");
+    // Without it: the package is unknown, and the help says where situ looked.
+    let (c, found) = check_env(ARM, "tests/ros2/arm.toml", &[], None);
+    assert_eq!(c, 1);
+    let e = of(&found, "E0402");
+    assert_eq!(e.iter().map(|d| (d.0, d.1)).collect::<Vec<_>>(), [(7, 8), (16, 8)], "{found:?}");
+    assert_eq!(
+        e[0].3,
+        "no package `arm_msgs` in: the definitions situ carries; give its folder with `--msg-path DIR` or `msg_path = [\"DIR\"]`"
+    );
+    assert_eq!(found.len(), 2, "nothing after an unknown type: {found:?}");
+}
+
+#[test]
+fn a_package_of_the_robot_with_msg_path_in_the_map() {
+    let (c, found) = check_env(ARM, "tests/ros2/arm_msg_path.toml", &["--deny-warnings"], None);
+    assert_eq!((c, found.len()), (0, 0), "{found:?}");
+    let (c, found) = check_env(ARM, "tests/ros2/bad_msg_path.toml", &[], None);
+    assert_eq!(c, 1);
+    let e = of(&found, "E0423");
+    assert_eq!((e[0].0, e[0].1), (1, 21), "{found:?}");
+    assert_eq!(e[0].2, "`msg_path` entry `no_such_folder` is not a folder");
+    let errors = found.iter().filter(|d| d["severity"] == "error").count();
+    assert_eq!(errors, 1, "the other folder is read: {found:?}");
+}
+
+/// A temporary folder of its own for one test.
+fn temp(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("situ-ros2-map-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("a temp folder");
+    dir
+}
+
+fn copy_package(to: &std::path::Path) {
+    std::fs::create_dir_all(to.join("msg")).expect("a folder");
+    for f in ["ArmStatus.msg", "Gripper.msg"] {
+        std::fs::copy(format!("tests/ros2/msgs/arm_msgs/msg/{f}"), to.join("msg").join(f)).expect("a copy");
+    }
+}
+
+#[test]
+fn a_package_of_the_robot_from_ament_prefix_path() {
+    let root = temp("ament");
+    copy_package(&root.join("install/share/arm_msgs"));
+    let other = root.join("other");
+    std::fs::create_dir_all(&other).expect("a folder");
+    let ament = std::env::join_paths([other, root.join("install")]).expect("a path list");
+    let (c, found) = check_env(ARM, "tests/ros2/arm.toml", &["--deny-warnings"], Some(std::path::Path::new(&ament)));
+    assert_eq!((c, found.len()), (0, 0), "{found:?}");
+    // A prefix given with --msg-path reads the same.
+    let prefix = root.join("install");
+    let (c, found) = check_env(ARM, "tests/ros2/arm.toml", &["--msg-path", prefix.to_str().expect("UTF-8")], None);
+    assert_eq!((c, found.len()), (0, 0), "{found:?}");
+    let _ = std::fs::remove_dir_all(root);
+}
+
+#[test]
+fn a_definition_that_does_not_parse_is_a_finding() {
+    let root = temp("broken");
+    copy_package(&root.join("arm_msgs"));
+    let gripper = root.join("arm_msgs/msg/Gripper.msg");
+    std::fs::write(&gripper, "float32 gap\nbool closed\nint16[<=0] forces\n").expect("write");
+    let (c, found) = check_env(ARM, "tests/ros2/arm.toml", &["--msg-path", root.to_str().expect("UTF-8")], None);
+    assert_eq!(c, 1);
+    let e = of(&found, "E0422");
+    assert_eq!(e.iter().map(|d| (d.0, d.1)).collect::<Vec<_>>(), [(7, 8), (16, 8)], "{found:?}");
+    assert_eq!(e[0].2, "the definition of `arm_msgs/msg/ArmStatus` does not load");
+    let at = format!("{}:3: `int16[<=0]`: the size of an array is a whole number above 0", gripper.display());
+    assert!(e[0].3.starts_with(&at), "{}", e[0].3);
+    assert_eq!(found.len(), 2, "no follow-on findings: {found:?}");
+    // A field of a type no place defines.
+    std::fs::write(&gripper, "float32 gap\nFinger[] fingers\n").expect("write");
+    let (_, found) = check_env(ARM, "tests/ros2/arm.toml", &["--msg-path", root.to_str().expect("UTF-8")], None);
+    let e = of(&found, "E0422");
+    assert!(
+        e[0].3.contains(
+            ":2: field `fingers` of `arm_msgs/msg/Gripper` is of type `arm_msgs/msg/Finger`, which is not found"
+        ),
+        "{}",
+        e[0].3
+    );
+    let _ = std::fs::remove_dir_all(root);
+}
+
+#[test]
+fn msg_path_must_be_a_folder_and_needs_a_map() {
+    let o = situ(&["check", ARM, "--ros2-map", "tests/ros2/arm.toml", "--msg-path", "tests/ros2/nowhere"]);
+    assert_eq!(code(&o), 2, "{}", text(&o));
+    assert!(stderr(&o).contains("--msg-path tests/ros2/nowhere: not a folder"), "{}", text(&o));
+    let o = situ(&["check", ARM, "--msg-path", "tests/ros2/msgs"]);
+    assert_eq!(code(&o), 2, "{}", text(&o));
+}
+
+#[test]
+fn an_unknown_type_lists_its_package_and_raises_nothing_after_it() {
+    let (c, found) = check_env(RULES, "tests/ros2/unknown_type_on_a_topic.toml", &[], None);
+    assert_eq!(c, 1);
+    let e = of(&found, "E0402");
+    assert_eq!((e[0].0, e[0].1), (16, 8), "{found:?}");
+    let help = &e[0].3;
+    assert!(
+        help.starts_with("did you mean `sensor_msgs/msg/LaserScan`? `sensor_msgs` has: BatteryState, CameraInfo, "),
+        "{help}"
+    );
+    assert!(help.contains(", JointState, "), "{help}");
+    assert!(of(&found, "E0413").is_empty(), "{found:?}");
+}
+
+#[test]
+fn a_name_that_is_neither_field_nor_constant_lists_both() {
+    let root = temp("constants");
+    let map = root.join("arm.toml");
+    let original = std::fs::read_to_string("tests/ros2/arm_msg_path.toml").expect("the map");
+    let msgs = std::fs::canonicalize("tests/ros2/msgs").expect("the folder");
+    let folder = format!("[{:?}]", msgs.to_str().expect("UTF-8"));
+    std::fs::write(&map, original.replace("[\"msgs\"]", &folder).replace("MODE_MOVING", "MODE_MOVNG")).expect("write");
+    let (c, found) = check_env(ARM, map.to_str().expect("UTF-8"), &[], None);
+    assert_eq!(c, 1);
+    let e = of(&found, "E0403");
+    assert_eq!(e.len(), 1, "{found:?}");
+    assert_eq!(e[0].2, "`arm_msgs/msg/ArmStatus` has no field `MODE_MOVNG`");
+    assert_eq!(
+        e[0].3,
+        "did you mean `MODE_MOVING`? `arm_msgs/msg/ArmStatus` has: header, mode, joints, gripper, tool; \
+         its constants: MODE_IDLE, MODE_MOVING, MODE_FAULT, MAX_SPEED"
+    );
+    let _ = std::fs::remove_dir_all(root);
+}
+
+#[test]
+fn explain_prints_the_codes_of_definitions() {
+    for code_name in ["E0422", "E0423"] {
+        let o = situ(&["explain", code_name]);
+        assert_eq!(code(&o), 0, "{}", text(&o));
+        assert!(stdout(&o).contains(&format!("{code_name}: ")), "{}", text(&o));
+    }
+}

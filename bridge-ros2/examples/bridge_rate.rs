@@ -112,7 +112,8 @@ fn main() {
 
     let checked = check_source("amr.situ", RULES);
     let content = Arc::new(bundle::build(&checked));
-    let core = Core::new(content, &checked.model, MAP, FileId(1)).expect("the map");
+    let core =
+        Core::new(content, &checked.model, MAP, &situ_ros2_map::Registry::carried(), FileId(1)).expect("the map");
     let stop = Arc::new(AtomicBool::new(false));
     let options = Options {
         domain: DOMAIN,

@@ -3,7 +3,8 @@
 //! with `metadata.yaml` and one `.mcap` file of profile `ros2`: every
 //! message the bridge read (its CDR bytes as they came) and everything it
 //! published (`/situ/state`, `/situ/agents`, `/diagnostics`), each channel
-//! with its type's `.msg` definition (`ros2msg`, from the map's catalogue).
+//! with its type's `.msg` definition (`ros2msg`, the text the map's
+//! definitions were loaded from).
 //!
 //! The MCAP file is kept readable at every flush (once a second at most,
 //! [`situ_runtime::record::mcap::staged`]): a bridge killed mid-run leaves
@@ -12,7 +13,7 @@
 //! disk, and at the end; each time whole (written aside, then renamed).
 
 use serde::Serialize;
-use situ_ros2_map::msgs::CATALOGUE;
+use situ_ros2_map::Registry;
 use situ_runtime::record::mcap::staged::Staged;
 use std::collections::BTreeMap;
 use std::fs::{self, File};
@@ -36,6 +37,7 @@ pub struct Bag {
     finishing: std::sync::Arc<std::sync::atomic::AtomicBool>,
     channels: BTreeMap<String, Channel>,
     schemas: BTreeMap<String, u16>,
+    msgs: Registry,
     first: Option<u64>,
     last: u64,
     sequence: u32,
@@ -46,38 +48,17 @@ fn mcap_err(e: mcap::McapError) -> io::Error {
     io::Error::other(e.to_string())
 }
 
-/// The `.msg` text of a catalogue type and of every type it uses, as
-/// ROS 2 tools write a `ros2msg` schema: the type's own fields, then each
-/// dependency after a line of `=` and `MSG: package/msg/Name`.
-pub fn ros2msg(full: &str) -> Option<String> {
-    let fields = |name: &str| CATALOGUE.iter().find(|(n, _)| *n == name).map(|(_, f)| *f);
-    let mut out = fields(full)?.to_string();
-    let mut seen = vec![full.to_string()];
-    let mut queue = vec![full.to_string()];
-    while let Some(ty) = queue.pop() {
-        let package = ty.split('/').next().unwrap_or("");
-        for line in fields(&ty).unwrap_or("").lines() {
-            let Some(field_ty) = line.split_whitespace().next() else { continue };
-            let base = field_ty.split('[').next().unwrap_or(field_ty);
-            let dep = match base.split('/').collect::<Vec<_>>()[..] {
-                [p, n] => format!("{p}/msg/{n}"),
-                [n] if n.starts_with(|c: char| c.is_ascii_uppercase()) => format!("{package}/msg/{n}"),
-                _ => continue,
-            };
-            if fields(&dep).is_some() && !seen.contains(&dep) {
-                out.push_str(&format!("\n{}\nMSG: {dep}\n{}", "=".repeat(80), fields(&dep).unwrap_or("")));
-                seen.push(dep.clone());
-                queue.push(dep);
-            }
-        }
-    }
-    Some(out)
+/// The `ros2msg` schema of `full` as rosbag2 writes it (see
+/// [`Registry::schema`]): from `msgs`, else from the definitions situ
+/// carries (the types the bridge publishes itself).
+pub fn ros2msg(msgs: &Registry, full: &str) -> Option<String> {
+    msgs.schema(full).or_else(|| Registry::carried().schema(full))
 }
 
 impl Bag {
     /// A new bag in `dir`, which must not exist yet (a bag is never
-    /// written over).
-    pub fn create(dir: &Path) -> io::Result<Bag> {
+    /// written over); its schemas are the definitions of `msgs`.
+    pub fn create(dir: &Path, msgs: &Registry) -> io::Result<Bag> {
         fs::create_dir(dir)?;
         let stem = dir.file_name().and_then(|n| n.to_str()).unwrap_or("situ").to_string();
         let file_name = format!("{stem}_0.mcap");
@@ -97,6 +78,7 @@ impl Bag {
             finishing,
             channels: BTreeMap::new(),
             schemas: BTreeMap::new(),
+            msgs: msgs.clone(),
             first: None,
             last: 0,
             sequence: 0,
@@ -106,7 +88,7 @@ impl Bag {
         Ok(bag)
     }
 
-    /// Adds a topic of type `ty` (`package/msg/Name`, of the catalogue).
+    /// Adds a topic of type `ty` (a full name the bag's registry defines).
     pub fn add_topic(&mut self, topic: &str, ty: &str) -> io::Result<()> {
         if self.channels.contains_key(topic) {
             return Ok(());
@@ -115,7 +97,8 @@ impl Bag {
         let schema = match self.schemas.get(ty) {
             Some(&id) => id,
             None => {
-                let text = ros2msg(ty).ok_or_else(|| io::Error::other(format!("no definition of `{ty}`")))?;
+                let text =
+                    ros2msg(&self.msgs, ty).ok_or_else(|| io::Error::other(format!("no definition of `{ty}`")))?;
                 let id = w.add_schema(ty, "ros2msg", text.as_bytes()).map_err(mcap_err)?;
                 self.schemas.insert(ty.to_string(), id);
                 id
@@ -219,30 +202,33 @@ mod tests {
 
     #[test]
     fn definitions_carry_their_dependencies_once() {
-        let scan = ros2msg("sensor_msgs/msg/LaserScan").unwrap();
-        assert!(scan.starts_with("std_msgs/Header header\n"));
+        let msgs = Registry::carried();
+        let scan = ros2msg(&msgs, "sensor_msgs/msg/LaserScan").unwrap();
+        assert!(scan.starts_with("# Single scan from a planar laser range-finder\n"), "{scan}");
+        assert!(scan.contains("\nstd_msgs/Header header "), "{scan}");
         assert_eq!(scan.matches("MSG: std_msgs/msg/Header").count(), 1);
         assert_eq!(scan.matches("MSG: builtin_interfaces/msg/Time").count(), 1);
-        let diag = ros2msg("diagnostic_msgs/msg/DiagnosticArray").unwrap();
+        let diag = ros2msg(&msgs, "diagnostic_msgs/msg/DiagnosticArray").unwrap();
         // `DiagnosticStatus` and `KeyValue` are named without their package.
         assert!(diag.contains("MSG: diagnostic_msgs/msg/DiagnosticStatus\n"), "{diag}");
         assert!(diag.contains("MSG: diagnostic_msgs/msg/KeyValue\n"), "{diag}");
-        assert_eq!(ros2msg("std_msgs/msg/String").unwrap(), "string data");
-        assert_eq!(ros2msg("nope/msg/Nope"), None);
+        assert!(diag.contains("byte ERROR=2"), "the constants are in the schema: {diag}");
+        assert!(ros2msg(&msgs, "std_msgs/msg/String").unwrap().ends_with("\nstring data\n"));
+        assert_eq!(ros2msg(&msgs, "nope/msg/Nope"), None);
     }
 
     #[test]
     fn a_bag_is_never_written_over() {
         let dir = std::env::temp_dir().join(format!("situ-bag-{}", std::process::id()));
         let _ = fs::remove_dir_all(&dir);
-        let mut bag = Bag::create(&dir).unwrap();
+        let mut bag = Bag::create(&dir, &Registry::carried()).unwrap();
         bag.add_topic("/situ/state", "std_msgs/msg/String").unwrap();
         bag.write("/situ/state", 5, &[0, 1, 0, 0, 2, 0, 0, 0, b'A', 0]).unwrap();
         assert!(bag.write("/nope", 6, &[]).is_err());
         bag.finish().unwrap();
         let meta = fs::read_to_string(dir.join("metadata.yaml")).unwrap();
         assert!(meta.contains("message_count: 1") && meta.contains("name: /situ/state"), "{meta}");
-        assert!(Bag::create(&dir).is_err());
+        assert!(Bag::create(&dir, &Registry::carried()).is_err());
         fs::remove_dir_all(&dir).unwrap();
     }
 }

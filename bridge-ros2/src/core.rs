@@ -13,7 +13,7 @@ use situ_compiler::model::Model;
 use situ_grammar::diag::{Diagnostic, FileId};
 use situ_ros2_map::lifecycle::{self, NodeState, Target, Transition};
 use situ_ros2_map::map;
-use situ_ros2_map::Translator;
+use situ_ros2_map::{Registry, Translator};
 use situ_runtime::bulletinboard::Bulletinboard;
 use situ_runtime::organise::Organisation;
 use situ_runtime::rete::{PostError, StateChange};
@@ -92,6 +92,8 @@ pub struct Core {
     board: Bulletinboard,
     org: Organisation,
     translator: Translator,
+    /// The message definitions the map is read with.
+    msgs: Registry,
     nodes: Vec<Node>,
     /// Node number by agent id.
     node_of: BTreeMap<u32, usize>,
@@ -108,10 +110,17 @@ pub struct Core {
 
 impl Core {
     /// A bridge for the compiled rules `content` (whose checked `model` the
-    /// map `map_text`, file `map_file`, is read against).
-    pub fn new(content: Arc<Content>, model: &Model, map_text: &str, map_file: FileId) -> Result<Core, SetupError> {
+    /// map `map_text`, file `map_file`, is read against, its message types
+    /// as `msgs` defines them).
+    pub fn new(
+        content: Arc<Content>,
+        model: &Model,
+        map_text: &str,
+        msgs: &Registry,
+        map_file: FileId,
+    ) -> Result<Core, SetupError> {
         let parsed = map::parse(map_text, map_file).map_err(|d| SetupError::Map(vec![*d]))?;
-        let translator = Translator::of(model, &parsed, map_file).map_err(SetupError::Map)?;
+        let translator = Translator::of(model, &parsed, msgs, map_file).map_err(SetupError::Map)?;
         let mut nodes = Vec::new();
         let mut node_of = BTreeMap::new();
         for n in &parsed.nodes {
@@ -131,6 +140,7 @@ impl Core {
             board: Bulletinboard::new(content.clone()),
             org: Organisation::new(content),
             translator,
+            msgs: msgs.clone(),
             nodes,
             node_of,
             in_flight: None,
@@ -139,6 +149,11 @@ impl Core {
             problems: BTreeMap::new(),
             next_diagnostics: 0,
         })
+    }
+
+    /// The message definitions the map is read with.
+    pub fn msgs(&self) -> &Registry {
+        &self.msgs
     }
 
     pub fn content(&self) -> &Arc<Content> {
@@ -187,7 +202,7 @@ impl Core {
         let ty = self.translator.topics().find(|(t, _)| *t == topic).map(|(_, ty)| ty);
         let plain;
         let cdr = match ty {
-            Some(ty) if xcdr2::is_xcdr2(cdr) => match xcdr2::to_xcdr1(ty, cdr) {
+            Some(ty) if xcdr2::is_xcdr2(cdr) => match xcdr2::to_xcdr1(&self.msgs, ty, cdr) {
                 Ok(bytes) => {
                     plain = bytes;
                     &plain[..]

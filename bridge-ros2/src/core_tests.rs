@@ -22,7 +22,8 @@ fn core() -> Core {
     let checked = check_source("amr.situ", RULES);
     assert_eq!(checked.errors(), 0, "{:?}", checked.diagnostics);
     let content = Arc::new(bundle::build(&checked));
-    Core::new(content, &checked.model, MAP, FileId(1)).unwrap_or_else(|e| panic!("{e:?}"))
+    Core::new(content, &checked.model, MAP, &situ_ros2_map::Registry::carried(), FileId(1))
+        .unwrap_or_else(|e| panic!("{e:?}"))
 }
 
 fn cdr<T: Serialize>(msg: &T) -> Vec<u8> {

@@ -97,10 +97,10 @@ impl Recording {
 
 /// The DDS name of a message type: `sensor_msgs/msg/LaserScan` → package
 /// and name for [`MessageTypeName`].
-fn type_parts(full: &str) -> Option<(&str, &str)> {
+/// The package, the kind (`msg`, `srv`, `action`) and the name of a full type name.
+fn type_parts(full: &str) -> Option<(&str, &str, &str)> {
     let mut parts = full.split('/');
-    let (package, _, name) = (parts.next()?, parts.next()?, parts.next()?);
-    Some((package, name))
+    Some((parts.next()?, parts.next()?, parts.next()?))
 }
 
 fn now_ns() -> u64 {
@@ -167,12 +167,24 @@ fn open(core: &Core, options: &Options) -> Result<Shell, DdsError> {
         .build();
     let subscriber = context.domain_participant().create_subscriber(&read_qos).map_err(dds("the subscriber"))?;
     let mut readers = Vec::new();
+    let node_name = NodeName::new("/", "situ_bridge").map_err(dds("node name"))?;
     for (topic, ty) in core.topics() {
-        let (package, name) = type_parts(ty).ok_or_else(|| DdsError(format!("type `{ty}`")))?;
+        let (package, kind, name) = type_parts(ty).ok_or_else(|| DdsError(format!("type `{ty}`")))?;
         let profile = QosProfile::subscription_default();
-        let t = node
-            .create_topic(&Name::parse(&topic).map_err(dds(&topic))?, MessageTypeName::new(package, name), &profile)
-            .map_err(dds(&topic))?;
+        let ros_name = Name::parse(&topic).map_err(dds(&topic))?;
+        let t = if kind == "msg" {
+            node.create_topic(&ros_name, MessageTypeName::new(package, name), &profile).map_err(dds(&topic))?
+        } else {
+            // A part of a service or an action (`pkg/action/Name_FeedbackMessage`):
+            // its DDS type is `pkg::action::dds_::Name_FeedbackMessage_`.
+            let dds_type = format!("{package}::{kind}::dds_::{name}_");
+            let qos: rustdds::QosPolicies = (&profile).into();
+            let dds_name = ros_name.to_dds_name("rt", &node_name, "");
+            context
+                .domain_participant()
+                .create_topic(dds_name, dds_type, &qos, rustdds::TopicKind::NoKey)
+                .map_err(dds(&topic))?
+        };
         let reader =
             subscriber.create_datareader_no_key::<Raw, RawAdapter>(&t, Some(read_qos.clone())).map_err(dds(&topic))?;
         readers.push((topic, reader));

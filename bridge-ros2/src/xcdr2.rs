@@ -1,5 +1,5 @@
 //! XCDR2 (DDS-XTypes 1.3, §7.4.3) read into the XCDR1 the map's decoder
-//! reads, for the types of the catalogue: a sample in `00 06`/`00 07`
+//! reads, for the types of the registry: a sample in `00 06`/`00 07`
 //! (final types) or `00 08`/`00 09` (appendable: delimited) becomes the
 //! same message in plain little-endian CDR (`00 01`).
 //!
@@ -12,7 +12,8 @@
 //! Bounded like the decoder: nothing is allocated beyond what the input
 //! holds, and a length or count past its end is an error.
 
-use situ_ros2_map::msgs::{self, FieldType, CATALOGUE};
+use situ_ros2_map::msgs::idl::{Array, Base, Prim, TypeRef};
+use situ_ros2_map::msgs::{intern, Registry};
 
 /// Whether `cdr`'s encapsulation is one [`to_xcdr1`] reads.
 pub fn is_xcdr2(cdr: &[u8]) -> bool {
@@ -26,7 +27,7 @@ pub enum Xcdr2Error {
     TooShort { len: usize },
     #[error("encapsulation {0:02x} {1:02x} is not XCDR2")]
     NotXcdr2(u8, u8),
-    #[error("`{0}` is not a message type of the catalogue")]
+    #[error("`{0}` is not a message type situ knows (or it has a `wstring`)")]
     UnknownType(&'static str),
     #[error("{needed} bytes needed at {at}, {left} left")]
     Truncated { needed: usize, at: usize, left: usize },
@@ -40,9 +41,9 @@ pub enum Xcdr2Error {
     SequencePastDheader,
 }
 
-/// The message `ty` (a full name of the catalogue) of the XCDR2 sample
-/// `cdr` (its encapsulation header included), as plain little-endian CDR.
-pub fn to_xcdr1(ty: &'static str, cdr: &[u8]) -> Result<Vec<u8>, Xcdr2Error> {
+/// The message `ty` (a full name of `reg`) of the XCDR2 sample `cdr` (its
+/// encapsulation header included), as plain little-endian CDR.
+pub fn to_xcdr1(reg: &Registry, ty: &str, cdr: &[u8]) -> Result<Vec<u8>, Xcdr2Error> {
     let Some((header, body)) = cdr.split_first_chunk::<4>() else {
         return Err(Xcdr2Error::TooShort { len: cdr.len() });
     };
@@ -53,12 +54,13 @@ pub fn to_xcdr1(ty: &'static str, cdr: &[u8]) -> Result<Vec<u8>, Xcdr2Error> {
         (0, 9) => (true, true),
         (a, b) => return Err(Xcdr2Error::NotXcdr2(a, b)),
     };
-    let mut t = Transcoder { input: body, pos: 0, little, delimited, out: vec![0, 1, 0, 0] };
-    t.msg(ty)?;
+    let mut t = Transcoder { reg, input: body, pos: 0, little, delimited, out: vec![0, 1, 0, 0] };
+    t.msg(ty, 0)?;
     Ok(t.out)
 }
 
 struct Transcoder<'a> {
+    reg: &'a Registry,
     input: &'a [u8],
     pos: usize,
     little: bool,
@@ -66,12 +68,12 @@ struct Transcoder<'a> {
     out: Vec<u8>,
 }
 
-/// The size of a primitive named as in the catalogue; a string's length is 4.
-fn width(ty: &str) -> usize {
-    match ty {
-        "bool" | "byte" | "char" | "int8" | "uint8" => 1,
-        "int16" | "uint16" => 2,
-        "int64" | "uint64" | "float64" => 8,
+/// The size of a primitive; a string's length is 4.
+fn width(p: Prim) -> usize {
+    match p {
+        Prim::Bool | Prim::Byte | Prim::Char | Prim::I8 | Prim::U8 => 1,
+        Prim::I16 | Prim::U16 => 2,
+        Prim::I64 | Prim::U64 | Prim::F64 => 8,
         _ => 4,
     }
 }
@@ -121,73 +123,87 @@ impl Transcoder<'_> {
         end.ok_or(Xcdr2Error::Dheader { len, left: self.input.len() - self.pos })
     }
 
-    fn msg(&mut self, ty: &'static str) -> Result<(), Xcdr2Error> {
+    fn msg(&mut self, ty: &str, depth: usize) -> Result<(), Xcdr2Error> {
         let end = if self.delimited { Some(self.dheader()?) } else { None };
-        let text = CATALOGUE.iter().find(|(n, _)| *n == ty).map(|(_, t)| *t).ok_or(Xcdr2Error::UnknownType(ty))?;
-        if text.trim().is_empty() {
+        let reg = self.reg;
+        let def = reg.def(ty).filter(|_| depth <= 64).ok_or_else(|| Xcdr2Error::UnknownType(intern(ty)))?;
+        if def.fields.is_empty() {
             // The DDS type of an empty ROS 2 message has one octet.
             let octet = self.read(1, 1)?.to_vec();
             self.write(&octet, 1);
         }
-        let names = text.lines().map(str::trim).filter(|l| !l.is_empty()).filter_map(|l| l.split_once(' '));
-        for ((written, _), (_, field)) in names.zip(msgs::fields(ty)) {
-            let base = written.split('[').next().unwrap_or(written);
-            self.field(base, &field)?;
+        for f in &def.fields {
+            self.field(&f.ty, depth).map_err(|e| match e {
+                Xcdr2Error::UnknownType(_) if matches!(f.ty.base, Base::Prim(_)) => Xcdr2Error::UnknownType(intern(ty)),
+                e => e,
+            })?;
         }
         if let Some(end) = end {
             if self.pos > end {
-                return Err(Xcdr2Error::PastDheader(ty));
+                return Err(Xcdr2Error::PastDheader(intern(ty)));
             }
             self.pos = end; // members a newer definition appended
         }
         Ok(())
     }
 
-    fn field(&mut self, base: &str, field: &FieldType) -> Result<(), Xcdr2Error> {
-        match field {
-            FieldType::Prim(msgs::Prim::String) => {
+    fn elem(&mut self, base: &Base, depth: usize) -> Result<(), Xcdr2Error> {
+        match base {
+            Base::Prim(Prim::WString(_)) => Err(Xcdr2Error::UnknownType("wstring")),
+            Base::Prim(Prim::String(_)) => {
                 let len = self.u32()?;
                 self.write_u32(len);
                 let bytes = self.read(len as usize, 1)?.to_vec();
                 self.out.extend(bytes);
+                Ok(())
             }
-            FieldType::Prim(_) => {
-                let w = width(base);
+            Base::Prim(p) => {
+                let w = width(*p);
                 let bytes = self.read(w, w)?.to_vec();
                 self.write(&bytes, w);
+                Ok(())
             }
-            FieldType::Msg(m) => self.msg(m)?,
-            FieldType::Array(elem, size) => {
-                let plain = matches!(**elem, FieldType::Prim(p) if p != msgs::Prim::String);
-                let end = if plain { None } else { Some(self.dheader()?) };
-                let count = match size {
-                    Some(n) => *n,
-                    None => {
-                        let count = self.u32()?;
-                        self.write_u32(count);
-                        count as usize
-                    }
-                };
-                if count > self.input.len() - self.pos {
-                    return Err(Xcdr2Error::Elements { count, left: self.input.len() - self.pos });
+            Base::Msg(m) => self.msg(m, depth + 1),
+        }
+    }
+
+    fn field(&mut self, ty: &TypeRef, depth: usize) -> Result<(), Xcdr2Error> {
+        let size = match ty.array {
+            Array::Not => return self.elem(&ty.base, depth),
+            Array::Fixed(n) => Some(n),
+            Array::Unbounded | Array::Bounded(_) => None,
+        };
+        let plain = matches!(ty.base, Base::Prim(p) if !p.is_string());
+        let end = if plain { None } else { Some(self.dheader()?) };
+        let count = match size {
+            Some(n) => n,
+            None => {
+                let count = self.u32()?;
+                self.write_u32(count);
+                count as usize
+            }
+        };
+        if count > self.input.len() - self.pos {
+            return Err(Xcdr2Error::Elements { count, left: self.input.len() - self.pos });
+        }
+        match &ty.base {
+            // Nothing, not even the padding before the elements.
+            _ if count == 0 => {}
+            Base::Prim(p) if plain => {
+                // A run of primitives: one read, one write.
+                let w = width(*p);
+                let bytes = self.read(w * count, w)?.to_vec();
+                self.write(&bytes, w);
+            }
+            base => {
+                for _ in 0..count {
+                    self.elem(base, depth)?;
                 }
-                if count == 0 {
-                    // Nothing, not even the padding before the elements.
-                } else if plain {
-                    // A run of primitives: one read, one write.
-                    let w = width(base);
-                    let bytes = self.read(w * count, w)?.to_vec();
-                    self.write(&bytes, w);
-                } else {
-                    for _ in 0..count {
-                        self.field(base, elem)?;
-                    }
-                }
-                if let Some(end) = end {
-                    if self.pos > end {
-                        return Err(Xcdr2Error::SequencePastDheader);
-                    }
-                }
+            }
+        }
+        if let Some(end) = end {
+            if self.pos > end {
+                return Err(Xcdr2Error::SequencePastDheader);
             }
         }
         Ok(())
@@ -197,6 +213,10 @@ impl Transcoder<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn to_xcdr1(ty: &str, cdr: &[u8]) -> Result<Vec<u8>, Xcdr2Error> {
+        super::to_xcdr1(&Registry::carried(), ty, cdr)
+    }
 
     #[test]
     fn an_appendable_point_loses_its_dheader_and_its_padding() {
@@ -242,8 +262,9 @@ mod tests {
             seed ^= seed << 17;
             seed
         };
-        for ty in msgs::names() {
-            for round in 0..300 {
+        let reg = Registry::carried();
+        for ty in reg.names() {
+            for round in 0..60 {
                 let len = (next() % 96) as usize;
                 let mut v2 = vec![0, 6 + (round % 4) as u8, 0, 0];
                 // Small numbers mostly, so counts and lengths often fit.

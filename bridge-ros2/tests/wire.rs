@@ -31,7 +31,8 @@ fn bridge(domain: u16, stop: Arc<AtomicBool>) -> std::thread::JoinHandle<Report>
 fn bridge_on(domain: u16, rmw: Rmw, stop: Arc<AtomicBool>) -> std::thread::JoinHandle<Report> {
     let checked = check_source("amr.situ", RULES);
     let content = Arc::new(bundle::build(&checked));
-    let core = Core::new(content, &checked.model, MAP, FileId(1)).expect("the map");
+    let core =
+        Core::new(content, &checked.model, MAP, &situ_ros2_map::Registry::carried(), FileId(1)).expect("the map");
     let options = Options { domain, rmw, heartbeat: Duration::from_millis(10), duration: None, stop };
     std::thread::spawn(move || dds::run(core, &options, None).expect("the bridge"))
 }

@@ -112,6 +112,8 @@ codes! {
     ROS2_BRIDGE_TOPIC = "E0418", Error, "map that reads the bridge's own `/situ` topics";
     ROS2_ZERO_DIVISION = "E0419", Error, "division by a constant zero in a map expression";
     ROS2_BAD_INDEX = "E0420", Error, "array index in a map expression that is not an integer";
+    ROS2_BAD_DEFINITION = "E0422", Error, "ROS 2 message definition that does not load";
+    ROS2_BAD_MSG_PATH = "E0423", Error, "`msg_path` folder that is not a folder";
     ROS2_BRIDGE_DIAGNOSTICS = "W0421", Warning, "map that reads `/diagnostics` without naming the reporter";
     VACUOUS_PROPERTY = "W0501", Warning, "property whose premise never holds";
     UNDECIDED_PROPERTY = "E0502", Error, "property neither proved nor violated";

@@ -53,7 +53,8 @@ fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let checked = situ_compiler::check(&root.join("tests/ros2/delivery.situ"), &FsLoader).expect("the rules read");
     let map = std::fs::read_to_string(root.join("tests/ros2/delivery.toml")).expect("the map reads");
-    let mut t = Translator::new(&checked.model, &map, FileId(1)).unwrap_or_else(|d| panic!("{d:?}"));
+    let mut t = Translator::new(&checked.model, &map, &situ_ros2_map::Registry::carried(), FileId(1))
+        .unwrap_or_else(|d| panic!("{d:?}"));
     // Obstacle and clear scans in turn: both entries of /scan are evaluated.
     let scans = [laser_scan(ranges, 0.3, 1), laser_scan(ranges, 1.5, 2)];
     let mut lat = Vec::with_capacity(messages);

@@ -1,4 +1,4 @@
-//! Decoding of the catalogue's messages from CDR, as ROS 2 middlewares send
+//! Decoding of messages from CDR, as ROS 2 middlewares send
 //! them: a 4-byte encapsulation header (`00 01` little-endian, `00 00`
 //! big-endian), then the fields in order with the XCDR1 rules: each
 //! primitive aligned to its size (8 at most) from the end of the header,
@@ -7,12 +7,13 @@
 //! messages inline.
 //!
 //! One generic walker reads every type: [`Decoder::new`] compiles the
-//! catalogue's field lines of a type into a layout once, and
+//! registry's definition of a type into a layout once, and
 //! [`Decoder::decode`] walks it. It never panics and never allocates more
 //! than the input can hold: a count larger than the bytes left is an error.
 
 use crate::expr::{self, Expr, Step};
-use crate::msgs::{self, FieldType, CATALOGUE};
+use crate::msgs::idl::{self, Array, Base};
+use crate::msgs::{intern, Registry};
 use std::fmt;
 
 /// A decoded value.
@@ -114,10 +115,6 @@ const PRIMS: [(&str, Prim); 14] = [
 ];
 
 impl Prim {
-    fn of(name: &str) -> Option<Prim> {
-        PRIMS.iter().find(|(n, _)| *n == name).map(|(_, p)| *p)
-    }
-
     fn name(self) -> &'static str {
         PRIMS.iter().find(|(_, p)| *p == self).map_or("?", |(n, _)| n)
     }
@@ -161,33 +158,51 @@ struct Layout {
     fields: Vec<(&'static str, Kind)>,
 }
 
-fn layout(msg: &'static str) -> Option<Layout> {
-    let (name, text) = CATALOGUE.iter().find(|(n, _)| *n == msg)?;
-    let mut fields = Vec::new();
-    for line in text.lines().map(str::trim).filter(|l| !l.is_empty()) {
-        let (ty, field) = line.split_once(' ')?;
-        let field = field.trim();
-        fields.push((field, kind(ty, &msgs::field(name, field)?)?));
+/// The layout of the message `msg` (a full name); `None` if it or a type
+/// it uses is not defined, or uses `wstring` (whose encoding middlewares
+/// do not agree on). Recursive definitions cannot be written in `.msg`
+/// files; `depth` bounds them anyway.
+fn layout(reg: &Registry, msg: &str, depth: usize) -> Option<Layout> {
+    let def = reg.def(msg)?;
+    if depth > 64 {
+        return None;
     }
-    Some(Layout { name, fields })
+    let mut fields = Vec::with_capacity(def.fields.len());
+    for f in &def.fields {
+        let elem = match &f.ty.base {
+            Base::Prim(p) => Kind::Prim(wire(*p)?),
+            Base::Msg(m) => Kind::Msg(Box::new(layout(reg, m, depth + 1)?)),
+        };
+        let k = match f.ty.array {
+            Array::Not => elem,
+            Array::Fixed(n) => Kind::Fixed(Box::new(elem), n),
+            Array::Unbounded | Array::Bounded(_) => Kind::Seq(Box::new(elem)),
+        };
+        fields.push((intern(&f.name), k));
+    }
+    Some(Layout { name: intern(&def.name), fields })
 }
 
-/// The wire kind of a field written `ty` in the catalogue, of type `ft`.
-fn kind(ty: &str, ft: &FieldType) -> Option<Kind> {
-    Some(match ft {
-        FieldType::Prim(_) => Kind::Prim(Prim::of(ty)?),
-        FieldType::Msg(m) => Kind::Msg(Box::new(layout(m)?)),
-        FieldType::Array(elem, size) => {
-            let k = Box::new(kind(ty.split('[').next()?, elem)?);
-            match size {
-                Some(n) => Kind::Fixed(k, *n),
-                None => Kind::Seq(k),
-            }
-        }
+/// The wire primitive of a `.msg` primitive.
+fn wire(p: idl::Prim) -> Option<Prim> {
+    Some(match p {
+        idl::Prim::Bool => Prim::Bool,
+        idl::Prim::I8 => Prim::I8,
+        idl::Prim::Byte | idl::Prim::Char | idl::Prim::U8 => Prim::U8,
+        idl::Prim::I16 => Prim::I16,
+        idl::Prim::U16 => Prim::U16,
+        idl::Prim::I32 => Prim::I32,
+        idl::Prim::U32 => Prim::U32,
+        idl::Prim::I64 => Prim::I64,
+        idl::Prim::U64 => Prim::U64,
+        idl::Prim::F32 => Prim::F32,
+        idl::Prim::F64 => Prim::F64,
+        idl::Prim::String(_) => Prim::String,
+        idl::Prim::WString(_) => return None,
     })
 }
 
-/// The decoder of one message type of the catalogue.
+/// The decoder of one message type.
 #[derive(Debug, Clone)]
 pub struct Decoder {
     layout: Layout,
@@ -197,10 +212,11 @@ pub struct Decoder {
 pub const MAX_COUNT: u32 = 1 << 26;
 
 impl Decoder {
-    /// The decoder of `ty` (`pkg/msg/Name` or `pkg/Name`); `None` if the
-    /// type is not in the catalogue.
-    pub fn new(ty: &str) -> Option<Decoder> {
-        layout(msgs::lookup(ty)?).map(|layout| Decoder { layout })
+    /// The decoder of `ty` (`pkg/msg/Name` or `pkg/Name`) as `reg` defines
+    /// it; `None` if the type or a type it uses is not defined (or has a
+    /// `wstring`).
+    pub fn new(reg: &Registry, ty: &str) -> Option<Decoder> {
+        layout(reg, reg.lookup(ty)?, 0).map(|layout| Decoder { layout })
     }
 
     /// The full name of the type it decodes.
@@ -386,6 +402,14 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
+    fn decoder(ty: &str) -> Option<Decoder> {
+        Decoder::new(&Registry::carried(), ty)
+    }
+
+    fn names() -> Vec<String> {
+        Registry::carried().names().map(str::to_string).collect()
+    }
+
     /// A test encoder: writes a random valid message of a layout and
     /// returns the value it wrote.
     struct Writer {
@@ -469,7 +493,7 @@ mod tests {
 
     /// A random valid message of `ty`: its CDR bytes and its value.
     fn sample(ty: &str, seed: u64, little: bool) -> (Vec<u8>, Value) {
-        let d = Decoder::new(ty).unwrap();
+        let d = decoder(ty).unwrap();
         let mut w = Writer { body: Vec::new(), little, seed: seed | 1 };
         let v = w.msg(&d.layout);
         let mut bytes = vec![0, u8::from(little), 0, 0];
@@ -478,13 +502,13 @@ mod tests {
     }
 
     #[test]
-    fn every_catalogue_type_has_a_decoder() {
-        for name in msgs::names() {
-            let d = Decoder::new(name).unwrap_or_else(|| panic!("{name}"));
+    fn every_carried_type_has_a_decoder() {
+        for name in names() {
+            let d = decoder(&name).unwrap_or_else(|| panic!("{name}"));
             assert_eq!(d.type_name(), name);
         }
-        assert!(Decoder::new("sensor_msgs/LaserScan").is_some());
-        assert!(Decoder::new("sensor_msgs/msg/Nothing").is_none());
+        assert!(decoder("sensor_msgs/LaserScan").is_some());
+        assert!(decoder("sensor_msgs/msg/Nothing").is_none());
     }
 
     /// A LaserScan written byte by byte, little-endian.
@@ -508,8 +532,7 @@ mod tests {
 
     #[test]
     fn laser_scan_by_hand() {
-        let v =
-            Decoder::new("sensor_msgs/msg/LaserScan").unwrap().decode(&scan_le(&[0.25, 2.0, f32::INFINITY])).unwrap();
+        let v = decoder("sensor_msgs/msg/LaserScan").unwrap().decode(&scan_le(&[0.25, 2.0, f32::INFINITY])).unwrap();
         assert_eq!(v.at("header.stamp.sec"), Some(&Value::Int(7)));
         assert_eq!(v.at("header.stamp.nanosec"), Some(&Value::Int(9)));
         assert_eq!(v.at("header.frame_id"), Some(&Value::Str("laser".into())));
@@ -533,7 +556,7 @@ mod tests {
         for i in 0..(3 + 4 + 36 + 6 + 36) {
             b.extend(f64::from(i).to_be_bytes());
         }
-        let v = Decoder::new("nav_msgs/Odometry").unwrap().decode(&b).unwrap();
+        let v = decoder("nav_msgs/Odometry").unwrap().decode(&b).unwrap();
         assert_eq!(v.at("child_frame_id"), Some(&Value::Str("bs".into())));
         assert_eq!(v.at("pose.pose.position.x"), Some(&Value::Float(0.0)));
         assert_eq!(v.at("pose.covariance[35]"), Some(&Value::Float(42.0)));
@@ -543,7 +566,7 @@ mod tests {
 
     #[test]
     fn errors_are_clear() {
-        let d = Decoder::new("sensor_msgs/msg/LaserScan").unwrap();
+        let d = decoder("sensor_msgs/msg/LaserScan").unwrap();
         let mut b = scan_le(&[]);
         let at = b.len() - 8;
         b.truncate(at);
@@ -572,16 +595,16 @@ mod tests {
         b.extend(1u32.to_le_bytes()); // one key value
         b.extend(99u32.to_le_bytes()); // key claims 99 bytes
         b.extend([0; 4]);
-        let e = Decoder::new("diagnostic_msgs/DiagnosticArray").unwrap().decode(&b).unwrap_err();
+        let e = decoder("diagnostic_msgs/DiagnosticArray").unwrap().decode(&b).unwrap_err();
         assert_eq!(e.to_string(), "DiagnosticArray: string `status[0].values[0].key` claims 99 bytes, 4 left");
     }
 
     #[test]
     fn empty_and_bool() {
-        let d = Decoder::new("std_msgs/msg/Empty").unwrap();
+        let d = decoder("std_msgs/msg/Empty").unwrap();
         assert_eq!(d.decode(&[0, 1, 0, 0, 0]), Ok(Value::Msg(vec![])));
         assert!(d.decode(&[0, 1, 0, 0]).is_err());
-        let b = Decoder::new("std_msgs/Bool").unwrap();
+        let b = decoder("std_msgs/Bool").unwrap();
         assert_eq!(b.decode(&[0, 1, 0, 0, 1, 0, 0, 0]).unwrap().at("data"), Some(&Value::Bool(true)));
     }
 
@@ -592,9 +615,9 @@ mod tests {
         /// in both byte orders.
         #[test]
         fn round_trip(seed in any::<u64>(), little in any::<bool>()) {
-            for ty in msgs::names() {
-                let (bytes, v) = sample(ty, seed, little);
-                prop_assert_eq!(Decoder::new(ty).unwrap().decode(&bytes), Ok(v), "{}", ty);
+            for ty in names() {
+                let (bytes, v) = sample(&ty, seed, little);
+                prop_assert_eq!(decoder(&ty).unwrap().decode(&bytes), Ok(v), "{}", ty);
             }
         }
 
@@ -606,9 +629,9 @@ mod tests {
             edits in proptest::collection::vec((any::<usize>(), any::<u8>(), 0u8..4), 1..8),
             noise in proptest::collection::vec(any::<u8>(), 0..64),
         ) {
-            for ty in msgs::names() {
-                let d = Decoder::new(ty).unwrap();
-                let (mut bytes, _) = sample(ty, seed, seed & 1 == 0);
+            for ty in names() {
+                let d = decoder(&ty).unwrap();
+                let (mut bytes, _) = sample(&ty, seed, seed & 1 == 0);
                 for (at, byte, op) in &edits {
                     let at = at % (bytes.len() + 1);
                     match op {

@@ -3,7 +3,7 @@
 
 use crate::check_names;
 use crate::map::{self, EventEntry, Map};
-use crate::msgs;
+use crate::msgs::{Registry, TypeError};
 use crate::types::{type_of, Ty};
 use situ_compiler::codes;
 use situ_compiler::model::{Event, Model, Type};
@@ -11,20 +11,21 @@ use situ_compiler::suggest::suggest;
 use situ_grammar::diag::{Diagnostic, FileId};
 use std::collections::BTreeMap;
 
-/// One check: every finding of one kind.
-pub type Check = fn(&Model, &Map, FileId) -> Vec<Diagnostic>;
+/// One check: every finding of one kind, the message types read from the registry.
+pub type Check = fn(&Model, &Map, &Registry, FileId) -> Vec<Diagnostic>;
 
 /// Every finding of the map `text` (file `file`) against the rules'
-/// `model`, sorted by place. A map that does not parse is one finding.
-pub fn check_map(model: &Model, text: &str, file: FileId) -> Vec<Diagnostic> {
+/// `model` and the message definitions `msgs`, sorted by place. A map that
+/// does not parse is one finding.
+pub fn check_map(model: &Model, text: &str, msgs: &Registry, file: FileId) -> Vec<Diagnostic> {
     match map::parse(text, file) {
-        Ok(map) => check_parsed(model, &map, file),
+        Ok(map) => check_parsed(model, &map, msgs, file),
         Err(d) => vec![*d],
     }
 }
 
 /// [`check_map`] on a map already parsed (from `file`).
-pub fn check_parsed(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
+pub fn check_parsed(model: &Model, map: &Map, msgs: &Registry, file: FileId) -> Vec<Diagnostic> {
     let checks: [Check; 20] = [
         unknown_types,
         unknown_names,
@@ -47,7 +48,7 @@ pub fn check_parsed(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
         crate::expr_check::zero_divisions,
         crate::expr_check::non_integer_indexes,
     ];
-    let mut out: Vec<Diagnostic> = checks.iter().flat_map(|c| c(model, map, file)).collect();
+    let mut out: Vec<Diagnostic> = checks.iter().flat_map(|c| c(model, map, msgs, file)).collect();
     out.sort_by_key(|d| (d.primary.span.start, d.code));
     out
 }
@@ -64,19 +65,14 @@ fn did_you_mean<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> Op
     suggest(name, candidates).map(|s| format!("did you mean `{s}`?"))
 }
 
-/// E0402: a `type` that is not in the catalogue.
-pub fn unknown_types(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
+/// E0402: a `type` that no place of the search path defines; E0422: a
+/// `type` whose definition, or the definition of a type it uses, does not
+/// parse or names a type that cannot be found.
+pub fn unknown_types(_: &Model, map: &Map, msgs: &Registry, file: FileId) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for e in &map.events {
-        if msgs::lookup(&e.ty.value).is_some() {
-            continue;
-        }
-        let help = match msgs::full_name(&e.ty.value) {
-            None => "write the type as `package/msg/Name` or `package/Name`".to_string(),
-            Some(full) => did_you_mean(&full, msgs::names())
-                .unwrap_or_else(|| "see `docs/ros2.md` for the message types the map knows".into()),
-        };
-        out.push(
+        let Err(why) = msgs.resolve(&e.ty.value) else { continue };
+        let unknown = |help: String| {
             Diagnostic::error(
                 codes::ROS2_UNKNOWN_TYPE,
                 format!("unknown message type `{}`", e.ty.value),
@@ -84,14 +80,37 @@ pub fn unknown_types(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
                 e.ty.span,
                 "not a known message type",
             )
-            .with_help(help),
-        );
+            .with_help(help)
+        };
+        out.push(match why {
+            TypeError::Malformed => unknown("write the type as `package/msg/Name` or `package/Name`".into()),
+            TypeError::UnknownPackage { package } => unknown(format!(
+                "no package `{package}` in: {}; give its folder with `--msg-path DIR` or `msg_path = [\"DIR\"]`",
+                msgs.search_path().describe()
+            )),
+            TypeError::UnknownType { package, known } => {
+                let short = e.ty.value.rsplit('/').next().unwrap_or("");
+                let listed = format!("`{package}` has: {}", known.join(", "));
+                unknown(match suggest(short, known.iter().map(String::as_str)) {
+                    Some(s) => format!("did you mean `{package}/msg/{s}`? {listed}"),
+                    None => listed,
+                })
+            }
+            TypeError::Broken(err) => Diagnostic::error(
+                codes::ROS2_BAD_DEFINITION,
+                format!("the definition of `{}` does not load", e.ty.value),
+                file,
+                e.ty.span,
+                "its definition does not load",
+            )
+            .with_help(format!("{err}: fix the definition, or put a good one first on the search path")),
+        });
     }
     out
 }
 
 /// E0405: an agent or an event the rules do not declare (events and nodes).
-pub fn unknown_names(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
+pub fn unknown_names(model: &Model, map: &Map, _: &Registry, file: FileId) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     let agents = || model.agents.iter().map(|a| a.name.as_str());
     let mut unknown_agent = |s: &map::Str| {
@@ -135,7 +154,7 @@ pub fn unknown_names(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> 
 }
 
 /// E0406: an entry whose agent is not the one that reports its event.
-pub fn foreign_events(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
+pub fn foreign_events(model: &Model, map: &Map, _: &Registry, file: FileId) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for e in &map.events {
         let (Some(a), Some(ev)) = (agent(model, &e.agent.value), event(model, &e.event.value)) else { continue };
@@ -158,7 +177,7 @@ pub fn foreign_events(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic>
 }
 
 /// E0407: a payload field the event does not have.
-pub fn extra_payload(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
+pub fn extra_payload(model: &Model, map: &Map, _: &Registry, file: FileId) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for e in &map.events {
         let Some(ev) = event(model, &e.event.value) else { continue };
@@ -190,7 +209,7 @@ pub fn extra_payload(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> 
 }
 
 /// E0408: a payload field of the event that the entry does not fill.
-pub fn missing_payload(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
+pub fn missing_payload(model: &Model, map: &Map, _: &Registry, file: FileId) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for e in &map.events {
         let Some(ev) = event(model, &e.event.value) else { continue };
@@ -219,31 +238,31 @@ pub fn missing_payload(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic
 /// An expression of an entry: its payload key (none for `when`) and its text.
 type Keyed<'a> = (Option<&'a map::Str>, &'a map::Str);
 
-fn expressions(e: &EventEntry) -> Option<(&'static str, Vec<Keyed<'_>>)> {
-    let msg = msgs::lookup(&e.ty.value)?;
+fn expressions<'e>(e: &'e EventEntry, msgs: &Registry) -> Option<(&'static str, Vec<Keyed<'e>>)> {
+    let msg = msgs.lookup(&e.ty.value)?;
     let when = e.when.iter().map(|w| (None, w));
     Some((msg, when.chain(e.payload.iter().map(|(k, v)| (Some(k), v))).collect()))
 }
 
 /// E0404: an expression that does not parse.
-pub fn syntax(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
+pub fn syntax(_: &Model, map: &Map, msgs: &Registry, file: FileId) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for e in &map.events {
         // The syntax does not depend on the type: check even unknown ones.
-        let msg = msgs::lookup(&e.ty.value).unwrap_or("std_msgs/msg/Empty");
+        let msg = msgs.lookup(&e.ty.value).unwrap_or("std_msgs/msg/Empty");
         for text in e.when.iter().chain(e.payload.iter().map(|(_, v)| v)) {
-            out.extend(type_of(text, msg, file).syntax);
+            out.extend(type_of(text, msg, msgs, file).syntax);
         }
     }
     out
 }
 
 /// E0403: a field path that is not in the message.
-pub fn field_paths(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
+pub fn field_paths(_: &Model, map: &Map, msgs: &Registry, file: FileId) -> Vec<Diagnostic> {
     let mut out = Vec::new();
-    for (msg, exprs) in map.events.iter().filter_map(expressions) {
+    for (msg, exprs) in map.events.iter().filter_map(|e| expressions(e, msgs)) {
         for (_, text) in exprs {
-            out.extend(type_of(text, msg, file).paths);
+            out.extend(type_of(text, msg, msgs, file).paths);
         }
     }
     out
@@ -262,13 +281,13 @@ fn fits(ty: &Ty, field: &Type, literal: Option<&str>) -> bool {
 
 /// E0409: an operator on the wrong types, or a payload value whose type is
 /// not the event field's.
-pub fn type_mismatches(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
+pub fn type_mismatches(model: &Model, map: &Map, msgs: &Registry, file: FileId) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for e in &map.events {
-        let Some((msg, exprs)) = expressions(e) else { continue };
+        let Some((msg, exprs)) = expressions(e, msgs) else { continue };
         let ev = event(model, &e.event.value);
         for (key, text) in exprs {
-            let typed = type_of(text, msg, file);
+            let typed = type_of(text, msg, msgs, file);
             out.extend(typed.mismatches);
             let (Some(ty), Some(key), Some(ev)) = (typed.ty, key, ev) else { continue };
             let Some(field) = ev.fields.iter().find(|f| f.name == key.value) else { continue };
@@ -312,11 +331,11 @@ pub fn type_mismatches(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic
 }
 
 /// E0410: a `when` whose value is not a condition.
-pub fn when_not_bool(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
+pub fn when_not_bool(_: &Model, map: &Map, msgs: &Registry, file: FileId) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for e in &map.events {
-        let (Some(msg), Some(when)) = (msgs::lookup(&e.ty.value), &e.when) else { continue };
-        match type_of(when, msg, file).ty {
+        let (Some(msg), Some(when)) = (msgs.lookup(&e.ty.value), &e.when) else { continue };
+        match type_of(when, msg, msgs, file).ty {
             Some(Ty::Bool) | None => {}
             Some(ty) => out.push(
                 Diagnostic::error(
@@ -334,7 +353,7 @@ pub fn when_not_bool(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
 }
 
 /// W0411: an event of an agent that the map does map, which no entry produces.
-pub fn unmapped_events(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
+pub fn unmapped_events(model: &Model, map: &Map, _: &Registry, file: FileId) -> Vec<Diagnostic> {
     let mut first: BTreeMap<usize, &EventEntry> = BTreeMap::new();
     for e in &map.events {
         if let Some(a) = agent(model, &e.agent.value) {
@@ -367,7 +386,7 @@ pub fn unmapped_events(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic
 }
 
 /// E0412: one agent played by two lifecycle nodes.
-pub fn two_nodes(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
+pub fn two_nodes(_: &Model, map: &Map, _: &Registry, file: FileId) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for (i, n) in map.nodes.iter().enumerate() {
         // An entry that repeats another exactly is W0417.
@@ -393,12 +412,14 @@ pub fn two_nodes(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
     out
 }
 
-/// E0413: one topic read as two message types.
-pub fn topic_types(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
+/// E0413: one topic read as two message types. Entries whose type is
+/// unknown are left to E0402/E0422.
+pub fn topic_types(_: &Model, map: &Map, msgs: &Registry, file: FileId) -> Vec<Diagnostic> {
     let mut out = Vec::new();
-    let full = |e: &EventEntry| msgs::full_name(&e.ty.value).unwrap_or_else(|| e.ty.value.clone());
-    for (i, e) in map.events.iter().enumerate() {
-        let earlier = map.events[..i].iter().find(|m| m.topic.value == e.topic.value && full(m) != full(e));
+    let full = |e: &EventEntry| crate::msgs::full_name(&e.ty.value).unwrap_or_else(|| e.ty.value.clone());
+    let known: Vec<&EventEntry> = map.events.iter().filter(|e| msgs.lookup(&e.ty.value).is_some()).collect();
+    for (i, e) in known.iter().enumerate() {
+        let earlier = known[..i].iter().find(|m| m.topic.value == e.topic.value && full(m) != full(e));
         if let Some(first) = earlier {
             out.push(
                 Diagnostic::error(
@@ -433,7 +454,7 @@ pub fn is_node_name(name: &str) -> bool {
 /// E0414: a `[[node]]` the bridge could not drive: a name that is not a
 /// ROS 2 node name, a failure event that is another agent's or carries a
 /// payload, a timeout that is not a duration.
-pub fn bad_nodes(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
+pub fn bad_nodes(model: &Model, map: &Map, _: &Registry, file: FileId) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     let bad = |s: &map::Str, message: String, label: &str, help: &str| {
         Diagnostic::error(codes::ROS2_BAD_NODE, message, file, s.span, label).with_help(help)

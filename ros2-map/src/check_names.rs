@@ -5,7 +5,7 @@
 
 use crate::expr::{self, BinOp, Expr, Func, Step};
 use crate::map::{EventEntry, Map, NodeEntry, Str};
-use crate::msgs;
+use crate::msgs::{self, Registry};
 use situ_compiler::codes;
 use situ_compiler::model::Model;
 use situ_grammar::diag::{Diagnostic, FileId};
@@ -135,7 +135,7 @@ pub fn corrected_topic(name: &str) -> Option<String> {
 }
 
 /// E0415: a `topic` that is not a fully qualified ROS 2 topic name.
-pub fn bad_topics(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
+pub fn bad_topics(_: &Model, map: &Map, _: &Registry, file: FileId) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for e in &map.events {
         let name = &e.topic.value;
@@ -173,7 +173,7 @@ pub fn bad_topics(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
 
 /// E0416: one lifecycle node given to two agents of the rules (an agent
 /// the rules do not have is E0405, most often a misspelling of the other).
-pub fn shared_nodes(model: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
+pub fn shared_nodes(model: &Model, map: &Map, _: &Registry, file: FileId) -> Vec<Diagnostic> {
     let known = |n: &NodeEntry| model.agents.iter().any(|a| a.name == n.agent.value);
     let mut out = Vec::new();
     for (i, n) in map.nodes.iter().enumerate().filter(|(_, n)| known(n)) {
@@ -247,7 +247,7 @@ fn payload(e: &EventEntry) -> Vec<(&str, String)> {
 /// agent, event, topic, type and `when` post the event twice for every
 /// message (with two payloads when theirs differ); two identical
 /// `[[node]]` say one thing twice.
-pub fn duplicates(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
+pub fn duplicates(_: &Model, map: &Map, _: &Registry, file: FileId) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for (i, e) in map.events.iter().enumerate() {
         let Some(first) = map.events[..i].iter().find(|m| source(m) == source(e)) else { continue };
@@ -308,7 +308,7 @@ pub fn is_bridge_topic(topic: &str) -> bool {
 }
 
 /// E0418: an entry that reads the bridge's own topics, `/situ/…`.
-pub fn own_topics(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
+pub fn own_topics(_: &Model, map: &Map, _: &Registry, file: FileId) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for e in map.events.iter().filter(|e| is_bridge_topic(&e.topic.value)) {
         out.push(
@@ -371,7 +371,7 @@ fn names_reporter(e: &Expr) -> bool {
 
 /// W0421: an entry that reads `/diagnostics`, where the bridge reports its
 /// own status, without naming the reporter of the status it reads.
-pub fn bridge_diagnostics(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
+pub fn bridge_diagnostics(_: &Model, map: &Map, _: &Registry, file: FileId) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for e in map.events.iter().filter(|e| e.topic.value == DIAGNOSTICS) {
         if e.when.as_ref().is_some_and(|w| names_its_reporter(&w.value)) {

@@ -22,7 +22,7 @@ rule towed salience 1 { when state == CHARGING and MOVING then DONE }
 fn codes_of(map: &str) -> Vec<&'static str> {
     let checked = check_source("rules.situ", RULES);
     assert_eq!(checked.errors(), 0, "{:?}", checked.diagnostics);
-    check_map(&checked.model, map, FileId(1)).into_iter().map(|d| d.code).collect()
+    check_map(&checked.model, map, &Registry::carried(), FileId(1)).into_iter().map(|d| d.code).collect()
 }
 
 fn raises(code: &str, maps: [&str; 3]) {
@@ -403,7 +403,7 @@ fn every_finding_at_once_and_in_the_map() {
         ev("Lidar", "CLEAR", "/scan", "sensor_msgs/Rang", "")
     );
     let checked = check_source("rules.situ", RULES);
-    let found = check_map(&checked.model, &map, FileId(1));
+    let found = check_map(&checked.model, &map, &Registry::carried(), FileId(1));
     let codes: Vec<_> = found.iter().map(|d| d.code).collect();
     for code in
         [codes::ROS2_UNKNOWN_FIELD, codes::ROS2_MISSING_PAYLOAD, codes::ROS2_UNKNOWN_TYPE, codes::ROS2_UNKNOWN_NAME]
@@ -428,17 +428,61 @@ fn blocks<'a>(doc: &'a str, heading: &str, lang: &str) -> Vec<&'a str> {
 
 #[test]
 fn the_examples_of_the_codes_are_real() {
-    for c in codes::ALL.iter().filter(|c| c.code.starts_with("E04") || c.code.starts_with("W04")) {
+    // The examples of E0422 and E0423 need definition files and folders:
+    // `the_examples_with_files_are_real` holds them to their codes.
+    let with_files = [codes::ROS2_BAD_DEFINITION, codes::ROS2_BAD_MSG_PATH];
+    let ros2 = |c: &&codes::Code| c.code.starts_with("E04") || c.code.starts_with("W04");
+    for c in codes::ALL.iter().filter(ros2).filter(|c| !with_files.contains(&c.code)) {
         for (heading, raised) in [("## Example", true), ("## Use instead", false)] {
             let rules = blocks(c.explain, heading, "situ");
             let maps = blocks(c.explain, heading, "toml");
             assert!(!rules.is_empty() && !maps.is_empty(), "{}: {heading} needs rules and a map", c.code);
             let checked = check_source("rules.situ", rules[0]);
             assert_eq!(checked.errors(), 0, "{}: {heading}: the rules have errors", c.code);
-            let found: Vec<_> = check_map(&checked.model, maps[0], FileId(1)).into_iter().map(|d| d.code).collect();
+            let found: Vec<_> = check_map(&checked.model, maps[0], &Registry::carried(), FileId(1))
+                .into_iter()
+                .map(|d| d.code)
+                .collect();
             assert_eq!(found.contains(&c.code), raised, "{}: {heading}: found {found:?}", c.code);
         }
     }
+}
+
+/// The findings of `map` (rules `rules`) checked in folder `dir` with
+/// `--msg-path DIR/robot_msgs` when `msg_path` is set.
+fn codes_in(dir: &std::path::Path, rules: &str, map: &str, msg_path: bool) -> Vec<&'static str> {
+    let checked = check_source("rules.situ", rules);
+    assert_eq!(checked.errors(), 0, "{:?}", checked.diagnostics);
+    let user = if msg_path { vec![dir.join("robot_msgs")] } else { Vec::new() };
+    let (found, _) = crate::load::check_map_file(&checked.model, map, dir, &user, FileId(1));
+    found.into_iter().map(|d| d.code).collect()
+}
+
+#[test]
+fn the_examples_with_files_are_real() {
+    let dir = std::env::temp_dir().join(format!("situ-code-examples-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let msg = dir.join("robot_msgs/msg");
+    std::fs::create_dir_all(&msg).unwrap();
+    // E0422: Arm.msg of the Example, then Gripper.msg of Use instead.
+    let doc = codes::lookup("E0422").unwrap().explain;
+    let (example, fix) = (blocks(doc, "## Example", "text"), blocks(doc, "## Use instead", "text"));
+    std::fs::write(msg.join("Arm.msg"), example[0]).unwrap();
+    let (rules, map) = (blocks(doc, "## Example", "situ")[0], blocks(doc, "## Example", "toml")[0]);
+    assert!(codes_in(&dir, rules, map, true).contains(&codes::ROS2_BAD_DEFINITION));
+    std::fs::write(msg.join("Gripper.msg"), fix[0]).unwrap();
+    let (rules, map) = (blocks(doc, "## Use instead", "situ")[0], blocks(doc, "## Example", "toml")[0]);
+    assert!(!codes_in(&dir, rules, map, true).contains(&codes::ROS2_BAD_DEFINITION));
+    // E0423: the map in `dir/maps`, the package in `dir/robot_msgs`.
+    let doc = codes::lookup("E0423").unwrap().explain;
+    let maps = dir.join("maps");
+    std::fs::create_dir_all(&maps).unwrap();
+    let (rules, map) = (blocks(doc, "## Example", "situ")[0], blocks(doc, "## Example", "toml")[0]);
+    assert!(codes_in(&maps, rules, map, false).contains(&codes::ROS2_BAD_MSG_PATH));
+    let (rules, map) = (blocks(doc, "## Use instead", "situ")[0], blocks(doc, "## Use instead", "toml")[0]);
+    let found = codes_in(&maps, rules, map, false);
+    assert!(!found.contains(&codes::ROS2_BAD_MSG_PATH) && !found.contains(&codes::ROS2_UNKNOWN_TYPE), "{found:?}");
+    let _ = std::fs::remove_dir_all(dir);
 }
 
 #[test]
@@ -448,7 +492,7 @@ fn deep_and_long_inputs_are_refused_not_crashed() {
     let deep_table = format!("x = {}", "{a = ".repeat(100_000));
     let long_chain = scan("CLEAR", &format!("when = \"{} > 1\"", vec!["range_max"; 255].join(" + ")));
     for map in [deep_array, deep_table, long_chain] {
-        let _ = check_map(&checked.model, &map, FileId(1));
+        let _ = check_map(&checked.model, &map, &Registry::carried(), FileId(1));
     }
 }
 
@@ -470,7 +514,7 @@ mod no_panic {
             while !map.is_char_boundary(end) { end -= 1; }
             let mutated = format!("{}{}{}", &map[..at], insert, &map[end..]);
             let checked = check_source("rules.situ", RULES);
-            for d in check_map(&checked.model, &mutated, FileId(1)) {
+            for d in check_map(&checked.model, &mutated, &Registry::carried(), FileId(1)) {
                 prop_assert!(d.primary.span.start <= d.primary.span.end && d.primary.span.end <= mutated.len());
             }
         }
@@ -481,7 +525,7 @@ mod no_panic {
             let _ = crate::expr::parse(&text);
             let map = scan("CLEAR", &format!("when = {text:?}"));
             let checked = check_source("rules.situ", RULES);
-            let _ = check_map(&checked.model, &map, FileId(1));
+            let _ = check_map(&checked.model, &map, &Registry::carried(), FileId(1));
         }
     }
 }
@@ -489,7 +533,7 @@ mod no_panic {
 /// The findings of `code` in `map`.
 fn findings(map: &str, code: &str) -> Vec<Diagnostic> {
     let checked = check_source("rules.situ", RULES);
-    check_map(&checked.model, map, FileId(1)).into_iter().filter(|d| d.code == code).collect()
+    check_map(&checked.model, map, &Registry::carried(), FileId(1)).into_iter().filter(|d| d.code == code).collect()
 }
 
 /// The text of the map at a finding's place.
@@ -679,4 +723,98 @@ fn timeouts_are_written_as_the_rules_write_durations() {
     let map = node("Planner", "/p", "timeout = \"soon\"");
     let d = &findings(&map, codes::ROS2_BAD_NODE)[0];
     assert!(d.help.as_deref().is_some_and(|h| h.contains("`\"1.5s\"`")) && d.fixes.is_empty(), "{d:?}");
+}
+
+#[test]
+fn an_unknown_type_raises_no_follow_on_topic_finding() {
+    spares(
+        codes::ROS2_TOPIC_TYPES,
+        [
+            &(scan("CLEAR", "") + &ev("Lidar", "OBSTACLE", "/scan", "sensor_msgs/LaserScna", "")),
+            &(ev("Lidar", "OBSTACLE", "/scan", "robot_msgs/Scan", "") + &scan("CLEAR", "")),
+            &(scan("CLEAR", "") + &ev("Lidar", "OBSTACLE", "/scan", "LaserScan", "")),
+        ],
+    );
+}
+
+fn help_of(map: &str, code: &str) -> String {
+    let checked = check_source("rules.situ", RULES);
+    let found = check_map(&checked.model, map, &Registry::carried(), FileId(1));
+    let d = found.iter().find(|d| d.code == code).unwrap_or_else(|| panic!("no {code} in {found:?}"));
+    d.help.clone().unwrap_or_default()
+}
+
+#[test]
+fn an_unknown_type_lists_the_types_of_its_package_or_where_situ_looked() {
+    let help = help_of(&ev("Lidar", "CLEAR", "/scan", "sensor_msgs/msg/LaserScn", ""), codes::ROS2_UNKNOWN_TYPE);
+    assert!(help.starts_with("did you mean `sensor_msgs/msg/LaserScan`? `sensor_msgs` has: BatteryState, "), "{help}");
+    assert!(help.contains(", JointState, "), "{help}");
+    let help = help_of(&ev("Lidar", "CLEAR", "/scan", "sensor_msgs/Zzz", ""), codes::ROS2_UNKNOWN_TYPE);
+    assert!(help.starts_with("`sensor_msgs` has: BatteryState, "), "{help}");
+    let help = help_of(&ev("Lidar", "CLEAR", "/scan", "robot_msgs/Scan", ""), codes::ROS2_UNKNOWN_TYPE);
+    assert!(help.starts_with("no package `robot_msgs` in: the definitions situ carries; "), "{help}");
+    let help = help_of(&ev("Lidar", "CLEAR", "/scan", "Scan", ""), codes::ROS2_UNKNOWN_TYPE);
+    assert_eq!(help, "write the type as `package/msg/Name` or `package/Name`");
+}
+
+fn battery(when: &str) -> String {
+    ev("Battery", "LOW", "/battery", "sensor_msgs/BatteryState", &format!("when = \"{when}\""))
+}
+
+fn diag(when: &str) -> String {
+    ev("Diag", "FAULT", "/diagnostics", "diagnostic_msgs/DiagnosticArray", &format!("when = \"{when}\""))
+}
+
+#[test]
+fn constants_by_name() {
+    let fine = [
+        battery("power_supply_status == POWER_SUPPLY_STATUS_CHARGING"),
+        diag("len(status) > 0 and status[0].level >= DiagnosticStatus.ERROR"),
+        ev("Lidar", "CLEAR", "/fix", "sensor_msgs/NavSatFix", "when = \"status.status == NavSatStatus.STATUS_FIX\""),
+    ];
+    for code in [codes::ROS2_UNKNOWN_FIELD, codes::ROS2_TYPE_MISMATCH, codes::ROS2_WHEN_NOT_BOOL] {
+        spares(code, [&fine[0], &fine[1], &fine[2]]);
+    }
+    raises(
+        codes::ROS2_TYPE_MISMATCH,
+        [
+            &battery("present == POWER_SUPPLY_STATUS_CHARGING"),
+            &battery("POWER_SUPPLY_STATUS_CHARGING and present"),
+            &diag("status[0].name == DiagnosticStatus.WARN"),
+        ],
+    );
+    raises(
+        codes::ROS2_UNKNOWN_FIELD,
+        [
+            &battery("power_supply_status == POWER_SUPPLY_STATUS_CHARGNG"),
+            // KeyValue has no constants; Imu is not a type of DiagnosticArray's fields.
+            &diag("status[0].level == KeyValue.ERROR"),
+            &diag("status[0].level == Imu.ERROR"),
+        ],
+    );
+    let help = help_of(&battery("power_supply_status == CHARGING"), codes::ROS2_UNKNOWN_FIELD);
+    assert!(help.contains("; its constants: POWER_SUPPLY_STATUS_UNKNOWN, POWER_SUPPLY_STATUS_CHARGING, "), "{help}");
+    let help = help_of(&diag("status[0].level == DiagnosticStatus.EROR"), codes::ROS2_UNKNOWN_FIELD);
+    assert_eq!(
+        help,
+        "did you mean `DiagnosticStatus.ERROR`? `diagnostic_msgs/msg/DiagnosticStatus` has the constants: OK, WARN, ERROR, STALE"
+    );
+    let help = help_of(&diag("status[0].level == KeyValue.ERROR"), codes::ROS2_UNKNOWN_FIELD);
+    assert_eq!(help, "`diagnostic_msgs/msg/KeyValue` has no constants");
+}
+
+#[test]
+fn constants_type_as_their_type() {
+    let reg = Registry::carried();
+    let ty = |msg: &'static str, text: &str| {
+        let s = map::Str { value: text.to_string(), span: situ_grammar::ast::Span::new(0, 0), inner: None };
+        type_of(&s, msg, &reg, FileId(0)).ty
+    };
+    assert_eq!(ty("sensor_msgs/msg/BatteryState", "POWER_SUPPLY_STATUS_FULL"), Some(Ty::Int));
+    assert_eq!(ty("diagnostic_msgs/msg/DiagnosticArray", "DiagnosticStatus.STALE"), Some(Ty::Int));
+    assert_eq!(ty("diagnostic_msgs/msg/DiagnosticStatus", "DiagnosticStatus.OK"), Some(Ty::Int));
+    assert_eq!(ty("std_msgs/msg/Bool", "data"), Some(Ty::Bool));
+    // A field of the name wins over a type of the name.
+    assert_eq!(ty("sensor_msgs/msg/NavSatFix", "status.status"), Some(Ty::Int));
+    assert_eq!(ty("sensor_msgs/msg/BatteryState", "NOPE"), None);
 }

@@ -13,8 +13,11 @@ mod funcs;
 
 use crate::cdr::{self, Decoder};
 use crate::check::check_parsed;
-use crate::expr::{self, BinOp, Expr, Range, Reducer, Step};
+use crate::expr::{BinOp, Expr, Range, Reducer, Step};
 use crate::map;
+use crate::msgs::idl::ConstValue;
+use crate::msgs::Registry;
+use crate::types;
 use situ_compiler::bundle::Value;
 use situ_compiler::codes;
 use situ_compiler::model::{Model, Type};
@@ -485,28 +488,29 @@ pub struct Translator {
 
 impl Translator {
     /// The translator of the map `text` (file `file`) for the rules'
-    /// `model`; the map's error findings when it has any (warnings pass).
-    pub fn new(model: &Model, text: &str, file: FileId) -> Result<Translator, Vec<Diagnostic>> {
+    /// `model`, its messages as `msgs` defines them; the map's error
+    /// findings when it has any (warnings pass).
+    pub fn new(model: &Model, text: &str, msgs: &Registry, file: FileId) -> Result<Translator, Vec<Diagnostic>> {
         let parsed = map::parse(text, file).map_err(|d| vec![*d])?;
-        Translator::of(model, &parsed, file)
+        Translator::of(model, &parsed, msgs, file)
     }
 
     /// [`Translator::new`] of a map already parsed (from `file`).
-    pub fn of(model: &Model, parsed: &map::Map, file: FileId) -> Result<Translator, Vec<Diagnostic>> {
+    pub fn of(model: &Model, parsed: &map::Map, msgs: &Registry, file: FileId) -> Result<Translator, Vec<Diagnostic>> {
         let errors: Vec<Diagnostic> =
-            check_parsed(model, parsed, file).into_iter().filter(|d| d.severity == Severity::Error).collect();
+            check_parsed(model, parsed, msgs, file).into_iter().filter(|d| d.severity == Severity::Error).collect();
         if !errors.is_empty() {
             return Err(errors);
         }
         let mut topics: Vec<Topic> = Vec::new();
         for e in &parsed.events {
-            let entry = entry(model, e).ok_or_else(|| {
+            let entry = entry(model, e, msgs, file).ok_or_else(|| {
                 vec![Diagnostic::error(codes::ROS2_BAD_MAP, "entry not translatable", file, e.span, "")]
             })?;
             match topics.iter_mut().find(|t| t.name == e.topic.value) {
                 Some(t) => t.entries.push(entry),
                 None => {
-                    let Some(decoder) = Decoder::new(&e.ty.value) else {
+                    let Some(decoder) = Decoder::new(msgs, &e.ty.value) else {
                         let d = Diagnostic::error(codes::ROS2_UNKNOWN_TYPE, "unknown type", file, e.ty.span, "");
                         return Err(vec![d]);
                     };
@@ -564,13 +568,48 @@ impl Translator {
     }
 }
 
-fn source(s: &map::Str) -> Option<Source> {
-    Some(Source { expr: expr::parse(&s.value).ok()?, text: s.value.clone() })
+/// The expression of `s` on messages of type `msg`, each path that names a
+/// constant (as typing resolved it, scopes included) replaced by its value.
+fn source(s: &map::Str, msg: &'static str, msgs: &Registry, file: FileId) -> Option<Source> {
+    let typed = types::type_of(s, msg, msgs, file);
+    let mut expr = typed.expr?;
+    constants(&mut expr, &typed.constants);
+    Some(Source { expr, text: s.value.clone() })
+}
+
+/// Replaces each path of `e` whose range is one of `found` by its value.
+fn constants(e: &mut Expr, found: &[(Range, ConstValue)]) {
+    if found.is_empty() {
+        return;
+    }
+    match e {
+        Expr::Path(_, range) => {
+            let Some((_, value)) = found.iter().find(|(r, _)| r == range) else { return };
+            let range = *range;
+            *e = match value {
+                ConstValue::Bool(b) => Expr::Bool(*b, range),
+                ConstValue::Int(i) => Expr::Number(*i as f64, range),
+                ConstValue::Float(f) => Expr::Number(*f, range),
+                ConstValue::Str(s) => Expr::Str(s.clone(), range),
+            };
+        }
+        Expr::Number(..) | Expr::Str(..) | Expr::Bool(..) => {}
+        Expr::Neg(inner, _) | Expr::Not(inner, _) | Expr::Reduce(_, inner, _) | Expr::Member(inner, ..) => {
+            constants(inner, found)
+        }
+        Expr::Binary(_, l, r, _) | Expr::At(l, r, _) => {
+            constants(l, found);
+            constants(r, found);
+        }
+        Expr::Call(_, args, _) => args.iter_mut().for_each(|a| constants(a, found)),
+    }
 }
 
 /// The entry of a checked map's `[[event]]`; `None` only for a map that
 /// did not pass the check.
-fn entry(model: &Model, e: &map::EventEntry) -> Option<Entry> {
+fn entry(model: &Model, e: &map::EventEntry, msgs: &Registry, file: FileId) -> Option<Entry> {
+    let msg = msgs.lookup(&e.ty.value)?;
+    let source = |s: &map::Str| source(s, msg, msgs, file);
     let agent = model.agent_id(&e.agent.value)?;
     let event = model.event_id(&e.event.value)?;
     let def = model.event(event);

@@ -4,26 +4,26 @@
 //! are registered in [`crate::check`].
 
 use crate::map::Map;
-use crate::msgs;
+use crate::msgs::Registry;
 use crate::types::{type_of, Typed};
 use situ_compiler::model::Model;
 use situ_grammar::diag::{Diagnostic, FileId};
 
 /// Every expression of the map whose message type is known, typed.
-fn typed(map: &Map, file: FileId) -> impl Iterator<Item = Typed> + '_ {
+fn typed<'a>(map: &'a Map, msgs: &'a Registry, file: FileId) -> impl Iterator<Item = Typed> + 'a {
     map.events.iter().flat_map(move |e| {
-        let msg = msgs::lookup(&e.ty.value);
+        let msg = msgs.lookup(&e.ty.value);
         let texts = e.when.iter().chain(e.payload.iter().map(|(_, v)| v));
-        texts.filter_map(move |t| Some(type_of(t, msg?, file)))
+        texts.filter_map(move |t| Some(type_of(t, msg?, msgs, file)))
     })
 }
 
 /// E0419: `x / 0`, `x / (1 - 1)`: a value never defined.
-pub fn zero_divisions(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
-    typed(map, file).flat_map(|t| t.zero_divisions).collect()
+pub fn zero_divisions(_: &Model, map: &Map, msgs: &Registry, file: FileId) -> Vec<Diagnostic> {
+    typed(map, msgs, file).flat_map(|t| t.zero_divisions).collect()
 }
 
 /// E0420: `status[0.0]`, `status['motor']`, `status[true]`.
-pub fn non_integer_indexes(_: &Model, map: &Map, file: FileId) -> Vec<Diagnostic> {
-    typed(map, file).flat_map(|t| t.indexes).collect()
+pub fn non_integer_indexes(_: &Model, map: &Map, msgs: &Registry, file: FileId) -> Vec<Diagnostic> {
+    typed(map, msgs, file).flat_map(|t| t.indexes).collect()
 }

@@ -173,6 +173,8 @@ fn meant(text: &str) -> Option<String> {
 /// A parsed map.
 #[derive(Debug, Clone, Default)]
 pub struct Map {
+    /// `msg_path`: folders of message definitions, relative to the map file.
+    pub msg_path: Vec<Str>,
     pub events: Vec<EventEntry>,
     pub nodes: Vec<NodeEntry>,
 }
@@ -180,6 +182,8 @@ pub struct Map {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawMap {
+    #[serde(default)]
+    msg_path: Vec<Spanned<String>>,
     #[serde(default)]
     event: Vec<RawEvent>,
     #[serde(default)]
@@ -247,7 +251,7 @@ pub fn parse(text: &str, file: FileId) -> Result<Map, Box<Diagnostic>> {
         .into_iter()
         .map(|n| NodeEntry { agent: s(n.agent), node: s(n.node), failed: n.failed.map(s), timeout: n.timeout.map(s) })
         .collect();
-    Ok(Map { events, nodes })
+    Ok(Map { msg_path: raw.msg_path.into_iter().map(s).collect(), events, nodes })
 }
 
 /// The help of a TOML error on a line whose string a quote of the same kind

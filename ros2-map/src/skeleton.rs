@@ -71,10 +71,15 @@ mod tests {
         let checked = check_source("amr.situ", rules);
         let content = bundle::build(&checked);
         let skeleton = model_of(&content, FileId(0));
-        assert!(crate::check_map(&skeleton, map, FileId(1)).is_empty());
+        assert!(crate::check_map(&skeleton, map, &crate::Registry::carried(), FileId(1)).is_empty());
         // A mistake is found the same way.
         let bad = map.replace("pose.position.x", "pose.position.q");
-        let codes = |m: &Model| crate::check_map(m, &bad, FileId(1)).into_iter().map(|d| d.code).collect::<Vec<_>>();
+        let codes = |m: &Model| {
+            crate::check_map(m, &bad, &crate::Registry::carried(), FileId(1))
+                .into_iter()
+                .map(|d| d.code)
+                .collect::<Vec<_>>()
+        };
         assert_eq!(codes(&skeleton), codes(&checked.model));
         assert!(!codes(&skeleton).is_empty());
     }

@@ -1,5 +1,6 @@
-//! Types of map expressions against a message: every field path is looked up
-//! in the catalogue, every operator and function checked. The findings are
+//! Types of map expressions against a message: every field path (or
+//! constant) is looked up in the registry of message definitions, every
+//! operator and function checked. The findings are
 //! sorted by kind so that each check of [`crate::check`] reports its own.
 //!
 //! The second argument of `any all count min max mean find` is typed in the
@@ -8,7 +9,8 @@
 
 use crate::expr::{self, BinOp, Expr, Func, Reducer, Step};
 use crate::map::Str;
-use crate::msgs::{self, FieldType, Prim};
+use crate::msgs::idl::{self, ConstValue};
+use crate::msgs::{FieldType, Prim, Registry};
 use situ_compiler::codes;
 use situ_compiler::suggest::suggest;
 use situ_grammar::diag::{Diagnostic, FileId};
@@ -82,10 +84,15 @@ pub struct Typed {
     pub indexes: Vec<Diagnostic>,
     /// The parsed expression.
     pub expr: Option<Expr>,
+    /// The paths that name a constant (`STATUS_ABORTED`,
+    /// `DiagnosticStatus.ERROR`), by their range, and its value: what the
+    /// translator puts in their place.
+    pub constants: Vec<(expr::Range, ConstValue)>,
 }
 
-/// Parses and types `text` (a `when` or a payload value) on message `msg`.
-pub fn type_of(text: &Str, msg: &'static str, file: FileId) -> Typed {
+/// Parses and types `text` (a `when` or a payload value) on message `msg`
+/// of the registry `reg`.
+pub fn type_of(text: &Str, msg: &'static str, reg: &Registry, file: FileId) -> Typed {
     let mut out = Typed::default();
     match expr::parse(&text.value) {
         Err(e) => {
@@ -107,7 +114,7 @@ pub fn type_of(text: &Str, msg: &'static str, file: FileId) -> Typed {
             );
         }
         Ok(e) => {
-            let mut cx = Cx { text, msg, file, out: &mut out, scope: None };
+            let mut cx = Cx { text, msg, reg, file, out: &mut out, scope: None };
             let ty = cx.ty(&e);
             out.ty = ty;
             out.expr = Some(e);
@@ -119,6 +126,7 @@ pub fn type_of(text: &Str, msg: &'static str, file: FileId) -> Typed {
 struct Cx<'a> {
     text: &'a Str,
     msg: &'static str,
+    reg: &'a Registry,
     file: FileId,
     out: &'a mut Typed,
     /// The element scope of the innermost `any(array, …)` and its kind.
@@ -136,20 +144,20 @@ struct Scope {
     array: String,
 }
 
-/// The type of field `name` of message `m`: where typing reads the catalogue.
-fn field_of(m: &'static str, name: &str) -> Option<Ty> {
-    msgs::field(m, name).map(|t| Ty::of(&t))
+/// The type of field `name` of message `m`: where typing reads the definitions.
+fn field_of(reg: &Registry, m: &'static str, name: &str) -> Option<Ty> {
+    reg.field(m, name).map(|t| Ty::of(&t))
 }
 
 /// The names of the fields of message `m`, in order.
-fn field_names(m: &'static str) -> Vec<&'static str> {
-    msgs::fields(m).into_iter().map(|(n, _)| n).collect()
+fn field_names(reg: &Registry, m: &'static str) -> Vec<&'static str> {
+    reg.fields(m).into_iter().map(|(n, _)| n).collect()
 }
 
 /// Whether `t` is a message with numeric fields of every one of `names`.
-fn has_numbers(t: &Ty, names: &[&str]) -> bool {
+fn has_numbers(reg: &Registry, t: &Ty, names: &[&str]) -> bool {
     match t {
-        Ty::Msg(m) => names.iter().all(|n| field_of(m, n).is_some_and(|f| f.is_numeric())),
+        Ty::Msg(m) => names.iter().all(|n| field_of(reg, m, n).is_some_and(|f| f.is_numeric())),
         _ => false,
     }
 }
@@ -212,7 +220,7 @@ impl Cx<'_> {
             Expr::Number(n, _) => Some(if n.fract() == 0.0 { Ty::Int } else { Ty::Float }),
             Expr::Str(..) => Some(Ty::Str),
             Expr::Bool(..) => Some(Ty::Bool),
-            Expr::Path(steps, _) => self.path(steps),
+            Expr::Path(steps, r) => self.path(steps, *r),
             Expr::Neg(inner, r) => match self.ty(inner)? {
                 t if t.is_numeric() => Some(t),
                 t => self.mismatch(
@@ -311,11 +319,50 @@ impl Cx<'_> {
         }
     }
 
-    fn path(&mut self, steps: &[Step]) -> Option<Ty> {
+    /// E0403 for `Type.NAME` where `Type` is `msg` or the type of one of
+    /// its fields but has no constant `NAME`.
+    fn missing_constant(&self, msg: &'static str, steps: &[Step]) -> Option<Diagnostic> {
+        let [Step::Field(ty, _), Step::Field(name, r)] = steps else { return None };
+        if self.reg.field(msg, ty).is_some() || (ty == "it" && self.scope.is_some()) {
+            return None;
+        }
+        let def = self.reg.reachable(msg, ty).into_iter().next()?;
+        let names: Vec<&str> = def.constants.iter().map(|c| c.name.as_str()).collect();
+        let listed = match names.as_slice() {
+            [] => format!("`{}` has no constants", def.name),
+            _ => format!("`{}` has the constants: {}", def.name, names.join(", ")),
+        };
+        let help = match suggest(name, names.iter().copied()) {
+            Some(s) => format!("did you mean `{ty}.{s}`? {listed}"),
+            None => listed,
+        };
+        let message = format!("`{}` has no constant `{name}`", def.name);
+        let span = self.text.sub(r.0, r.1);
+        Some(Diagnostic::error(codes::ROS2_UNKNOWN_FIELD, message, self.file, span, "not a constant").with_help(help))
+    }
+
+    /// A field path, or a constant: `NAME` of the element's message in an
+    /// element's scope, then of the message; `Type.NAME` of a message
+    /// reachable from either.
+    fn path(&mut self, steps: &[Step], range: expr::Range) -> Option<Ty> {
+        let element = match self.scope.as_ref().map(|s| &s.el) {
+            Some(Ty::Msg(m)) => Some(*m),
+            _ => None,
+        };
+        for msg in element.into_iter().chain([self.msg]) {
+            if let Some((ty, value)) = constant_of(self.reg, msg, steps) {
+                self.out.constants.push((range, value));
+                return Some(ty);
+            }
+        }
+        if let Some(found) = self.missing_constant(element.unwrap_or(self.msg), steps) {
+            self.out.paths.push(found);
+            return None;
+        }
         let Some(scope) = self.scope.clone() else { return self.path_from(Ty::Msg(self.msg), steps) };
         let Some((Step::Field(name, r), rest)) = steps.split_first() else { return None };
         let is_field = match &scope.el {
-            Ty::Msg(m) => field_of(m, name).is_some(),
+            Ty::Msg(m) => field_of(self.reg, m, name).is_some(),
             _ => false,
         };
         if name == "it" && !is_field {
@@ -332,7 +379,7 @@ impl Cx<'_> {
         let (f, array) = (scope.func, &scope.array);
         let (message, help) = match &scope.el {
             Ty::Msg(m) => {
-                let all = field_names(m);
+                let all = field_names(self.reg, m);
                 let near = suggest(name, all.iter().copied()).map(|s| format!("did you mean `{s}`? ")).unwrap_or_default();
                 (
                     format!("`{m}`, an element of `{array}`, has no field `{name}`"),
@@ -360,15 +407,26 @@ impl Cx<'_> {
         let mut ty = start;
         for step in steps {
             ty = match (step, &ty) {
-                (Step::Field(name, r), Ty::Msg(m)) => match field_of(m, name) {
+                (Step::Field(name, r), Ty::Msg(m)) => match field_of(self.reg, m, name) {
                     Some(t) => t,
                     None => {
-                        let all = field_names(m);
+                        let mut all = field_names(self.reg, m);
+                        let fields = all.len();
+                        let constants = self.reg.constants(m);
+                        all.extend(constants.iter().map(|c| c.name.as_str()));
                         let near = suggest(name, all.iter().copied());
+                        let listed = match (fields == 0, constants.is_empty()) {
+                            (true, true) => format!("`{m}` has no fields"),
+                            (_, true) => format!("`{m}` has: {}", all.join(", ")),
+                            (true, false) => format!("`{m}` has no fields; its constants: {}", all.join(", ")),
+                            (false, false) => {
+                                let (f, c) = all.split_at(fields);
+                                format!("`{m}` has: {}; its constants: {}", f.join(", "), c.join(", "))
+                            }
+                        };
                         let help = match near {
-                            Some(s) => format!("did you mean `{s}`? `{m}` has: {}", all.join(", ")),
-                            None if all.is_empty() => format!("`{m}` has no fields"),
-                            None => format!("`{m}` has: {}", all.join(", ")),
+                            Some(s) => format!("did you mean `{s}`? {listed}"),
+                            None => listed,
                         };
                         let span = self.text.sub(r.0, r.1);
                         self.out.paths.push(
@@ -592,11 +650,11 @@ impl Cx<'_> {
             }
             Func::Norm => match self.ty(first)? {
                 Ty::Array(el, _) if Ty::of(&el).is_numeric() => Some(Ty::Float),
-                t if has_numbers(&t, &["x", "y", "z"]) => Some(Ty::Float),
+                t if has_numbers(self.reg, &t, &["x", "y", "z"]) => Some(Ty::Float),
                 t => self.bad_arg(f, first, "a vector (numeric `x y z`, or an array of numbers)", &t),
             },
             _ => match self.ty(first)? {
-                t if has_numbers(&t, &["x", "y", "z", "w"]) => Some(Ty::Float),
+                t if has_numbers(self.reg, &t, &["x", "y", "z", "w"]) => Some(Ty::Float),
                 t => self.bad_arg(f, first, "a quaternion (numeric `x y z w`)", &t),
             },
         }
@@ -609,6 +667,26 @@ impl Cx<'_> {
             t => self.bad_arg(f, e, "an array", &t),
         }
     }
+}
+
+/// The type and value of the constant a path names on `msg`, if it names
+/// one (see [`Registry::path_constant`]).
+fn constant_of(reg: &Registry, msg: &str, steps: &[Step]) -> Option<(Ty, ConstValue)> {
+    let names: Vec<&str> = steps
+        .iter()
+        .map(|s| match s {
+            Step::Field(n, _) => Some(n.as_str()),
+            Step::Index(..) => None,
+        })
+        .collect::<Option<_>>()?;
+    let c = reg.path_constant(msg, &names)?;
+    let ty = match (&c.value, c.ty) {
+        (ConstValue::Bool(_), _) => Ty::Bool,
+        (ConstValue::Str(_), _) => Ty::Str,
+        (_, p) if idl::Prim::is_float(p) => Ty::Float,
+        (ConstValue::Float(_), _) | (ConstValue::Int(_), _) => Ty::Int,
+    };
+    Some((ty, c.value.clone()))
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@ const IMU: &str = "sensor_msgs/msg/Imu";
 
 fn typed(text: &str, msg: &'static str) -> Typed {
     let s = Str { value: text.to_string(), span: Span::new(0, text.len()), inner: Some(0) };
-    type_of(&s, msg, FileId(1))
+    type_of(&s, msg, &crate::msgs::Registry::carried(), FileId(1))
 }
 
 fn ty(text: &str, msg: &'static str) -> Ty {

@@ -1,8 +1,9 @@
 //! The CDR decoder against an independent implementation: Eclipse Cyclone
 //! DDS (the `cyclonedds` Python package, one of ROS 2's middlewares)
-//! serializes messages of the catalogue (`cdr_samples.py`), and every field
-//! decoded here must be the value it was given. Then the clean map of
-//! `tests/ros2/delivery.toml` is evaluated on those messages.
+//! serializes messages of the carried definitions and of a package of the
+//! tests' own (`cdr_samples.py`), and every field decoded here must be the
+//! value it was given. Then the clean map of `tests/ros2/delivery.toml`, and
+//! a map with constants on the tests' own package, are evaluated on them.
 //!
 //! A missing `python3` or `cyclonedds` fails the test: install the test
 //! requirements with `python3 -m pip install -r examples/python/requirements.txt`.
@@ -12,6 +13,7 @@ use situ_compiler::bundle::Value;
 use situ_grammar::diag::FileId;
 use situ_ros2_map::cdr::{Decoder, Value as Msg};
 use situ_ros2_map::eval::Produced;
+use situ_ros2_map::msgs::{Registry, SearchPath};
 use situ_ros2_map::Translator;
 use std::path::Path;
 use std::process::Command;
@@ -56,6 +58,13 @@ fn samples() -> Vec<Sample> {
     samples
 }
 
+/// The carried definitions and the tests' own package `arm_msgs`
+/// (`tests/ros2/msgs`, a folder of packages).
+fn registry() -> Registry {
+    let msgs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/ros2/msgs");
+    Registry::load(&SearchPath::with_ament(&[msgs], None))
+}
+
 /// The leaves of a decoded value.
 fn leaves(v: &Msg) -> usize {
     match v {
@@ -94,10 +103,11 @@ fn same(got: &Msg, want: &Json, f32: bool) -> bool {
 #[test]
 fn decodes_what_cyclonedds_serializes() {
     let samples = samples();
+    let reg = registry();
     let mut types = std::collections::BTreeSet::new();
     let mut checked = 0;
     for s in &samples {
-        let decoder = Decoder::new(&s.ty).unwrap_or_else(|| panic!("{}: {} is not in the catalogue", s.name, s.ty));
+        let decoder = Decoder::new(&reg, &s.ty).unwrap_or_else(|| panic!("{}: {} is not defined", s.name, s.ty));
         let v = decoder.decode(&s.cdr).unwrap_or_else(|e| panic!("{}: {e}", s.name));
         let mut leaf_count = 0;
         for (path, want) in &s.expect {
@@ -130,6 +140,9 @@ fn decodes_what_cyclonedds_serializes() {
         "std_msgs/msg/Bool",
         "sensor_msgs/msg/NavSatFix",
         "sensor_msgs/msg/Imu",
+        "sensor_msgs/msg/JointState",
+        "action_msgs/msg/GoalStatusArray",
+        "arm_msgs/msg/ArmStatus",
     ] {
         assert!(types.contains(ty), "no sample of {ty}");
     }
@@ -144,7 +157,7 @@ fn delivery_map_on_cyclonedds_messages() {
     let checked = situ_compiler::check_source("tests/ros2/delivery.situ", RULES);
     assert_eq!(checked.errors(), 0, "{:?}", checked.diagnostics);
     let model = &checked.model;
-    let mut t = Translator::new(model, MAP, FileId(1)).unwrap_or_else(|d| panic!("{d:?}"));
+    let mut t = Translator::new(model, MAP, &Registry::carried(), FileId(1)).unwrap_or_else(|d| panic!("{d:?}"));
     let ev = |agent: &str, event: &str, payload: Vec<Value>| Produced {
         agent: model.agent_id(agent).expect("agent").0,
         event: model.event_id(event).expect("event").0,
@@ -192,4 +205,80 @@ fn delivery_map_on_cyclonedds_messages() {
     let stats = t.stats();
     // `scan_empty` in both byte orders, two entries each.
     assert_eq!((stats.messages, stats.refused, stats.failed), (27, 1, 4));
+}
+
+const ARM_RULES: &str = "
+states { IDLE initial MOVING FAULT final }
+agent Arm sensor { event ARM_MOVING { speed: f64, tool: {suction, none} } event ARM_FAULT { forces: i64 } }
+agent Nav processing { event NAV_ABORTED }
+rule go { when state == IDLE and ARM_MOVING then MOVING }
+rule fault salience 5 { when state != FAULT and ARM_FAULT then FAULT }
+rule abort salience 5 { when state != FAULT and NAV_ABORTED then FAULT }
+";
+
+/// Constants by name in conditions and payloads: of the message
+/// (`MODE_MOVING`), of the message by its type (`ArmStatus.MODE_FAULT`),
+/// of a field's type (`GoalStatus.STATUS_ABORTED`).
+const ARM_MAP: &str = r#"
+[[event]]
+agent = "Arm"
+event = "ARM_MOVING"
+topic = "/arm"
+type = "arm_msgs/ArmStatus"
+when = "mode == MODE_MOVING and not gripper.closed"
+[event.payload]
+speed = "MAX_SPEED * 2"
+tool = "tool"
+
+[[event]]
+agent = "Arm"
+event = "ARM_FAULT"
+topic = "/arm"
+type = "arm_msgs/msg/ArmStatus"
+when = "mode == ArmStatus.MODE_FAULT and gripper.closed"
+[event.payload]
+forces = "len(gripper.forces) + Gripper.LIMIT"
+
+[[event]]
+agent = "Nav"
+event = "NAV_ABORTED"
+topic = "/navigate_to_pose/_action/status"
+type = "action_msgs/msg/GoalStatusArray"
+when = "len(status_list) > 1 and status_list[1].status == GoalStatus.STATUS_ABORTED"
+"#;
+
+#[test]
+fn constants_and_a_package_of_its_own_on_cyclonedds_messages() {
+    let checked = situ_compiler::check_source("arm.situ", ARM_RULES);
+    assert_eq!(checked.errors(), 0, "{:?}", checked.diagnostics);
+    let model = &checked.model;
+    let reg = registry();
+    // `Gripper.LIMIT` is not a constant: the map is refused, the help says what there is.
+    let errors = Translator::new(model, ARM_MAP, &reg, FileId(1)).unwrap_err();
+    assert_eq!(errors.len(), 1, "{errors:?}");
+    assert_eq!(errors[0].message, "`arm_msgs/msg/Gripper` has no constant `LIMIT`");
+    assert_eq!(errors[0].help.as_deref(), Some("`arm_msgs/msg/Gripper` has no constants"));
+    let map = ARM_MAP.replace(" + Gripper.LIMIT", " + 10 * ArmStatus.MODE_FAULT");
+    let mut t = Translator::new(model, &map, &reg, FileId(1)).unwrap_or_else(|d| panic!("{d:?}"));
+    let ev = |agent: &str, event: &str, payload: Vec<Value>| Produced {
+        agent: model.agent_id(agent).expect("agent").0,
+        event: model.event_id(event).expect("event").0,
+        payload,
+    };
+    let mut seen = 0;
+    for s in samples() {
+        let base = s.name.strip_suffix("_be").unwrap_or(&s.name);
+        let (topic, want) = match base {
+            "arm_moving" => ("/arm", vec![ev("Arm", "ARM_MOVING", vec![Value::F64(3.0), Value::Symbol(0)])]),
+            "arm_fault" => ("/arm", vec![ev("Arm", "ARM_FAULT", vec![Value::I64(20)])]),
+            "goal_status" => ("/navigate_to_pose/_action/status", vec![ev("Nav", "NAV_ABORTED", vec![])]),
+            "goal_status_empty" => ("/navigate_to_pose/_action/status", vec![]),
+            _ => continue,
+        };
+        let out = t.on_message(topic, &s.cdr);
+        assert_eq!(out.produced, want, "{}: {:?}", s.name, out.problems);
+        assert!(out.problems.is_empty(), "{}: {:?}", s.name, out.problems);
+        seen += 1;
+    }
+    assert_eq!(seen, 8);
 }

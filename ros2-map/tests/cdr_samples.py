@@ -203,6 +203,7 @@ class Range(IdlStruct, typename="sensor_msgs::msg::dds_::Range_"):
     min_range: f32 = 0.0
     max_range: f32 = 0.0
     range: f32 = 0.0
+    variance: f32 = 0.0  # since ROS 2 Jazzy
 
 
 @dataclass
@@ -230,6 +231,54 @@ class DiagnosticArray(IdlStruct, typename="diagnostic_msgs::msg::dds_::Diagnosti
 class State(IdlStruct, typename="lifecycle_msgs::msg::dds_::State_"):
     id: t.uint8 = 0
     label: str = ""
+
+
+@dataclass
+class JointState(IdlStruct, typename="sensor_msgs::msg::dds_::JointState_"):
+    header: Header = field(default_factory=Header)
+    name: t.sequence[str] = field(default_factory=list)
+    position: t.sequence[f64] = field(default_factory=list)
+    velocity: t.sequence[f64] = field(default_factory=list)
+    effort: t.sequence[f64] = field(default_factory=list)
+
+
+@dataclass
+class UUID(IdlStruct, typename="unique_identifier_msgs::msg::dds_::UUID_"):
+    uuid: t.array[t.uint8, 16] = field(default_factory=lambda: [0] * 16)
+
+
+@dataclass
+class GoalInfo(IdlStruct, typename="action_msgs::msg::dds_::GoalInfo_"):
+    goal_id: UUID = field(default_factory=UUID)
+    stamp: Time = field(default_factory=Time)
+
+
+@dataclass
+class GoalStatus(IdlStruct, typename="action_msgs::msg::dds_::GoalStatus_"):
+    goal_info: GoalInfo = field(default_factory=GoalInfo)
+    status: t.int8 = 0
+
+
+@dataclass
+class GoalStatusArray(IdlStruct, typename="action_msgs::msg::dds_::GoalStatusArray_"):
+    status_list: t.sequence[GoalStatus] = field(default_factory=list)
+
+
+# A package of the tests' own: tests/ros2/msgs/arm_msgs.
+@dataclass
+class Gripper(IdlStruct, typename="arm_msgs::msg::dds_::Gripper_"):
+    gap: f32 = 0.0
+    closed: bool = False
+    forces: t.sequence[t.int16, 4] = field(default_factory=list)
+
+
+@dataclass
+class ArmStatus(IdlStruct, typename="arm_msgs::msg::dds_::ArmStatus_"):
+    header: Header = field(default_factory=Header)
+    mode: t.uint8 = 0
+    joints: t.array[f64, 6] = field(default_factory=lambda: [0.0] * 6)
+    gripper: Gripper = field(default_factory=Gripper)
+    tool: t.bounded_str[32] = ""
 
 
 def full_name(msg) -> str:
@@ -308,9 +357,19 @@ def samples():
     yield "navsat_nofix", NavSatFix(header(frame="gps"), NavSatStatus(-1, 1), nan, nan, nan, [0.0] * 9, 0)
     yield "imu", Imu(header(frame="imu"), Quaternion(0.0, 0.0, 0.0, 1.0), [0.01, 0, 0, 0, 0.01, 0, 0, 0, 0.01],
                      Vector3(0.001, -0.002, 0.3), [-1.0] + [0.0] * 8, Vector3(0.0, 0.1, 9.81), [0.1] * 9)
-    yield "range", Range(header(frame="sonar"), 0, 0.5, 0.02, 4.0, 1.234)
+    yield "range", Range(header(frame="sonar"), 0, 0.5, 0.02, 4.0, 1.234, 0.0004)
     yield "pose_stamped", PoseStamped(header(frame="map"), Pose(Point(3.0, 4.0, 0.0), Quaternion()))
     yield "state", State(3, "active")
+    yield "joint_state", JointState(header(frame=""), ["shoulder", "elbow", "wrist"], [0.1, -1.2, 3.0],
+                                    [0.0, 0.5, -0.25], [])
+    yield "joint_state_empty", JointState(header(0, 0, ""), [], [], [], [])
+    uuid = lambda k: UUID([(k * 17 + i) % 256 for i in range(16)])
+    yield "goal_status", GoalStatusArray([GoalStatus(GoalInfo(uuid(1), Time(12, 5)), 2),
+                                          GoalStatus(GoalInfo(uuid(9), Time(13, 0)), 6)])
+    yield "goal_status_empty", GoalStatusArray([])
+    yield "arm_moving", ArmStatus(header(frame="arm"), 1, [0.0, 0.5, -0.5, 1.0, 1.5, -3.0],
+                                  Gripper(0.04, False, [3, -2, 1]), "suction")
+    yield "arm_fault", ArmStatus(header(frame="arm"), 2, [0.0] * 6, Gripper(0.0, True, []), "")
 
 
 def main():

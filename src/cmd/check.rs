@@ -1,5 +1,5 @@
 //! `situ check FILE… [--format human|json|sarif] [--deny-warnings] [--watch]
-//! [--ros2-map MAP]`.
+//! [--ros2-map MAP [--msg-path DIR]…]`.
 
 use super::{CliError, FAILED, OK, USAGE};
 use situ_compiler::loader::{FsLoader, Loader};
@@ -38,14 +38,31 @@ pub struct Args {
     /// Also check this ROS 2 map (TOML, docs/ros2.md) against the rules; one root file only.
     #[arg(long, value_name = "MAP")]
     pub ros2_map: Option<PathBuf>,
+    /// A folder of ROS 2 message definitions for the map, searched before the map's `msg_path`,
+    /// AMENT_PREFIX_PATH and situ's own (repeatable): an install prefix (with `share/`), a
+    /// folder of packages (`DIR/<pkg>/msg/*.msg`) or one package (`DIR/msg/*.msg`).
+    #[arg(long, value_name = "DIR", requires = "ros2_map")]
+    pub msg_path: Vec<PathBuf>,
+}
+
+/// `--msg-path` folders that are not folders: a usage error.
+pub fn msg_path_folders(dirs: &[PathBuf]) -> Result<(), CliError> {
+    match dirs.iter().find(|d| !d.is_dir()) {
+        Some(d) => Err(CliError::Usage(format!(
+            "--msg-path {}: not a folder (give a prefix with `share/`, a folder of packages, or a package)",
+            d.display()
+        ))),
+        None => Ok(()),
+    }
 }
 
 pub fn run(args: &Args) -> super::Outcome {
-    let (files, format, deny_warnings, ros2_map) =
-        (&args.files, args.format, args.deny_warnings, args.ros2_map.as_deref());
+    let (files, format, deny_warnings) = (&args.files, args.format, args.deny_warnings);
+    let ros2_map = args.ros2_map.as_deref().map(|m| (m, args.msg_path.as_slice()));
     if ros2_map.is_some() && files.len() > 1 {
         return Err(CliError::Usage(format!("--ros2-map applies to one root file; {} were given", files.len())));
     }
+    msg_path_folders(&args.msg_path)?;
     if args.watch {
         let machine = !matches!(format, Format::Human);
         return super::recheck::run(|loader| check_all(files, format, deny_warnings, ros2_map, loader).1, machine);
@@ -57,8 +74,14 @@ pub fn run(args: &Args) -> super::Outcome {
 /// more source of the check and its findings join the rules' ones, so every
 /// format renders them with the map's name, line and column. Not done when
 /// the rules have errors (their model is then partial). A map that cannot be
-/// read, or is not UTF-8, is an I/O error like an unreadable root.
-fn check_map(checked: &mut situ_compiler::Checked, map: &Path, loader: &dyn Loader) -> Result<(), RootError> {
+/// read, or is not UTF-8, is an I/O error like an unreadable root. Its
+/// message types are looked for in the `msg_path` folders first.
+fn check_map(
+    checked: &mut situ_compiler::Checked,
+    map: &Path,
+    msg_path: &[PathBuf],
+    loader: &dyn Loader,
+) -> Result<(), RootError> {
     let failure = |error| RootError { path: map.to_path_buf(), error };
     let bytes = loader.read(map).map_err(failure)?;
     let text = String::from_utf8(bytes)
@@ -68,7 +91,9 @@ fn check_map(checked: &mut situ_compiler::Checked, map: &Path, loader: &dyn Load
         return Ok(());
     }
     let file = checked.sources.add(SourceFile::new(map.display().to_string(), text));
-    let found = situ_ros2_map::check_map(&checked.model, &checked.sources.get(file).text, file);
+    let dir = map.parent().unwrap_or(Path::new(""));
+    let text = &checked.sources.get(file).text;
+    let (found, _) = situ_ros2_map::load::check_map_file(&checked.model, text, dir, msg_path, file);
     checked.diagnostics.extend(found);
     Ok(())
 }
@@ -79,7 +104,7 @@ fn check_all(
     files: &[PathBuf],
     format: Format,
     deny_warnings: bool,
-    ros2_map: Option<&Path>,
+    ros2_map: Option<(&Path, &[PathBuf])>,
     loader: &dyn Loader,
 ) -> (u8, String) {
     let mut checks = Vec::new();
@@ -87,8 +112,8 @@ fn check_all(
     for path in files {
         match situ_compiler::check(path, loader) {
             Ok(mut checked) => {
-                if let Some(map) = ros2_map {
-                    if let Err(err) = check_map(&mut checked, map, loader) {
+                if let Some((map, msg_path)) = ros2_map {
+                    if let Err(err) = check_map(&mut checked, map, msg_path, loader) {
                         eprintln!("error: {err}");
                         failures.push(err);
                     }

@@ -1,4 +1,4 @@
-//! `situ ros2 FILE --map MAP [--domain N] [--rmw cyclonedds|fastrtps]
+//! `situ ros2 FILE --map MAP [--msg-path DIR]… [--domain N] [--rmw cyclonedds|fastrtps]
 //! [--duration S] [--record DIR] [--trust PUBKEY…]`: the ROS 2 bridge (docs/ros2.md), built with
 //! `--features ros2`.
 
@@ -22,6 +22,11 @@ pub struct Args {
     /// The ROS 2 map (TOML): which topic each event comes from, which agents are lifecycle nodes.
     #[arg(long)]
     pub map: PathBuf,
+    /// A folder of ROS 2 message definitions, searched before the map's `msg_path`,
+    /// AMENT_PREFIX_PATH and situ's own (repeatable): an install prefix (with `share/`), a
+    /// folder of packages (`DIR/<pkg>/msg/*.msg`) or one package (`DIR/msg/*.msg`).
+    #[arg(long, value_name = "DIR")]
+    pub msg_path: Vec<PathBuf>,
     /// The DDS domain (default: ROS_DOMAIN_ID, else 0).
     #[arg(long)]
     pub domain: Option<u16>,
@@ -43,7 +48,18 @@ const NO_BRIDGE: &str = "this situ was built without the ROS 2 bridge: `cargo bu
 
 #[cfg(not(feature = "ros2"))]
 pub fn run(args: Args) -> Outcome {
-    let _ = (&args.file, &args.map, args.domain, args.rmw, args.duration, &args.record, &args.trust.trust, OK, FAILED);
+    let _ = (
+        &args.file,
+        &args.map,
+        &args.msg_path,
+        args.domain,
+        args.rmw,
+        args.duration,
+        &args.record,
+        &args.trust.trust,
+        OK,
+        FAILED,
+    );
     Err(CliError::Usage(NO_BRIDGE.into()))
 }
 
@@ -83,6 +99,7 @@ pub fn run(args: Args) -> Outcome {
             return Err(CliError::Usage(format!("--duration {s}: give a number of seconds above 0")));
         }
     };
+    super::check::msg_path_folders(&args.msg_path)?;
     let trust = args.trust.policy()?;
     let program = super::program::load(&args.file, false, &trust).map_err(CliError::Reported)?;
     let text = match read_bounded(&args.map, MAX_FILE_BYTES, "a map")
@@ -105,9 +122,19 @@ pub fn run(args: Args) -> Outcome {
     };
     let file = sources.add(SourceFile::new(args.map.display().to_string(), text));
     let map_text = sources.get(file).text.clone();
-    let core = match Core::new(program.content, &model, &map_text, file) {
-        Ok(core) => core,
-        Err(SetupError::Map(found)) => {
+    let map_dir = args.map.parent().unwrap_or(std::path::Path::new(""));
+    let (msgs, found) = match situ_ros2_map::map::parse(&map_text, file) {
+        Ok(parsed) => situ_ros2_map::load::registry_of(&parsed, map_dir, &args.msg_path, file),
+        // Core::new reports the map that does not parse.
+        Err(_) => (situ_ros2_map::Registry::carried(), Vec::new()),
+    };
+    let core = match Core::new(program.content, &model, &map_text, &msgs, file) {
+        Ok(core) if found.is_empty() => core,
+        result => {
+            let mut found = found;
+            if let Err(SetupError::Map(more)) = result {
+                found.extend(more);
+            }
             print!("{}", render::human_list(&sources, &found, super::style()));
             return Err(CliError::Failed(format!(
                 "`{}` has errors; `situ check RULES --ros2-map {}` explains each",
@@ -130,7 +157,7 @@ pub fn run(args: Args) -> Outcome {
     );
     let bag = match &args.record {
         None => None,
-        Some(dir) => match situ_bridge_ros2::bag::Bag::create(dir) {
+        Some(dir) => match situ_bridge_ros2::bag::Bag::create(dir, &msgs) {
             Ok(bag) => Some(bag),
             Err(e) => {
                 return Err(CliError::Usage(format!(

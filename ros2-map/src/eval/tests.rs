@@ -2,6 +2,7 @@
 
 use super::*;
 use crate::cdr::Value as M;
+use crate::expr;
 
 fn msg() -> M {
     let status = |level: i64, hw: &str| {
@@ -99,7 +100,7 @@ fn scan(ranges: &[f32]) -> Vec<u8> {
 #[test]
 fn delivery_scan_by_hand() {
     let checked = situ_compiler::check_source("delivery.situ", RULES);
-    let mut t = Translator::new(&checked.model, MAP, FileId(1)).unwrap();
+    let mut t = Translator::new(&checked.model, MAP, &Registry::carried(), FileId(1)).unwrap();
     let topics: Vec<_> = t.topics().collect();
     assert_eq!(topics[0], ("/scan", "sensor_msgs/msg/LaserScan"));
     let (lidar, obstacle, clear) = (
@@ -127,7 +128,7 @@ fn delivery_scan_by_hand() {
 fn a_map_with_errors_is_refused() {
     let checked = situ_compiler::check_source("delivery.situ", RULES);
     let bad = MAP.replace("min(ranges) < 0.5", "min(rangez) < 0.5");
-    let errors = Translator::new(&checked.model, &bad, FileId(1)).unwrap_err();
+    let errors = Translator::new(&checked.model, &bad, &Registry::carried(), FileId(1)).unwrap_err();
     assert!(errors.iter().any(|d| d.code == codes::ROS2_UNKNOWN_FIELD));
 }
 
@@ -351,7 +352,8 @@ fn a_missing_value_is_a_problem_of_the_entry() {
                when = \"any(status, name == 'motor' and any(values, key == 'fault'))\"\n\
                [event.payload]\nlevel = \"find(status, level >= 2).level\"\n";
     let checked = situ_compiler::check_source("diag.situ", rules);
-    let mut t = Translator::new(&checked.model, map, FileId(1)).unwrap_or_else(|e| panic!("{e:?}"));
+    let mut t =
+        Translator::new(&checked.model, map, &Registry::carried(), FileId(1)).unwrap_or_else(|e| panic!("{e:?}"));
     let array = diagnostic_array;
     let hot = array(&[(0, "lidar", &[]), (2, "motor", &[("fault", "overheat")])]);
     let out = t.on_message("/diagnostics", &hot);
@@ -547,7 +549,7 @@ mod props {
 
     fn agree(text: &str) -> Result<(), TestCaseError> {
         let s = map::Str { value: text.to_string(), span: Span::new(0, text.len()), inner: Some(0) };
-        let typed = type_of(&s, "diagnostic_msgs/msg/DiagnosticArray", FileId(1));
+        let typed = type_of(&s, "diagnostic_msgs/msg/DiagnosticArray", &Registry::carried(), FileId(1));
         let findings = || {
             typed
                 .syntax
@@ -561,7 +563,7 @@ mod props {
             prop_assert!(d.primary.span.end <= text.len() && d.help.is_some(), "{text}: {d:?}");
         }
         let (Some(e), Some(ty), 0) = (&typed.expr, &typed.ty, findings().count()) else { return Ok(()) };
-        let decoder = cdr::Decoder::new("diagnostic_msgs/msg/DiagnosticArray").unwrap();
+        let decoder = cdr::Decoder::new(&Registry::carried(), "diagnostic_msgs/msg/DiagnosticArray").unwrap();
         for msg in [
             diagnostic_array(&[(0, "lidar", &[("rate", "10")]), (2, "motor", &[("fault", "hot")])]),
             diagnostic_array(&[(1, "motor", &[])]),
@@ -596,4 +598,45 @@ mod props {
             agree(&text)?;
         }
     }
+}
+
+/// The expression `text` on messages of type `msg`, its constants replaced
+/// as the translator replaces them (typing resolves them, scopes included).
+fn with_constants(msg: &'static str, text: &str) -> Expr {
+    let s = map::Str { value: text.into(), span: situ_grammar::ast::Span::new(0, 0), inner: None };
+    let typed = crate::types::type_of(&s, msg, &Registry::carried(), FileId(1));
+    assert!(typed.paths.is_empty() && typed.mismatches.is_empty(), "{text}: {typed:?}");
+    let mut e = typed.expr.expect("parsed");
+    constants(&mut e, &typed.constants);
+    e
+}
+
+#[test]
+fn constants_evaluate_to_their_values() {
+    let m = M::Msg(vec![("power_supply_status", M::Int(1)), ("present", M::Bool(true))]);
+    let run = |msg: &'static str, text: &str| {
+        eval(&with_constants(msg, text), &m).map(|v| format!("{v:?}")).map_err(|e| e.message)
+    };
+    let battery = "sensor_msgs/msg/BatteryState";
+    assert_eq!(run(battery, "power_supply_status == POWER_SUPPLY_STATUS_CHARGING"), Ok("Bool(true)".into()));
+    assert_eq!(run(battery, "present and POWER_SUPPLY_STATUS_FULL - 1 > 2"), Ok("Bool(true)".into()));
+    assert_eq!(run("diagnostic_msgs/msg/DiagnosticArray", "DiagnosticStatus.STALE"), Ok("Int(3)".into()));
+    assert_eq!(run("action_msgs/msg/GoalStatusArray", "GoalStatus.STATUS_ABORTED"), Ok("Int(6)".into()));
+    // A field of the name is the field, not a constant.
+    assert_eq!(run(battery, "power_supply_status"), Ok("Int(1)".into()));
+}
+
+#[test]
+fn constants_in_an_elements_scope_are_the_elements() {
+    let goal = |status: i64| M::Msg(vec![("status", M::Int(status))]);
+    let m = M::Msg(vec![("status_list", M::Array(vec![goal(4), goal(6), goal(2)]))]);
+    let run = |text: &str| {
+        eval(&with_constants("action_msgs/msg/GoalStatusArray", text), &m)
+            .map(|v| format!("{v:?}"))
+            .map_err(|e| e.message)
+    };
+    assert_eq!(run("any(status_list, status == STATUS_ABORTED)"), Ok("Bool(true)".into()));
+    assert_eq!(run("count(status_list, status == GoalStatus.STATUS_SUCCEEDED)"), Ok("Int(1)".into()));
+    assert_eq!(run("status_list[-1].status == GoalStatus.STATUS_EXECUTING"), Ok("Bool(true)".into()));
+    assert_eq!(run("all(status_list, status != STATUS_CANCELED)"), Ok("Bool(true)".into()));
 }
