@@ -160,6 +160,11 @@ impl Core {
         self.board.content()
     }
 
+    /// The map's warnings (W04xx): the bridge runs, and says them first.
+    pub fn map_warnings(&self) -> &[Diagnostic] {
+        self.translator.warnings()
+    }
+
     /// The topics to subscribe to, with the full names of their types.
     pub fn topics(&self) -> Vec<(String, &'static str)> {
         self.translator.topics().map(|(t, ty)| (t.to_string(), ty)).collect()

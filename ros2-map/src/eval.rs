@@ -484,6 +484,8 @@ struct Topic {
 pub struct Translator {
     topics: Vec<Topic>,
     stats: Stats,
+    /// The map's warnings: it translates, but its author should know.
+    warnings: Vec<Diagnostic>,
 }
 
 impl Translator {
@@ -497,8 +499,8 @@ impl Translator {
 
     /// [`Translator::new`] of a map already parsed (from `file`).
     pub fn of(model: &Model, parsed: &map::Map, msgs: &Registry, file: FileId) -> Result<Translator, Vec<Diagnostic>> {
-        let errors: Vec<Diagnostic> =
-            check_parsed(model, parsed, msgs, file).into_iter().filter(|d| d.severity == Severity::Error).collect();
+        let (errors, warnings): (Vec<Diagnostic>, Vec<Diagnostic>) =
+            check_parsed(model, parsed, msgs, file).into_iter().partition(|d| d.severity == Severity::Error);
         if !errors.is_empty() {
             return Err(errors);
         }
@@ -518,7 +520,12 @@ impl Translator {
                 }
             }
         }
-        Ok(Translator { topics, stats: Stats::default() })
+        Ok(Translator { topics, stats: Stats::default(), warnings })
+    }
+
+    /// The map's warnings (W04xx), which do not stop the translation.
+    pub fn warnings(&self) -> &[Diagnostic] {
+        &self.warnings
     }
 
     /// Every topic the map reads, with the full name of its message type:

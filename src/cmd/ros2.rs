@@ -143,6 +143,9 @@ pub fn run(args: Args) -> Outcome {
             )));
         }
     };
+    if !core.map_warnings().is_empty() {
+        eprint!("{}", render::human_list(&sources, core.map_warnings(), super::style()));
+    }
     let rmw = match args.rmw {
         Rmw::Cyclonedds => dds::Rmw::CycloneDds,
         Rmw::Fastrtps => dds::Rmw::FastRtps,
