@@ -191,6 +191,10 @@ pub struct World {
     /// again only the items it touched; it keeps the items of the last
     /// [`World::refresh`] only.
     pub parses: ItemCache,
+    /// Analyses replaced by newer ones, dropped by [`World::drop_retired`]
+    /// once the diagnostics are out (freeing a large program's analysis takes
+    /// a while: not between a change and its diagnostics).
+    retired: Vec<Analysis>,
 }
 
 impl World {
@@ -239,7 +243,7 @@ impl World {
                         let generation = self.generations.get(&root).copied().unwrap_or(0);
                         jobs.push(Job { root: root.clone(), generation, docs: self.docs.clone() });
                     }
-                    self.analyses.insert(root, a);
+                    self.retired.extend(self.analyses.insert(root, a));
                 }
                 None => {
                     self.analyses.remove(&root);
@@ -261,8 +265,13 @@ impl World {
         if current != generation || !self.docs.contains_key(&root) || self.dirty.contains(&root) {
             return false;
         }
-        self.analyses.insert(root, analysis);
+        self.retired.extend(self.analyses.insert(root, analysis));
         true
+    }
+
+    /// Drops the analyses that newer ones replaced.
+    pub fn drop_retired(&mut self) {
+        self.retired.clear();
     }
 
     /// Checks everything stale, the static checks included, here and now.
@@ -272,6 +281,7 @@ impl World {
                 self.accept(job.root.clone(), job.generation, a);
             }
         }
+        self.drop_retired();
     }
 
     /// The analysis that answers for `path`, and the file's id in it.
