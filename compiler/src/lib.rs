@@ -111,6 +111,18 @@ pub fn check_quick(root: &Path, loader: &dyn Loader) -> Result<(Checked, ParsedF
     Ok(check_phases(loaded, false))
 }
 
+/// [`check_quick`] with the files parsed through `cache`, which keeps each
+/// item's parse from one call to the next: after an edit, only the items it
+/// touched are parsed again. The result is [`check_quick`]'s.
+pub fn check_quick_cached(
+    root: &Path,
+    loader: &dyn Loader,
+    cache: &mut situ_grammar::ItemCache,
+) -> Result<(Checked, ParsedFiles), RootError> {
+    let loaded = load::load_cached(root, loader, Some(cache))?;
+    Ok(check_phases(loaded, false))
+}
+
 /// Codes that only say a name is missing: after a syntax error the name may
 /// well be declared in the item that failed to parse, so these are not shown.
 const NAME_CODES: &[&str] = &[

@@ -6,6 +6,7 @@ use crate::loader::Loader;
 use crate::source::{SourceFile, SourceMap};
 use situ_grammar::ast::{File, Item, Span};
 use situ_grammar::diag::{Diagnostic, FileId};
+use situ_grammar::ItemCache;
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
@@ -43,9 +44,17 @@ impl std::error::Error for RootError {}
 
 /// Loads `root` and its includes.
 pub fn load(root: &Path, loader: &dyn Loader) -> Result<Loaded, RootError> {
+    load_cached(root, loader, None)
+}
+
+/// [`load`], every file parsed through `cache` when there is one (a tool that
+/// loads the same files again after each edit: only the items an edit
+/// touched are parsed again); the result is the same.
+pub fn load_cached(root: &Path, loader: &dyn Loader, cache: Option<&mut ItemCache>) -> Result<Loaded, RootError> {
     let bytes = loader.read(root).map_err(|error| RootError { path: root.to_path_buf(), error })?;
     let identity = loader.identity(root).unwrap_or_else(|_| root.to_path_buf());
     let mut state = LoadState::new(loader, Loaded::default());
+    state.cache = cache;
     state.visit(root, identity, bytes);
     Ok(state.loaded)
 }
@@ -86,12 +95,14 @@ struct LoadState<'a> {
     stack: Vec<(PathBuf, String)>,
     /// Where each identity of `stack` is in it.
     on_stack: HashMap<PathBuf, usize>,
+    /// Where parses are kept between loads, if anywhere.
+    cache: Option<&'a mut ItemCache>,
 }
 
 impl<'a> LoadState<'a> {
     fn new(loader: &'a dyn Loader, loaded: Loaded) -> Self {
         let seen = loaded.sources_identities.iter().cloned().collect();
-        LoadState { loader, loaded, seen, stack: Vec::new(), on_stack: HashMap::new() }
+        LoadState { loader, loaded, seen, stack: Vec::new(), on_stack: HashMap::new(), cache: None }
     }
 
     fn visit(&mut self, path: &Path, identity: PathBuf, bytes: Vec<u8>) -> FileId {
@@ -120,7 +131,11 @@ impl<'a> LoadState<'a> {
             }
         };
         let id = self.loaded.sources.add(SourceFile::new(name, text));
-        let parsed = situ_grammar::parse(&self.loaded.sources.get(id).text, id);
+        let text = &self.loaded.sources.get(id).text;
+        let parsed = match self.cache.as_deref_mut() {
+            Some(cache) => cache.parse(text, id),
+            None => situ_grammar::parse(text, id),
+        };
         self.loaded.diagnostics.extend(parsed.errors);
         self.on_stack.insert(identity.clone(), self.stack.len());
         self.stack.push((identity, self.loaded.sources.get(id).name.clone()));

@@ -17,6 +17,8 @@ pub mod fmt;
 pub mod lex;
 pub mod parse;
 mod script;
+mod shift;
 
 pub use fmt::format;
+pub use parse::cache::ItemCache;
 pub use parse::{parse, Parsed};

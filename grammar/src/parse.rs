@@ -10,6 +10,7 @@ use pest::Parser as _;
 use std::num::NonZeroUsize;
 use std::sync::{Mutex, Once};
 
+pub mod cache;
 mod declarations;
 mod hints;
 mod report;
@@ -99,6 +100,20 @@ fn parse_item(text: &str) -> Result<pest::iterators::Pairs<'_, Rule>, pest::erro
 
 /// Parses a whole source, recovering at item boundaries.
 pub fn parse(src: &str, file: FileId) -> Parsed {
+    parse_items(src, file, |text, offset| parse_one(text, offset, file))
+}
+
+/// One item's parse: its AST (none when it failed) and its errors.
+#[derive(Debug, Clone)]
+pub(crate) struct ItemParse {
+    pub(crate) item: Option<Item>,
+    pub(crate) errors: Vec<Diagnostic>,
+}
+
+/// Parses a whole source, each item by `item` (its text and where it starts);
+/// the errors of the items in order, at most [`MAX_SYNTAX_ERRORS`] and then
+/// one more to say so.
+pub(crate) fn parse_items(src: &str, file: FileId, mut item: impl FnMut(&str, usize) -> ItemParse) -> Parsed {
     configure_pest();
     let mut items = Vec::new();
     let mut errors = Vec::new();
@@ -116,35 +131,45 @@ pub fn parse(src: &str, file: FileId) -> Parsed {
             );
             break;
         }
-        let text = &src[span.start..span.end];
-        let (depth, at) = lex::max_nesting(text);
-        if depth > MAX_NESTING {
-            let at = span.start + at;
-            errors.push(
-                Diagnostic::error(
-                    TOO_DEEP,
-                    format!("this item is nested {depth} levels deep; at most {MAX_NESTING} are allowed"),
-                    file,
-                    Span::new(at, at + 1),
-                    "too deep from here",
-                )
-                .with_help("split the expression into several rules or properties"),
-            );
-            continue;
-        }
-        match parse_item(text) {
-            Ok(mut pairs) => {
-                let item = pairs.next().and_then(|p| p.into_inner().next());
-                let Some(pair) = item else { continue };
-                let mut builder = Builder { offset: span.start, file, errors: &mut errors };
-                if let Some(item) = builder.item(pair) {
-                    items.push(item);
-                }
-            }
-            Err(err) => errors.push(syntax_error(&err, text, span.start, file)),
-        }
+        let parsed = item(&src[span.start..span.end], span.start);
+        items.extend(parsed.item);
+        errors.extend(parsed.errors);
     }
     Parsed { file: File { items }, comments: lex::comments(src), errors }
+}
+
+/// Parses the item `text`, which starts at `offset` of `file`. What it gives
+/// depends on the text alone, but for its spans (shifted by `offset`) and
+/// the file its errors name.
+pub(crate) fn parse_one(text: &str, offset: usize, file: FileId) -> ItemParse {
+    configure_pest();
+    let mut errors = Vec::new();
+    let (depth, at) = lex::max_nesting(text);
+    if depth > MAX_NESTING {
+        let at = offset + at;
+        errors.push(
+            Diagnostic::error(
+                TOO_DEEP,
+                format!("this item is nested {depth} levels deep; at most {MAX_NESTING} are allowed"),
+                file,
+                Span::new(at, at + 1),
+                "too deep from here",
+            )
+            .with_help("split the expression into several rules or properties"),
+        );
+        return ItemParse { item: None, errors };
+    }
+    let item = match parse_item(text) {
+        Ok(mut pairs) => pairs.next().and_then(|p| p.into_inner().next()).and_then(|pair| {
+            let mut builder = Builder { offset, file, errors: &mut errors };
+            builder.item(pair)
+        }),
+        Err(err) => {
+            errors.push(syntax_error(&err, text, offset, file));
+            None
+        }
+    };
+    ItemParse { item, errors }
 }
 
 /// The reserved words of the language (mirrors `keyword` in the grammar).

@@ -243,10 +243,80 @@ fn verdicts(rel: &str) {
     );
 }
 
+/// What a change to the 10,000-rule file costs, stage by stage, in-process
+/// (no JSON-RPC): the parse from scratch and through the item cache, the
+/// quick check, the whole analysis (with the index of names), and the
+/// diagnostics as the protocol's findings.
+fn stages() {
+    use situ_grammar::diag::FileId;
+    use situ_lsp::world::{Analysis, Doc, World};
+    let big = generated(10_000);
+    let path = std::path::PathBuf::from("/bench/rules10k.situ");
+    let mut world = World::default();
+    world.open(path.clone(), Doc::new("file:///bench/rules10k.situ".into(), big.clone(), 1));
+    world.refresh();
+    let (line, col, len) = target_of_first_rule(&big);
+    let at = big.lines().take(line).map(|l| l.len() + 1).sum::<usize>() + col;
+    let mut times: [Vec<Duration>; 7] = Default::default();
+    for i in 0..20 {
+        let mut text = big.clone();
+        if i % 2 == 0 {
+            text.insert(at + len, 'Q');
+        }
+        let t = Instant::now();
+        let parsed = situ_grammar::parse(&text, FileId(0));
+        times[0].push(t.elapsed());
+        drop(parsed);
+        world.docs.get_mut(&path).unwrap().text = text.clone();
+        let t = Instant::now();
+        let parsed = world.parses.parse(&text, FileId(0));
+        times[1].push(t.elapsed());
+        drop(parsed);
+        let loader = situ_lsp::world::DocLoader { docs: &world.docs };
+        let t = Instant::now();
+        let checked = situ_compiler::check_quick_cached(&path, &loader, &mut world.parses);
+        times[2].push(t.elapsed());
+        drop(checked);
+        let t = Instant::now();
+        let analysis = Analysis::with_cache(&path, &world.docs, false, Some(&mut world.parses));
+        times[3].push(t.elapsed());
+        drop(analysis);
+        world.touch(&path);
+        let t = Instant::now();
+        world.refresh();
+        times[4].push(t.elapsed());
+        let t = Instant::now();
+        let _ = situ_lsp::diagnostics::all(&world);
+        times[5].push(t.elapsed());
+        world.drop_retired();
+        let mut cache = situ_grammar::ItemCache::new();
+        let t = Instant::now();
+        let parsed = cache.parse(&text, FileId(0));
+        times[6].push(t.elapsed());
+        drop((parsed, cache));
+    }
+    let names = [
+        "parse from scratch",
+        "parse through the item cache",
+        "check_quick_cached (parse, resolve, allow)",
+        "Analysis (check, ASTs, line index, name index)",
+        "World::refresh (the old analysis kept to drop later)",
+        "diagnostics::all (findings to publish)",
+        "parse through an empty cache (an open)",
+    ];
+    for (name, t) in names.iter().zip(times) {
+        split(&format!("10,000 rules: {name}"), &t);
+    }
+}
+
 fn main() {
     if std::env::args().nth(1).as_deref() == Some("verdicts") {
         verdicts("rules/outdoor.situ");
         verdicts("examples/mower/mower.situ");
+        return;
+    }
+    if std::env::args().nth(1).as_deref() == Some("stages") {
+        stages();
         return;
     }
     let outdoor = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../rules/outdoor.situ")).unwrap();
@@ -294,5 +364,5 @@ fn main() {
         t.elapsed().as_secs_f64() * 1e3,
         big.lines().count()
     );
-    split("10,000 rules: change to diagnostics", &edits(&c2, uri, &big, 10, |_| {}));
+    split("10,000 rules: change to diagnostics", &edits(&c2, uri, &big, 40, |_| {}));
 }

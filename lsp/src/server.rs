@@ -267,6 +267,7 @@ impl<W: Write> Server<W> {
             let _ = self.runs.send(run);
         }
         if !stale && !force {
+            self.world.drop_retired();
             return;
         }
         let skipped: Vec<String> = self
@@ -300,5 +301,7 @@ impl<W: Write> Server<W> {
             self.published.insert(uri, findings);
             self.send(message);
         }
+        // The old analyses go once the diagnostics are out.
+        self.world.drop_retired();
     }
 }

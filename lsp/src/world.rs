@@ -14,6 +14,7 @@ use situ_compiler::loader::{normalize, FsLoader, Loader};
 use situ_compiler::Checked;
 use situ_grammar::ast;
 use situ_grammar::diag::FileId;
+use situ_grammar::ItemCache;
 use std::collections::{BTreeMap, BTreeSet};
 use std::io;
 use std::path::{Path, PathBuf};
@@ -86,11 +87,22 @@ pub const MAX_RULES_CHECKED: usize = 2_000;
 impl Analysis {
     /// `full`: with the static checks; otherwise without them (`check_quick`).
     pub fn new(root: &Path, docs: &BTreeMap<PathBuf, Doc>, full: bool) -> Option<Analysis> {
+        Analysis::with_cache(root, docs, full, None)
+    }
+
+    /// [`Analysis::new`], the quick check parsing through `cache` when there
+    /// is one (only the items an edit touched are parsed again).
+    pub fn with_cache(
+        root: &Path,
+        docs: &BTreeMap<PathBuf, Doc>,
+        full: bool,
+        cache: Option<&mut ItemCache>,
+    ) -> Option<Analysis> {
         let loader = DocLoader { docs };
-        let (checked, mut files) = if full {
-            (situ_compiler::check(root, &loader).ok()?, Vec::new())
-        } else {
-            situ_compiler::check_quick(root, &loader).ok()?
+        let (checked, mut files) = match cache {
+            _ if full => (situ_compiler::check(root, &loader).ok()?, Vec::new()),
+            Some(cache) => situ_compiler::check_quick_cached(root, &loader, cache).ok()?,
+            None => situ_compiler::check_quick(root, &loader).ok()?,
         };
         // The files by id (the quick check gives them in include order).
         files.sort_by_key(|(id, _)| *id);
@@ -175,6 +187,14 @@ pub struct World {
     next_generation: u64,
     /// The verdicts of the properties and tests, run on open and save.
     pub verdicts: Board,
+    /// The items' parses of the last quick checks, so that a change parses
+    /// again only the items it touched; it keeps the items of the last
+    /// [`World::refresh`] only.
+    pub parses: ItemCache,
+    /// Analyses replaced by newer ones, dropped by [`World::drop_retired`]
+    /// once the diagnostics are out (freeing a large program's analysis takes
+    /// a while: not between a change and its diagnostics).
+    retired: Vec<Analysis>,
 }
 
 impl World {
@@ -217,19 +237,20 @@ impl World {
                 self.analyses.remove(&root);
                 continue;
             }
-            match Analysis::new(&root, &self.docs, false) {
+            match Analysis::with_cache(&root, &self.docs, false, Some(&mut self.parses)) {
                 Some(a) => {
                     if !a.complete {
                         let generation = self.generations.get(&root).copied().unwrap_or(0);
                         jobs.push(Job { root: root.clone(), generation, docs: self.docs.clone() });
                     }
-                    self.analyses.insert(root, a);
+                    self.retired.extend(self.analyses.insert(root, a));
                 }
                 None => {
                     self.analyses.remove(&root);
                 }
             }
         }
+        self.parses.end_round();
         Some(jobs)
     }
 
@@ -244,8 +265,13 @@ impl World {
         if current != generation || !self.docs.contains_key(&root) || self.dirty.contains(&root) {
             return false;
         }
-        self.analyses.insert(root, analysis);
+        self.retired.extend(self.analyses.insert(root, analysis));
         true
+    }
+
+    /// Drops the analyses that newer ones replaced.
+    pub fn drop_retired(&mut self) {
+        self.retired.clear();
     }
 
     /// Checks everything stale, the static checks included, here and now.
@@ -255,6 +281,7 @@ impl World {
                 self.accept(job.root.clone(), job.generation, a);
             }
         }
+        self.drop_retired();
     }
 
     /// The analysis that answers for `path`, and the file's id in it.
@@ -339,5 +366,27 @@ mod tests {
         w.refresh_fully();
         assert_eq!(w.primary(&common).unwrap().0.root, common);
         assert!(w.primary(&main).is_none());
+    }
+
+    #[test]
+    fn a_change_parses_again_the_item_it_touched_only() {
+        let path = PathBuf::from("/nonexistent/situ-lsp/cache.situ");
+        let mut w = World::default();
+        w.open(path.clone(), Doc::new(path_to_uri(&path), SMALL.into(), 1));
+        w.refresh();
+        let parsed = w.parses.misses();
+        assert_eq!(parsed, 3, "states, agent, rule");
+        // The event's name grows: the rule after it moves, and is not parsed again.
+        let edited = SMALL.replace("event E\n", "event EV\n");
+        w.docs.get_mut(&path).unwrap().text = edited.clone();
+        w.touch(&path);
+        w.refresh();
+        assert_eq!(w.parses.misses(), parsed + 1);
+        assert_eq!(w.parses.len(), 3, "the agent's old parse is dropped");
+        let cached = &w.analyses[&path];
+        let fresh = Analysis::new(&path, &w.docs, false).unwrap();
+        assert_eq!(cached.asts, fresh.asts);
+        assert_eq!(cached.checked.diagnostics, fresh.checked.diagnostics);
+        assert!(cached.checked.diagnostics.iter().any(|d| d.code == "E0104"), "E is undefined now");
     }
 }
