@@ -6,7 +6,15 @@
 //! 2. **status fan-out**: the Bulletinboard's broadcast of a new state to
 //!    12 agents shared among one worker thread per core, as the real-time
 //!    scheduler runs them: from the broadcast to the last agent seeing it,
-//!    p50 / p99 / max, over 10,000 broadcasts.
+//!    p50 / p99 / max, over 10,000 broadcasts;
+//! 3. **one wake-up**: the floor under the fan-out, the same bell
+//!    (`Doorbell`: a mutex and a condition variable) rung 10,000 times for
+//!    one sleeping thread, from the ring to the thread running again.
+//!
+//! `FIFO=1` runs the workers and the woken thread under `SCHED_FIFO`
+//! (priority 50; it needs the privilege, and says when it is refused), as a
+//! robot's real-time computer would; `WORKERS=N` sets the workers;
+//! `ONLY=latency` skips the data figure.
 //!
 //! `cargo run --release -p situ-runtime-tests --example stack_bench`
 
@@ -85,6 +93,72 @@ fn data() {
     );
 }
 
+/// Puts the calling thread under `SCHED_FIFO` when `FIFO=1`; whether it is.
+fn real_time() -> bool {
+    if std::env::var("FIFO").as_deref() != Ok("1") {
+        return false;
+    }
+    let param = libc::sched_param { sched_priority: 50 };
+    // SAFETY: sched_setscheduler(2) on the calling thread (pid 0) with a
+    // valid parameter; it only changes how the kernel schedules it.
+    let r = unsafe { libc::sched_setscheduler(0, libc::SCHED_FIFO, &param) };
+    if r != 0 {
+        eprintln!("SCHED_FIFO refused: {}", std::io::Error::last_os_error());
+    }
+    r == 0
+}
+
+/// p50, p99 and max of latencies in ns, in µs.
+fn quantiles(lat: &mut [u64]) -> (f64, f64, f64) {
+    lat.sort_unstable();
+    let q = |p: f64| lat[((lat.len() as f64 * p) as usize).min(lat.len() - 1)] as f64 / 1e3;
+    (q(0.5), q(0.99), lat[lat.len() - 1] as f64 / 1e3)
+}
+
+/// One thread asleep on a `Doorbell`, rung `ROUNDS` times: from the ring
+/// to the thread running again. Nothing else of the runtime: the kernel's
+/// wake-up, the floor under every fan-out.
+fn wake_up() {
+    const ROUNDS: usize = 10_000;
+    let bell = Arc::new(Doorbell::default());
+    let start = Instant::now();
+    let woke = Arc::new(AtomicU64::new(0));
+    let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let mut lat = Vec::with_capacity(ROUNDS);
+    let fifo = std::sync::atomic::AtomicBool::new(false);
+    std::thread::scope(|scope| {
+        let (bell2, woke2, stop2, fifo) = (bell.clone(), woke.clone(), stop.clone(), &fifo);
+        scope.spawn(move || {
+            fifo.store(real_time(), Ordering::Release);
+            while !stop2.load(Ordering::Acquire) {
+                if bell2.wait_until(Instant::now() + Duration::from_millis(100)) {
+                    woke2.store(start.elapsed().as_nanos() as u64, Ordering::Release);
+                }
+            }
+        });
+        for _ in 0..ROUNDS {
+            woke.store(0, Ordering::Release);
+            // Let the thread go back to sleep first.
+            std::thread::sleep(Duration::from_micros(200));
+            let t0 = start.elapsed().as_nanos() as u64;
+            bell.ring();
+            let mut t = woke.load(Ordering::Acquire);
+            while t == 0 {
+                std::hint::spin_loop();
+                t = woke.load(Ordering::Acquire);
+            }
+            lat.push(t.saturating_sub(t0));
+        }
+        stop.store(true, Ordering::Release);
+        bell.ring();
+    });
+    let (p50, p99, max) = quantiles(&mut lat);
+    println!(
+        "one wake-up{}: p50 {p50:.1} µs, p99 {p99:.1} µs, max {max:.1} µs ({ROUNDS} rings)",
+        if fifo.load(Ordering::Acquire) { " (SCHED_FIFO)" } else { "" }
+    );
+}
+
 /// The fan-out as the real-time scheduler does it: the agents shared among
 /// one worker thread per core, each sleeping on a bell its agents' mailboxes
 /// ring; an agent has seen the status when its worker has read it.
@@ -111,6 +185,7 @@ fn fan_out() {
             }
             let (bus, seen, acks, stop, main) = (bus.clone(), seen.clone(), acks.clone(), stop.clone(), main.clone());
             scope.spawn(move || {
+                real_time();
                 let mut last = [0u64; AGENTS];
                 while !stop.load(Ordering::Acquire) {
                     for &a in &mine {
@@ -145,18 +220,18 @@ fn fan_out() {
         stop.store(true, Ordering::Release);
         bus.close();
     });
-    lat.sort_unstable();
-    let q = |p: f64| lat[((lat.len() as f64 * p) as usize).min(lat.len() - 1)] as f64 / 1e3;
+    let (p50, p99, max) = quantiles(&mut lat);
+    let fifo = if std::env::var("FIFO").as_deref() == Ok("1") { ", SCHED_FIFO asked" } else { "" };
     println!(
-        "status fan-out to {AGENTS} agents on {workers} workers: p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs ({ROUNDS} broadcasts)",
-        q(0.5),
-        q(0.99),
-        *lat.last().unwrap() as f64 / 1e3
+        "status fan-out to {AGENTS} agents on {workers} workers{fifo}: p50 {p50:.1} µs, p99 {p99:.1} µs, max {max:.1} µs ({ROUNDS} broadcasts)"
     );
 }
 
 fn main() {
     println!("{} cores", std::thread::available_parallelism().map_or(1, |n| n.get()));
-    data();
+    if std::env::var("ONLY").as_deref() != Ok("latency") {
+        data();
+    }
     fan_out();
+    wake_up();
 }
