@@ -98,6 +98,18 @@ pub struct Engine {
     active_pos: Vec<u32>,
     cascade_limit: usize,
     record: Record,
+    /// The network's memories in the initial state with no facts, which a
+    /// [`reset`](Self::reset) restores.
+    initial: Arc<Memories>,
+}
+
+/// The memories of the network (alpha, beta, activated rules).
+#[derive(Debug, Clone, Default)]
+struct Memories {
+    alpha_mem: Vec<bool>,
+    beta_tok: Vec<bool>,
+    active: Vec<u32>,
+    active_pos: Vec<u32>,
 }
 
 impl Engine {
@@ -128,10 +140,17 @@ impl Engine {
             active_pos: vec![NONE; content.rules.len()],
             cascade_limit: CASCADE_LIMIT,
             record: Record::default(),
+            initial: Arc::default(),
             content,
             net,
         };
         e.recompute();
+        e.initial = Arc::new(Memories {
+            alpha_mem: e.alpha_mem.clone(),
+            beta_tok: e.beta_tok.clone(),
+            active: e.active.clone(),
+            active_pos: e.active_pos.clone(),
+        });
         e
     }
 
@@ -224,25 +243,25 @@ impl Engine {
 
     /// Back to the initial state with no facts; now, and each agent's
     /// latest accepted time, are kept (§10.12: a mission ends in a final
-    /// state, the clocks go on). Incremental:
-    /// only the nodes of the facts there were, and of the state, change.
+    /// state, the clocks go on). The network's memories are those of the
+    /// initial state with no facts, which depend on nothing else: they are
+    /// copied back from the engine's construction, not propagated (no
+    /// allocation: the buffers keep their capacity).
     pub fn reset(&mut self) {
-        for a in 0..self.slots.len() {
-            let event = self.slots[a].event;
-            if event != NONE {
-                self.clear_event_alpha(event);
-            }
-            if self.stale[a] {
-                self.stale[a] = false;
-                self.set_stale_alpha(a as u32, false);
-            }
-        }
         self.slots.fill(EMPTY);
+        self.stale.fill(false);
         self.stale_at.fill(u64::MAX);
         self.window_at.fill(u64::MAX);
         self.next_deadline = u64::MAX;
-        self.set_state(self.content.initial);
-        self.propagate();
+        self.state = self.content.initial;
+        let m = &*self.initial;
+        self.alpha_mem.copy_from_slice(&m.alpha_mem);
+        self.beta_tok.copy_from_slice(&m.beta_tok);
+        self.active.clone_from(&m.active);
+        self.active_pos.copy_from_slice(&m.active_pos);
+        self.dirty.fill(0);
+        self.dirty_lo = usize::MAX;
+        self.dirty_hi = 0;
     }
 
     /// Processes one event: expiry, rest, the new fact, rest. Returns the
@@ -403,16 +422,17 @@ impl Engine {
     }
 
     /// Replaces the agent's fact and updates its alpha memories (no propagation).
+    #[inline]
     fn insert(&mut self, event: u32, time: u64, payload: &[Value]) {
-        let agent = self.net.event_agent[event as usize];
+        let ev = self.net.event[event as usize];
+        let agent = ev.agent;
         let a = agent as usize;
         let old = self.slots[a];
         self.seq += 1;
         let run = if old.event == event { old.run + 1 } else { 1 };
         self.slots[a] = Slot { event, time, run, seq: self.seq };
         self.last[a] = self.last[a].max(time);
-        let at = self.net.payload_at[a] as usize;
-        self.payload[at..at + payload.len()].copy_from_slice(payload);
+        copy_payload(&mut self.payload[ev.payload_at as usize..], payload);
         if self.stale[a] {
             self.stale[a] = false;
             self.set_stale_alpha(agent, false);
@@ -420,18 +440,24 @@ impl Engine {
         if old.event != NONE && old.event != event {
             self.clear_event_alpha(old.event);
         }
-        self.eval_event_alpha(event);
+        self.eval_event_alpha(ev.alpha);
         // Timers.
-        let stale_after = self.net.stale_after[a];
-        self.stale_at[a] = if stale_after == u64::MAX { u64::MAX } else { time.saturating_add(stale_after) };
-        self.window_at[a] = self.next_window(event, time);
-        self.next_deadline = self.next_deadline.min(self.stale_at[a]).min(self.window_at[a]);
+        let stale_at = if ev.stale_after == u64::MAX { u64::MAX } else { time.saturating_add(ev.stale_after) };
+        let window_at = self.next_window(ev.windows, time);
+        self.stale_at[a] = stale_at;
+        self.window_at[a] = window_at;
+        self.next_deadline = self.next_deadline.min(stale_at).min(window_at);
     }
 
-    /// When the next window of a fact of `event` reported at `time` closes:
-    /// `time + w` for the smallest window `w` still open (`u64::MAX`: none).
-    fn next_window(&self, event: u32, time: u64) -> u64 {
-        let (s, e) = self.net.event_windows_at[event as usize];
+    /// When the next window of a fact reported at `time` closes, its
+    /// event's windows being `windows` (in `net.windows`): `time + w` for
+    /// the smallest window `w` still open (`u64::MAX`: none).
+    #[inline]
+    fn next_window(&self, windows: (u32, u32), time: u64) -> u64 {
+        let (s, e) = windows;
+        if s == e {
+            return u64::MAX;
+        }
         self.net.windows[s as usize..e as usize]
             .iter()
             .map(|w| time.saturating_add(*w))
@@ -456,7 +482,7 @@ impl Engine {
             } else if self.window_at[a] < self.now {
                 self.refresh_alpha(a as u32);
                 let slot = self.slots[a];
-                self.window_at[a] = self.next_window(slot.event, slot.time);
+                self.window_at[a] = self.next_window(self.net.event[slot.event as usize].windows, slot.time);
             }
             next = next.min(self.stale_at[a]).min(self.window_at[a]);
         }
@@ -466,7 +492,7 @@ impl Engine {
     // ─── Alpha network ─────────────────────────────────────────────────
 
     fn clear_event_alpha(&mut self, event: u32) {
-        let (s, e) = self.net.event_alpha_at[event as usize];
+        let (s, e) = self.net.event[event as usize].alpha;
         for i in s..e {
             let a = self.net.event_alpha[i as usize] as usize;
             if self.alpha_mem[a] {
@@ -479,11 +505,11 @@ impl Engine {
     /// Re-evaluates the alpha nodes of `event` against its agent's new fact:
     /// successors are marked where the result changes, and where it stays
     /// true but join tests below read the replaced fact's values.
-    fn eval_event_alpha(&mut self, event: u32) {
-        let (s, e) = self.net.event_alpha_at[event as usize];
+    #[inline]
+    fn eval_event_alpha(&mut self, (s, e): (u32, u32)) {
         for i in s..e {
             let a = self.net.event_alpha[i as usize] as usize;
-            let pass = self.alpha_passes(a);
+            let pass = self.event_alpha_passes(&self.net.alpha[a]);
             if pass != self.alpha_mem[a] || (pass && self.net.alpha[a].refresh) {
                 self.alpha_mem[a] = pass;
                 self.mark_succ(a);
@@ -498,7 +524,7 @@ impl Engine {
         if event == NONE {
             return;
         }
-        let (s, e) = self.net.event_alpha_at[event as usize];
+        let (s, e) = self.net.event[event as usize].alpha;
         for i in s..e {
             let a = self.net.event_alpha[i as usize] as usize;
             let pass = self.alpha_passes(a);
@@ -522,19 +548,23 @@ impl Engine {
         match node.kind {
             AlphaKind::State => self.net.state_in(node, self.state),
             AlphaKind::Stale => self.stale[node.agent as usize],
-            AlphaKind::Event => {
-                let slot = &self.slots[node.agent as usize];
-                if slot.event != node.key || slot.run < node.min_run {
-                    return false;
-                }
-                if node.within_ns != u64::MAX && self.now.saturating_sub(slot.time) > node.within_ns {
-                    return false;
-                }
-                let at = self.net.payload_at[node.agent as usize] as usize;
-                let (s, e) = node.tests;
-                self.net.alpha_tests[s as usize..e as usize].iter().all(|t| self.test(t, at))
-            }
+            AlphaKind::Event => self.event_alpha_passes(node),
         }
+    }
+
+    /// An event alpha node's test of its agent's fact: the event, the run
+    /// length, the window, the payload tests.
+    #[inline(always)]
+    fn event_alpha_passes(&self, node: &net::AlphaRt) -> bool {
+        let slot = &self.slots[node.agent as usize];
+        if slot.event != node.key || slot.run < node.min_run {
+            return false;
+        }
+        if node.within_ns != u64::MAX && self.now.saturating_sub(slot.time) > node.within_ns {
+            return false;
+        }
+        let (s, e) = node.tests;
+        s == e || self.net.alpha_tests[s as usize..e as usize].iter().all(|t| self.test(t, node.at as usize))
     }
 
     #[inline]
@@ -567,7 +597,7 @@ impl Engine {
 
     // ─── Beta network ──────────────────────────────────────────────────
 
-    #[inline]
+    #[inline(always)]
     fn mark(&mut self, b: usize) {
         let w = b / 64;
         self.dirty[w] |= 1 << (b % 64);
@@ -575,6 +605,7 @@ impl Engine {
         self.dirty_hi = self.dirty_hi.max(w);
     }
 
+    #[inline]
     fn mark_succ(&mut self, a: usize) {
         let (s, e) = self.net.alpha[a].succ;
         for i in s..e {
@@ -638,7 +669,7 @@ impl Engine {
         if s == e {
             return true;
         }
-        let own = self.net.payload_at[node.agent as usize] as usize;
+        let own = node.at as usize;
         self.net.beta_tests[s as usize..e as usize].iter().all(|t| self.test(t, own))
     }
 
@@ -765,6 +796,22 @@ impl Engine {
             self.set_state(to);
         }
         Ok(())
+    }
+}
+
+/// Copies an event's payload into its agent's place in the arena
+/// (`dst` starts there and is at least as long); the usual zero, one or two
+/// values without a call to `memcpy`.
+#[inline(always)]
+fn copy_payload(dst: &mut [Value], src: &[Value]) {
+    match (src, dst) {
+        ([], _) => {}
+        ([x], [d, ..]) => *d = *x,
+        ([x, y], [d, e, ..]) => {
+            *d = *x;
+            *e = *y;
+        }
+        (src, dst) => dst[..src.len()].copy_from_slice(src),
     }
 }
 
