@@ -102,5 +102,6 @@ print(f"handwritten/situ ratio (instructions): {situ / hand:.2f}")
 PY
 if [[ $top -gt 0 ]]; then
     echo "== situ: the $top costliest functions (exclusive instructions, inlined code in its caller)"
-    callgrind_annotate --threshold=100 "$work/situ.cg" 2>/dev/null | sed -n '/^Ir/,$p' | head -n "$((top + 2))"
+    # sed, not head: the pipe is read to its end (no SIGPIPE under pipefail).
+    callgrind_annotate --threshold=100 "$work/situ.cg" 2>/dev/null | sed -n '/^Ir/,$p' | sed -n "1,$((top + 2))p"
 fi

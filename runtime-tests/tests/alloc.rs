@@ -78,8 +78,11 @@ fn outdoor() -> Arc<Content> {
     Arc::new(situ_compiler::bundle::build(&checked))
 }
 
-/// `n` events of the seeded stream, flat: `(event, time, payload start, end)`.
-fn stream(content: &Arc<Content>, seed: u64, n: usize) -> (Vec<(u32, u64, usize, usize)>, Vec<Value>) {
+/// Events, flat: `(event, time, payload start, end)` into a payload arena.
+type Events = Vec<(u32, u64, usize, usize)>;
+
+/// `n` events of the seeded stream, and their payloads.
+fn stream(content: &Arc<Content>, seed: u64, n: usize) -> (Events, Vec<Value>) {
     let mut g = Generator::new(content.clone(), seed);
     let mut values = Vec::new();
     let mut events = Vec::with_capacity(n);
