@@ -93,7 +93,7 @@ impl Engine {
     }
 
     /// [`validate`](Self::validate), giving the event's agent.
-    #[inline]
+    #[inline(always)]
     fn validated(&self, event: u32, payload: &[Value]) -> Result<u32, PostError> {
         let Some(ev) = self.net.event.get(event as usize) else {
             return Err(PostError::UnknownEvent { event });
