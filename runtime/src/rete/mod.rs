@@ -423,7 +423,7 @@ impl Engine {
     }
 
     /// Replaces the agent's fact and updates its alpha memories (no propagation).
-    #[inline]
+    #[inline(always)]
     fn insert(&mut self, event: u32, time: u64, payload: &[Value]) {
         let ev = self.net.event[event as usize];
         let agent = ev.agent;
