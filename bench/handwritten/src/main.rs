@@ -64,8 +64,11 @@ struct Run {
 /// Processes every event; this is the timed part. Collects a line for every
 /// event after which the state at rest differs from the state at rest before
 /// it. After a final state the engine resets to the initial state before the
-/// next event; the reset itself is no change.
-fn run(events: &[Event]) -> Result<Run, (usize, CascadeError)> {
+/// next event; the reset itself is no change. Never inlined: it is the one
+/// function that `bench/instructions.sh` has callgrind count
+/// (`--toggle-collect=*::process_stream`).
+#[inline(never)]
+fn process_stream(events: &[Event]) -> Result<Run, (usize, CascadeError)> {
     let mut engine = Engine::new();
     // A change per event at most: never regrows inside the loop.
     let mut changes = Vec::with_capacity(events.len());
@@ -120,7 +123,7 @@ fn main() -> ExitCode {
     drop(text);
 
     let start = Instant::now();
-    let result = run(&events);
+    let result = process_stream(&events);
     let seconds = start.elapsed().as_secs_f64();
 
     let run = match result {

@@ -64,7 +64,7 @@ impl Sim {
 /// Runs a stream text as the binary does: the `INDEX STATE` lines.
 fn states(text: &str) -> Vec<(usize, State)> {
     let events = stream::parse(text.as_bytes()).unwrap();
-    run(&events).unwrap_or_else(|(i, e)| panic!("event {i}: {e:?}")).changes
+    process_stream(&events).unwrap_or_else(|(i, e)| panic!("event {i}: {e:?}")).changes
 }
 
 /// The mission start of outdoor.situ as a stream: events 10 ms apart from 10 ms.

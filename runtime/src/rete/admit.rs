@@ -61,8 +61,7 @@ impl Engine {
     /// NaN and the infinities are accepted: §10.3 says what they match.
     /// A refused event changes nothing, not even now.
     pub fn admit(&self, event: u32, time: u64, payload: &[Value]) -> Result<(), PostError> {
-        self.validate(event, payload)?;
-        let agent = self.net.event_agent[event as usize] as usize;
+        let agent = self.validated(event, payload)? as usize;
         let last = self.last[agent];
         if time < last {
             return Err(PostError::OutOfOrder { event, time, last });
@@ -80,7 +79,7 @@ impl Engine {
     /// true. `situ bench` and its stream generator call it after each event
     /// (after both rests), unless told not to.
     pub fn reset_if_final(&mut self) -> bool {
-        let fin = self.content.states.get(self.state as usize).is_some_and(|s| s.is_final);
+        let fin = self.net.final_state.get(self.state as usize).copied().unwrap_or(false);
         if fin {
             self.reset();
         }
@@ -90,9 +89,16 @@ impl Engine {
     /// Checks an event against the bundle's schema (a part of
     /// [`admit`](Self::admit), which also checks its time).
     pub fn validate(&self, event: u32, payload: &[Value]) -> Result<(), PostError> {
-        let Some(&(s, e)) = self.net.event_kinds.get(event as usize) else {
+        self.validated(event, payload).map(|_| ())
+    }
+
+    /// [`validate`](Self::validate), giving the event's agent.
+    #[inline(always)]
+    fn validated(&self, event: u32, payload: &[Value]) -> Result<u32, PostError> {
+        let Some(ev) = self.net.event.get(event as usize) else {
             return Err(PostError::UnknownEvent { event });
         };
+        let (s, e) = ev.kinds;
         let kinds = &self.net.kinds[s as usize..e as usize];
         if kinds.len() != payload.len() {
             return Err(PostError::Arity { event, expected: kinds.len(), found: payload.len() });
@@ -108,6 +114,6 @@ impl Engine {
                 return Err(PostError::Type { event, field: i as u32, expected });
             }
         }
-        Ok(())
+        Ok(ev.agent)
     }
 }

@@ -30,6 +30,7 @@
 
 mod admit;
 mod eval;
+mod infer;
 mod net;
 mod report;
 
@@ -98,6 +99,18 @@ pub struct Engine {
     active_pos: Vec<u32>,
     cascade_limit: usize,
     record: Record,
+    /// The network's memories in the initial state with no facts, which a
+    /// [`reset`](Self::reset) restores.
+    initial: Arc<Memories>,
+}
+
+/// The memories of the network (alpha, beta, activated rules).
+#[derive(Debug, Clone, Default)]
+struct Memories {
+    alpha_mem: Vec<bool>,
+    beta_tok: Vec<bool>,
+    active: Vec<u32>,
+    active_pos: Vec<u32>,
 }
 
 impl Engine {
@@ -128,10 +141,17 @@ impl Engine {
             active_pos: vec![NONE; content.rules.len()],
             cascade_limit: CASCADE_LIMIT,
             record: Record::default(),
+            initial: Arc::default(),
             content,
             net,
         };
         e.recompute();
+        e.initial = Arc::new(Memories {
+            alpha_mem: e.alpha_mem.clone(),
+            beta_tok: e.beta_tok.clone(),
+            active: e.active.clone(),
+            active_pos: e.active_pos.clone(),
+        });
         e
     }
 
@@ -224,25 +244,25 @@ impl Engine {
 
     /// Back to the initial state with no facts; now, and each agent's
     /// latest accepted time, are kept (§10.12: a mission ends in a final
-    /// state, the clocks go on). Incremental:
-    /// only the nodes of the facts there were, and of the state, change.
+    /// state, the clocks go on). The network's memories are those of the
+    /// initial state with no facts, which depend on nothing else: they are
+    /// copied back from the engine's construction, not propagated (no
+    /// allocation: the buffers keep their capacity).
     pub fn reset(&mut self) {
-        for a in 0..self.slots.len() {
-            let event = self.slots[a].event;
-            if event != NONE {
-                self.clear_event_alpha(event);
-            }
-            if self.stale[a] {
-                self.stale[a] = false;
-                self.set_stale_alpha(a as u32, false);
-            }
-        }
         self.slots.fill(EMPTY);
+        self.stale.fill(false);
         self.stale_at.fill(u64::MAX);
         self.window_at.fill(u64::MAX);
         self.next_deadline = u64::MAX;
-        self.set_state(self.content.initial);
-        self.propagate();
+        self.state = self.content.initial;
+        let m = &*self.initial;
+        self.alpha_mem.copy_from_slice(&m.alpha_mem);
+        self.beta_tok.copy_from_slice(&m.beta_tok);
+        self.active.clone_from(&m.active);
+        self.active_pos.copy_from_slice(&m.active_pos);
+        self.dirty.fill(0);
+        self.dirty_lo = usize::MAX;
+        self.dirty_hi = 0;
     }
 
     /// Processes one event: expiry, rest, the new fact, rest. Returns the
@@ -403,16 +423,17 @@ impl Engine {
     }
 
     /// Replaces the agent's fact and updates its alpha memories (no propagation).
+    #[inline(always)]
     fn insert(&mut self, event: u32, time: u64, payload: &[Value]) {
-        let agent = self.net.event_agent[event as usize];
+        let ev = self.net.event[event as usize];
+        let agent = ev.agent;
         let a = agent as usize;
         let old = self.slots[a];
         self.seq += 1;
         let run = if old.event == event { old.run + 1 } else { 1 };
         self.slots[a] = Slot { event, time, run, seq: self.seq };
         self.last[a] = self.last[a].max(time);
-        let at = self.net.payload_at[a] as usize;
-        self.payload[at..at + payload.len()].copy_from_slice(payload);
+        copy_payload(&mut self.payload[ev.payload_at as usize..], payload);
         if self.stale[a] {
             self.stale[a] = false;
             self.set_stale_alpha(agent, false);
@@ -420,18 +441,24 @@ impl Engine {
         if old.event != NONE && old.event != event {
             self.clear_event_alpha(old.event);
         }
-        self.eval_event_alpha(event);
+        self.eval_event_alpha(ev.alpha);
         // Timers.
-        let stale_after = self.net.stale_after[a];
-        self.stale_at[a] = if stale_after == u64::MAX { u64::MAX } else { time.saturating_add(stale_after) };
-        self.window_at[a] = self.next_window(event, time);
-        self.next_deadline = self.next_deadline.min(self.stale_at[a]).min(self.window_at[a]);
+        let stale_at = if ev.stale_after == u64::MAX { u64::MAX } else { time.saturating_add(ev.stale_after) };
+        let window_at = self.next_window(ev.windows, time);
+        self.stale_at[a] = stale_at;
+        self.window_at[a] = window_at;
+        self.next_deadline = self.next_deadline.min(stale_at).min(window_at);
     }
 
-    /// When the next window of a fact of `event` reported at `time` closes:
-    /// `time + w` for the smallest window `w` still open (`u64::MAX`: none).
-    fn next_window(&self, event: u32, time: u64) -> u64 {
-        let (s, e) = self.net.event_windows_at[event as usize];
+    /// When the next window of a fact reported at `time` closes, its
+    /// event's windows being `windows` (in `net.windows`): `time + w` for
+    /// the smallest window `w` still open (`u64::MAX`: none).
+    #[inline]
+    fn next_window(&self, windows: (u32, u32), time: u64) -> u64 {
+        let (s, e) = windows;
+        if s == e {
+            return u64::MAX;
+        }
         self.net.windows[s as usize..e as usize]
             .iter()
             .map(|w| time.saturating_add(*w))
@@ -456,7 +483,7 @@ impl Engine {
             } else if self.window_at[a] < self.now {
                 self.refresh_alpha(a as u32);
                 let slot = self.slots[a];
-                self.window_at[a] = self.next_window(slot.event, slot.time);
+                self.window_at[a] = self.next_window(self.net.event[slot.event as usize].windows, slot.time);
             }
             next = next.min(self.stale_at[a]).min(self.window_at[a]);
         }
@@ -466,7 +493,7 @@ impl Engine {
     // ─── Alpha network ─────────────────────────────────────────────────
 
     fn clear_event_alpha(&mut self, event: u32) {
-        let (s, e) = self.net.event_alpha_at[event as usize];
+        let (s, e) = self.net.event[event as usize].alpha;
         for i in s..e {
             let a = self.net.event_alpha[i as usize] as usize;
             if self.alpha_mem[a] {
@@ -479,11 +506,11 @@ impl Engine {
     /// Re-evaluates the alpha nodes of `event` against its agent's new fact:
     /// successors are marked where the result changes, and where it stays
     /// true but join tests below read the replaced fact's values.
-    fn eval_event_alpha(&mut self, event: u32) {
-        let (s, e) = self.net.event_alpha_at[event as usize];
-        for i in s..e {
-            let a = self.net.event_alpha[i as usize] as usize;
-            let pass = self.alpha_passes(a);
+    #[inline]
+    fn eval_event_alpha(&mut self, (s, e): (u32, u32)) {
+        for i in s as usize..e as usize {
+            let a = self.net.event_alpha[i] as usize;
+            let pass = self.event_alpha_passes(&self.net.alpha[a]);
             if pass != self.alpha_mem[a] || (pass && self.net.alpha[a].refresh) {
                 self.alpha_mem[a] = pass;
                 self.mark_succ(a);
@@ -498,7 +525,7 @@ impl Engine {
         if event == NONE {
             return;
         }
-        let (s, e) = self.net.event_alpha_at[event as usize];
+        let (s, e) = self.net.event[event as usize].alpha;
         for i in s..e {
             let a = self.net.event_alpha[i as usize] as usize;
             let pass = self.alpha_passes(a);
@@ -522,19 +549,23 @@ impl Engine {
         match node.kind {
             AlphaKind::State => self.net.state_in(node, self.state),
             AlphaKind::Stale => self.stale[node.agent as usize],
-            AlphaKind::Event => {
-                let slot = &self.slots[node.agent as usize];
-                if slot.event != node.key || slot.run < node.min_run {
-                    return false;
-                }
-                if node.within_ns != u64::MAX && self.now.saturating_sub(slot.time) > node.within_ns {
-                    return false;
-                }
-                let at = self.net.payload_at[node.agent as usize] as usize;
-                let (s, e) = node.tests;
-                self.net.alpha_tests[s as usize..e as usize].iter().all(|t| self.test(t, at))
-            }
+            AlphaKind::Event => self.event_alpha_passes(node),
         }
+    }
+
+    /// An event alpha node's test of its agent's fact: the event, the run
+    /// length, the window, the payload tests.
+    #[inline]
+    fn event_alpha_passes(&self, node: &net::AlphaRt) -> bool {
+        let slot = &self.slots[node.agent as usize];
+        if slot.event != node.key || slot.run < node.min_run {
+            return false;
+        }
+        if node.within_ns != u64::MAX && self.now.saturating_sub(slot.time) > node.within_ns {
+            return false;
+        }
+        let (s, e) = node.tests;
+        s == e || self.net.alpha_tests[s as usize..e as usize].iter().all(|t| self.test(t, node.at as usize))
     }
 
     #[inline]
@@ -567,7 +598,7 @@ impl Engine {
 
     // ─── Beta network ──────────────────────────────────────────────────
 
-    #[inline]
+    #[inline(always)]
     fn mark(&mut self, b: usize) {
         let w = b / 64;
         self.dirty[w] |= 1 << (b % 64);
@@ -575,6 +606,10 @@ impl Engine {
         self.dirty_hi = self.dirty_hi.max(w);
     }
 
+    /// No `#[inline]`: with it, inlined into `insert`'s alpha loop, a step
+    /// cost 29 instructions more (`bench/instructions.sh`: 602 against 573
+    /// per event: the loop's set-up loaded its tables on every event);
+    /// `#[inline(never)]` cost 4 more than the compiler's choice.
     fn mark_succ(&mut self, a: usize) {
         let (s, e) = self.net.alpha[a].succ;
         for i in s..e {
@@ -638,7 +673,7 @@ impl Engine {
         if s == e {
             return true;
         }
-        let own = self.net.payload_at[node.agent as usize] as usize;
+        let own = node.at as usize;
         self.net.beta_tests[s as usize..e as usize].iter().all(|t| self.test(t, own))
     }
 
@@ -672,99 +707,21 @@ impl Engine {
         }
         self.propagate();
     }
+}
 
-    // ─── Inference ─────────────────────────────────────────────────────
-
-    fn set_state(&mut self, state: u32) {
-        let old = self.state;
-        if old == state {
-            return;
+/// Copies an event's payload into its agent's place in the arena
+/// (`dst` starts there and is at least as long); the usual zero, one or two
+/// values without a call to `memcpy`.
+#[inline(always)]
+fn copy_payload(dst: &mut [Value], src: &[Value]) {
+    match (src, dst) {
+        ([], _) => {}
+        ([x], [d, ..]) => *d = *x,
+        ([x, y], [d, e, ..]) => {
+            *d = *x;
+            *e = *y;
         }
-        self.state = state;
-        // Only the state alpha nodes that contain one of the two states flip.
-        for s in [old, state] {
-            let (lo, hi) = self.net.state_alpha_at[s as usize];
-            for i in lo..hi {
-                let a = self.net.state_alpha[i as usize] as usize;
-                let pass = self.net.state_in(&self.net.alpha[a], state);
-                if pass != self.alpha_mem[a] {
-                    self.alpha_mem[a] = pass;
-                    self.mark_succ(a);
-                }
-            }
-        }
-        self.propagate();
-    }
-
-    /// The activated rule that fires first (§10.4), if any.
-    fn best(&self) -> Option<u32> {
-        let mut best: Option<(u32, (i64, u32, u64))> = None;
-        for &r in &self.active {
-            let rule = &self.net.rules[r as usize];
-            let (s, e) = rule.matches;
-            let recency = self.net.rule_agents[s as usize..e as usize]
-                .iter()
-                .map(|&a| self.slots[a as usize].seq)
-                .max()
-                .unwrap_or(0);
-            let key = (rule.salience, rule.specificity, recency);
-            // Ties: the rule declared first.
-            let better = match best {
-                None => true,
-                Some((b, bk)) => key > bk || (key == bk && r < b),
-            };
-            if better {
-                best = Some((r, key));
-            }
-        }
-        best.map(|(r, _)| r)
-    }
-
-    /// Whether nothing waits to be propagated and no rule is activated.
-    #[inline]
-    fn at_rest(&self) -> bool {
-        self.dirty_lo == usize::MAX && self.active.is_empty()
-    }
-
-    /// Fires until no rule is activated; the bound counts the firings of
-    /// the whole step.
-    fn rest(&mut self) -> Result<(), PostError> {
-        self.propagate();
-        while let Some(r) = self.best() {
-            if self.record.firings.len() == self.cascade_limit {
-                let firings = self.last_change().firings;
-                return Err(PostError::Cascade { limit: self.cascade_limit, firings });
-            }
-            let rule = &self.content.rules[r as usize];
-            let to = rule.target;
-            let facts0 = self.record.facts.len() as u32;
-            for &a in &rule.matches {
-                let slot = self.slots[a as usize];
-                let n = self.content.events.get(slot.event as usize).map_or(0, |e| e.fields.len());
-                let at = self.net.payload_at[a as usize] as usize;
-                let v0 = self.record.values.len() as u32;
-                self.record.values.extend_from_slice(&self.payload[at..at + n]);
-                let values = (v0, self.record.values.len() as u32);
-                self.record.facts.push(FactRec { agent: a, event: slot.event, time: slot.time, run: slot.run, values });
-            }
-            let stale0 = self.record.stale.len() as u32;
-            for &a in &rule.stale {
-                if self.stale[a as usize] {
-                    self.record.stale.push(a);
-                }
-            }
-            let rec = FiringRec {
-                rule: r,
-                from: self.state,
-                to,
-                time: self.now,
-                facts: (facts0, self.record.facts.len() as u32),
-                stale: (stale0, self.record.stale.len() as u32),
-            };
-            self.record.firings.push(rec);
-            self.set_state(to);
-        }
-        Ok(())
+        (src, dst) => dst[..src.len()].copy_from_slice(src),
     }
 }
 

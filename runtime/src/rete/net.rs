@@ -54,6 +54,8 @@ pub struct AlphaRt {
     /// Whether a join test below it reads fact values: only then does a
     /// replaced fact that still passes need its successors re-evaluated.
     pub refresh: bool,
+    /// Its agent's payload offset (Event; 0 otherwise).
+    pub at: u32,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -61,8 +63,6 @@ pub struct BetaRt {
     pub parent: u32,
     pub negative: bool,
     pub alpha: u32,
-    /// The agent of its right fact (`NONE` for state and stale nodes).
-    pub agent: u32,
     pub tests: (u32, u32),
     pub children: (u32, u32),
     /// The rules it activates (rules with identical chains share it), in
@@ -70,6 +70,25 @@ pub struct BetaRt {
     pub terminals: (u32, u32),
     /// Whether a join test below it reads fact values (see [`AlphaRt::refresh`]).
     pub refresh: bool,
+    /// The payload offset of its right fact's agent (0 without one).
+    pub at: u32,
+}
+
+/// What a step needs of an event, in one place: one look-up per event on
+/// the hot path instead of one per table.
+#[derive(Debug, Clone, Copy)]
+pub struct EventRt {
+    pub agent: u32,
+    /// Its agent's payload offset.
+    pub payload_at: u32,
+    /// Its fields' kinds, in `kinds`.
+    pub kinds: (u32, u32),
+    /// Its alpha nodes, in `event_alpha`.
+    pub alpha: (u32, u32),
+    /// Its windows, in `windows`.
+    pub windows: (u32, u32),
+    /// Its agent's `stale after`, ns (`u64::MAX`: never).
+    pub stale_after: u64,
 }
 
 #[derive(Debug, Clone)]
@@ -92,11 +111,10 @@ pub struct Net {
     pub terminal_rules: Vec<u32>,
     pub rules: Vec<RuleRt>,
     pub rule_agents: Vec<u32>,
-    /// Per event, its alpha nodes, in `event_alpha`.
-    pub event_alpha_at: Vec<(u32, u32)>,
+    /// The alpha nodes of each event ([`EventRt::alpha`]).
     pub event_alpha: Vec<u32>,
-    /// Per event: the distinct windows of its alpha nodes, ascending, in `windows`.
-    pub event_windows_at: Vec<(u32, u32)>,
+    /// The distinct windows of each event's alpha nodes, ascending
+    /// ([`EventRt::windows`]).
     pub windows: Vec<u64>,
     /// Per agent: its stale alpha node, or `NONE`.
     pub stale_alpha: Vec<u32>,
@@ -111,14 +129,14 @@ pub struct Net {
     pub payload_at: Vec<u32>,
     pub stride: Vec<u32>,
     pub payload_len: usize,
-    /// Per agent: `stale after`, nanoseconds (`u64::MAX`: never).
-    pub stale_after: Vec<u64>,
     /// Agents with a staleness or a window to watch.
     pub timed_agents: Vec<u32>,
-    /// Per event: its agent, and its fields' kinds in `kinds`.
-    pub event_agent: Vec<u32>,
-    pub event_kinds: Vec<(u32, u32)>,
+    /// The fields' kinds of each event ([`EventRt::kinds`]).
     pub kinds: Vec<Kind>,
+    /// Per event, what a step needs of it (the tables above, gathered).
+    pub event: Vec<EventRt>,
+    /// Per state: whether it is final.
+    pub final_state: Vec<bool>,
 }
 
 /// A field's type, flat, for checking payloads fast.
@@ -195,6 +213,7 @@ impl Net {
                         within_ns: u64::MAX,
                         succ: succ_range,
                         refresh: false,
+                        at: 0,
                     }
                 }
                 AlphaNode::Event { event, tests, min_run, within_ns } => {
@@ -212,6 +231,7 @@ impl Net {
                         within_ns: within_ns.unwrap_or(u64::MAX),
                         succ: succ_range,
                         refresh: false,
+                        at: payload_at[c.events[*event as usize].agent as usize],
                     }
                 }
                 AlphaNode::Stale { agent } => {
@@ -225,6 +245,7 @@ impl Net {
                         within_ns: u64::MAX,
                         succ: succ_range,
                         refresh: false,
+                        at: 0,
                     }
                 }
             };
@@ -251,11 +272,11 @@ impl Net {
                 parent: b.parent.unwrap_or(NONE),
                 negative: b.kind == BetaKind::Negative,
                 alpha: b.alpha,
-                agent: if a.kind == AlphaKind::Event { a.agent } else { NONE },
                 tests: range(t0, beta_tests.len()),
                 children: range(c0, children.len()),
                 terminals: range(r0, terminal_rules.len()),
                 refresh: false,
+                at: if a.kind == AlphaKind::Event { a.at } else { 0 },
             });
         }
         // Bottom up (children come after their parents): whether a subtree
@@ -314,7 +335,7 @@ impl Net {
                     })
             })
             .collect();
-        let event_agent = c.events.iter().map(|e| e.agent).collect();
+        let event_agent: Vec<u32> = c.events.iter().map(|e| e.agent).collect();
         let mut kinds = Vec::new();
         let mut event_kinds = Vec::with_capacity(ne);
         for e in &c.events {
@@ -327,9 +348,23 @@ impl Net {
             }));
             event_kinds.push(range(s, kinds.len()));
         }
+        let event = (0..ne)
+            .map(|e| {
+                let agent = event_agent[e];
+                EventRt {
+                    agent,
+                    payload_at: payload_at[agent as usize],
+                    kinds: event_kinds[e],
+                    alpha: event_alpha_at[e],
+                    windows: event_windows_at[e],
+                    stale_after: stale_after[agent as usize],
+                }
+            })
+            .collect();
+        let final_state = c.states.iter().map(|s| s.is_final).collect();
         Net {
-            event_agent,
-            event_kinds,
+            event,
+            final_state,
             kinds,
             alpha,
             alpha_tests,
@@ -340,9 +375,7 @@ impl Net {
             terminal_rules,
             rules,
             rule_agents,
-            event_alpha_at,
             event_alpha,
-            event_windows_at,
             windows,
             stale_alpha,
             state_sets,
@@ -351,11 +384,11 @@ impl Net {
             payload_at,
             stride,
             payload_len: at as usize,
-            stale_after,
             timed_agents,
         }
     }
 
+    #[inline]
     pub fn state_in(&self, alpha: &AlphaRt, state: u32) -> bool {
         let off = alpha.key as usize + state as usize / 64;
         self.state_sets[off] & (1 << (state % 64)) != 0

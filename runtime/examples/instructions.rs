@@ -1,0 +1,111 @@
+//! The engine's processing loop alone, for counting its instructions
+//! (`bench/instructions.sh`, docs/performance.md):
+//!
+//! ```text
+//! cargo build --release -p situ-runtime --example instructions
+//! target/release/examples/instructions BUNDLE STREAM [STATES_OUT]
+//! ```
+//!
+//! Loads a bundle and reads a `.events` stream before anything is counted;
+//! then [`process_stream`], the one function that callgrind counts
+//! (`--toggle-collect=*::process_stream`), steps every event as `situ bench`
+//! does (the event's clock set, `Engine::step`, the state at rest compared,
+//! a mission reset in a final state). Writes the `INDEX STATE` lines of
+//! `situ bench --states-out` to STATES_OUT, so that the script checks the
+//! state sequence against the hand-written matcher's.
+
+use situ_runtime::rete::Engine;
+use situ_runtime::stream::{self, Event};
+use std::io::Write;
+use std::process::ExitCode;
+use std::sync::Arc;
+
+/// The events of the stream, flat: `(event, time, clock, payload start, end)`
+/// and the payloads in one arena, as `situ bench`'s chunks hold them.
+struct Flat {
+    events: Vec<(u32, u64, Option<u64>, u32, u32)>,
+    values: Vec<situ_bundle::Value>,
+}
+
+/// Every event through the engine, as `situ bench`'s timed loop: returns
+/// the state changes `(index, state)`, collected into `changes` (reserved
+/// beforehand: it does not grow here). Never inlined: callgrind counts
+/// this function and what it calls, nothing else.
+#[inline(never)]
+fn process_stream(engine: &mut Engine, flat: &Flat, changes: &mut Vec<(u64, u32)>) -> u64 {
+    let mut refused = 0;
+    let mut at_rest = engine.state();
+    for (i, &(event, time, clock, s, e)) in flat.events.iter().enumerate() {
+        engine.set_clock(clock);
+        if engine.step(event, time, &flat.values[s as usize..e as usize]).is_err() {
+            refused += 1;
+        }
+        let state = engine.state();
+        if state != at_rest {
+            changes.push((i as u64, state));
+            at_rest = state;
+        }
+        if engine.reset_if_final() {
+            at_rest = engine.state();
+        }
+    }
+    refused
+}
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.len() < 2 || args.len() > 3 {
+        eprintln!("usage: instructions BUNDLE STREAM [STATES_OUT]");
+        return ExitCode::from(2);
+    }
+    let content = match std::fs::read(&args[0]).map(|b| situ_bundle::codec::decode(&b)) {
+        Ok(Ok(c)) => Arc::new(c),
+        Ok(Err(e)) => {
+            eprintln!("instructions: {}: {e}", args[0]);
+            return ExitCode::from(2);
+        }
+        Err(e) => {
+            eprintln!("instructions: cannot read {}: {e}", args[0]);
+            return ExitCode::from(2);
+        }
+    };
+    let events: Vec<Event> = match std::fs::read_to_string(&args[1]).map(|t| stream::parse(&content, &t)) {
+        Ok(Ok(events)) => events,
+        Ok(Err(e)) => {
+            eprintln!("instructions: {}: {e}", args[1]);
+            return ExitCode::from(2);
+        }
+        Err(e) => {
+            eprintln!("instructions: cannot read {}: {e}", args[1]);
+            return ExitCode::from(2);
+        }
+    };
+    let mut flat = Flat { events: Vec::with_capacity(events.len()), values: Vec::new() };
+    for e in &events {
+        let s = flat.values.len() as u32;
+        flat.values.extend_from_slice(&e.payload);
+        flat.events.push((e.event, e.time, e.clock, s, flat.values.len() as u32));
+    }
+    drop(events);
+
+    let mut engine = Engine::new(content.clone());
+    let mut changes = Vec::with_capacity(flat.events.len());
+    let refused = process_stream(&mut engine, &flat, &mut changes);
+
+    if let Some(path) = args.get(2) {
+        let mut text = String::new();
+        for (i, s) in &changes {
+            text.push_str(&format!("{i} {}\n", content.states[*s as usize].name));
+        }
+        if let Err(e) = std::fs::File::create(path).and_then(|mut f| f.write_all(text.as_bytes())) {
+            eprintln!("instructions: cannot write {path}: {e}");
+            return ExitCode::from(2);
+        }
+    }
+    println!(
+        "{{\"engine\":\"situ\",\"events\":{},\"state_changes\":{},\"refused\":{refused}}}",
+        flat.events.len(),
+        changes.len()
+    );
+    ExitCode::SUCCESS
+}

@@ -1,0 +1,100 @@
+//! Inference (language reference §10.4): the state set with the state
+//! alpha nodes it flips, the activated rule that fires first, and the rest:
+//! firing until no rule is activated, each firing recorded with the facts
+//! it matched (for explanations) in the buffers of the step.
+
+use super::{Engine, FactRec, FiringRec, PostError};
+
+impl Engine {
+    pub(super) fn set_state(&mut self, state: u32) {
+        let old = self.state;
+        if old == state {
+            return;
+        }
+        self.state = state;
+        // Only the state alpha nodes that contain one of the two states flip.
+        for s in [old, state] {
+            let (lo, hi) = self.net.state_alpha_at[s as usize];
+            for i in lo..hi {
+                let a = self.net.state_alpha[i as usize] as usize;
+                let pass = self.net.state_in(&self.net.alpha[a], state);
+                if pass != self.alpha_mem[a] {
+                    self.alpha_mem[a] = pass;
+                    self.mark_succ(a);
+                }
+            }
+        }
+        self.propagate();
+    }
+
+    /// The activated rule that fires first (§10.4), if any.
+    pub(super) fn best(&self) -> Option<u32> {
+        let mut best: Option<(u32, (i64, u32, u64))> = None;
+        for &r in &self.active {
+            let rule = &self.net.rules[r as usize];
+            let (s, e) = rule.matches;
+            let recency = self.net.rule_agents[s as usize..e as usize]
+                .iter()
+                .map(|&a| self.slots[a as usize].seq)
+                .max()
+                .unwrap_or(0);
+            let key = (rule.salience, rule.specificity, recency);
+            // Ties: the rule declared first.
+            let better = match best {
+                None => true,
+                Some((b, bk)) => key > bk || (key == bk && r < b),
+            };
+            if better {
+                best = Some((r, key));
+            }
+        }
+        best.map(|(r, _)| r)
+    }
+
+    /// Whether nothing waits to be propagated and no rule is activated.
+    #[inline]
+    pub(super) fn at_rest(&self) -> bool {
+        self.dirty_lo == usize::MAX && self.active.is_empty()
+    }
+
+    /// Fires until no rule is activated; the bound counts the firings of
+    /// the whole step.
+    pub(super) fn rest(&mut self) -> Result<(), PostError> {
+        self.propagate();
+        while let Some(r) = self.best() {
+            if self.record.firings.len() == self.cascade_limit {
+                let firings = self.last_change().firings;
+                return Err(PostError::Cascade { limit: self.cascade_limit, firings });
+            }
+            let rule = &self.content.rules[r as usize];
+            let to = rule.target;
+            let facts0 = self.record.facts.len() as u32;
+            for &a in &rule.matches {
+                let slot = self.slots[a as usize];
+                let n = self.content.events.get(slot.event as usize).map_or(0, |e| e.fields.len());
+                let at = self.net.payload_at[a as usize] as usize;
+                let v0 = self.record.values.len() as u32;
+                self.record.values.extend_from_slice(&self.payload[at..at + n]);
+                let values = (v0, self.record.values.len() as u32);
+                self.record.facts.push(FactRec { agent: a, event: slot.event, time: slot.time, run: slot.run, values });
+            }
+            let stale0 = self.record.stale.len() as u32;
+            for &a in &rule.stale {
+                if self.stale[a as usize] {
+                    self.record.stale.push(a);
+                }
+            }
+            let rec = FiringRec {
+                rule: r,
+                from: self.state,
+                to,
+                time: self.now,
+                facts: (facts0, self.record.facts.len() as u32),
+                stale: (stale0, self.record.stale.len() as u32),
+            };
+            self.record.firings.push(rec);
+            self.set_state(to);
+        }
+        Ok(())
+    }
+}
