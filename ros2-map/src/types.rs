@@ -194,6 +194,38 @@ impl Cx<'_> {
         None
     }
 
+    /// E0403: a path that does not name a value of the message.
+    fn unknown(
+        &mut self,
+        range: expr::Range,
+        message: String,
+        label: impl Into<String>,
+        help: impl Into<String>,
+    ) -> Option<Ty> {
+        let span = self.text.sub(range.0, range.1);
+        self.out
+            .paths
+            .push(Diagnostic::error(codes::ROS2_UNKNOWN_FIELD, message, self.file, span, label).with_help(help));
+        None
+    }
+
+    /// E0403: an index on `t`, which is not an array.
+    fn not_an_array(&mut self, range: expr::Range, t: &Ty) -> Option<Ty> {
+        let message = format!("an index on {}, which is not an array", t.describe());
+        self.unknown(range, message, "not an array", "index an array field: `status[0]`, `status_list[-1]`")
+    }
+
+    /// E0403: index `i` outside a fixed-size array of `n`.
+    fn out_of_array(&mut self, range: expr::Range, i: impl std::fmt::Display, n: usize) -> Option<Ty> {
+        let help = format!("an index of this array is from 0 to {} (or -{n} to -1)", n.saturating_sub(1));
+        self.unknown(
+            range,
+            format!("index {i} is out of the array of {n}"),
+            format!("the array has {n} elements"),
+            help,
+        )
+    }
+
     /// A type mismatch of a function's argument, with the function's usage.
     fn bad_arg(&mut self, f: Func, arg: &Expr, needs: &str, found: &Ty) -> Option<Ty> {
         let r = arg.range();
@@ -395,12 +427,7 @@ impl Cx<'_> {
                 format!("write `it` for the element, e.g. `{f}({array}, it > 0)`; nothing outside the element is visible there"),
             ),
         };
-        let span = self.text.sub(r.0, r.1);
-        self.out.paths.push(
-            Diagnostic::error(codes::ROS2_UNKNOWN_FIELD, message, self.file, span, "not a field of the element")
-                .with_help(help),
-        );
-        None
+        self.unknown(r, message, "not a field of the element", help)
     }
 
     fn path_from(&mut self, start: Ty, steps: &[Step]) -> Option<Ty> {
@@ -428,71 +455,31 @@ impl Cx<'_> {
                             Some(s) => format!("did you mean `{s}`? {listed}"),
                             None => listed,
                         };
-                        let span = self.text.sub(r.0, r.1);
-                        self.out.paths.push(
-                            Diagnostic::error(
-                                codes::ROS2_UNKNOWN_FIELD,
-                                format!("`{m}` has no field `{name}`"),
-                                self.file,
-                                span,
-                                format!("not a field of `{m}`"),
-                            )
-                            .with_help(help),
+                        return self.unknown(
+                            *r,
+                            format!("`{m}` has no field `{name}`"),
+                            format!("not a field of `{m}`"),
+                            help,
                         );
-                        return None;
                     }
                 },
                 (Step::Index(i, r), Ty::Array(el, size)) => {
                     if let Some(n) = size.filter(|n| usize::try_from(*i).map_or(true, |i| i >= *n)) {
-                        let span = self.text.sub(r.0, r.1);
-                        self.out.paths.push(
-                            Diagnostic::error(
-                                codes::ROS2_UNKNOWN_FIELD,
-                                format!("index {i} is out of the array of {n}"),
-                                self.file,
-                                span,
-                                format!("the array has {n} elements"),
-                            )
-                            .with_help(format!(
-                                "an index of this array is from 0 to {} (or -{n} to -1)",
-                                n.saturating_sub(1)
-                            )),
-                        );
-                        return None;
+                        return self.out_of_array(*r, i, n);
                     }
                     Ty::of(el)
                 }
                 (Step::Field(name, r), t) => {
-                    let span = self.text.sub(r.0, r.1);
                     let help = match t {
                         Ty::Array(..) => format!("pick an element first: `[0]`, `[-1]`, or `find(array, …).{name}`"),
                         _ => format!("remove `.{name}`: only messages have fields"),
                     };
-                    self.out.paths.push(
-                        Diagnostic::error(
-                            codes::ROS2_UNKNOWN_FIELD,
-                            format!("`.{name}` of {}, which has no fields", t.describe()),
-                            self.file,
-                            span,
-                            "no such field",
-                        )
-                        .with_help(help),
-                    );
-                    return None;
+                    let message = format!("`.{name}` of {}, which has no fields", t.describe());
+                    return self.unknown(*r, message, "no such field", help);
                 }
                 (Step::Index(_, r), t) => {
-                    let span = self.text.sub(r.0, r.1);
-                    self.out.paths.push(
-                        Diagnostic::error(
-                            codes::ROS2_UNKNOWN_FIELD,
-                            format!("an index on {}, which is not an array", t.describe()),
-                            self.file,
-                            span,
-                            "not an array",
-                        )
-                        .with_help("index an array field: `status[0]`, `status_list[-1]`"),
-                    );
-                    return None;
+                    let t = t.clone();
+                    return self.not_an_array(*r, &t);
                 }
             };
         }
@@ -561,35 +548,11 @@ impl Cx<'_> {
     /// The element of `array` at the integer `index` (`a[-1]`, `a[i]`).
     fn element(&mut self, array: Ty, index: &Expr) -> Option<Ty> {
         let r = index.range();
-        let Ty::Array(el, size) = array else {
-            let span = self.text.sub(r.0, r.1);
-            self.out.paths.push(
-                Diagnostic::error(
-                    codes::ROS2_UNKNOWN_FIELD,
-                    format!("an index on {}, which is not an array", array.describe()),
-                    self.file,
-                    span,
-                    "not an array",
-                )
-                .with_help("index an array field: `status[0]`, `status_list[-1]`"),
-            );
-            return None;
-        };
+        let Ty::Array(el, size) = array else { return self.not_an_array(r, &array) };
         if let (Some(n), Some(i)) = (size, constant(index)) {
             let at = if i < 0.0 { i + n as f64 } else { i };
             if at < 0.0 || at >= n as f64 {
-                let span = self.text.sub(r.0, r.1);
-                self.out.paths.push(
-                    Diagnostic::error(
-                        codes::ROS2_UNKNOWN_FIELD,
-                        format!("index {i} is out of the array of {n}"),
-                        self.file,
-                        span,
-                        format!("the array has {n} elements"),
-                    )
-                    .with_help(format!("an index of this array is from 0 to {} (or -{n} to -1)", n.saturating_sub(1))),
-                );
-                return None;
+                return self.out_of_array(r, i, n);
             }
         }
         Some(Ty::of(&el))
