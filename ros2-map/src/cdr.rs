@@ -95,28 +95,24 @@ enum Prim {
     String,
 }
 
-/// The primitives by their names in `.msg` files; ROS 2 maps `byte` and
-/// `char` to octet and uint8, the first name is the one errors give.
-const PRIMS: [(&str, Prim); 14] = [
-    ("bool", Prim::Bool),
-    ("int8", Prim::I8),
-    ("uint8", Prim::U8),
-    ("byte", Prim::U8),
-    ("char", Prim::U8),
-    ("int16", Prim::I16),
-    ("uint16", Prim::U16),
-    ("int32", Prim::I32),
-    ("uint32", Prim::U32),
-    ("int64", Prim::I64),
-    ("uint64", Prim::U64),
-    ("float32", Prim::F32),
-    ("float64", Prim::F64),
-    ("string", Prim::String),
-];
-
 impl Prim {
+    /// Its name in `.msg` files (`byte` and `char` are `uint8` on the
+    /// wire, and named so in errors).
     fn name(self) -> &'static str {
-        PRIMS.iter().find(|(_, p)| *p == self).map_or("?", |(n, _)| n)
+        match self {
+            Prim::Bool => "bool",
+            Prim::I8 => "int8",
+            Prim::U8 => "uint8",
+            Prim::I16 => "int16",
+            Prim::U16 => "uint16",
+            Prim::I32 => "int32",
+            Prim::U32 => "uint32",
+            Prim::I64 => "int64",
+            Prim::U64 => "uint64",
+            Prim::F32 => "float32",
+            Prim::F64 => "float64",
+            Prim::String => "string",
+        }
     }
 
     /// Its size and alignment; a string's is its length's.
