@@ -14,22 +14,19 @@ import sys
 import time
 from dataclasses import dataclass, field
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "ros2-map", "tests"))
+sys.path.insert(0, os.path.dirname(__file__))
 
-try:
-    import cyclonedds.idl.types as t
-    from cyclonedds.core import Policy, Qos
-    from cyclonedds.domain import DomainParticipant
-    from cyclonedds.idl import IdlStruct
-    from cyclonedds.pub import DataWriter
-    from cyclonedds.sub import DataReader
-    from cyclonedds.topic import Topic
-except ImportError as err:
-    print(f"cyclonedds is not installed ({err}): python3 -m pip install -r examples/python/requirements.txt", file=sys.stderr)
-    sys.exit(3)
+from peer import LATCHED, RELIABLE  # noqa: E402  (exits 3 without cyclonedds; puts cdr_samples on the path)
 
-from cdr_samples import UUID, GoalInfo, GoalStatus, GoalStatusArray, Header, JointState, Time
-from cdr_samples import String as StringMsg
+import cyclonedds.idl.types as t  # noqa: E402
+from cyclonedds.domain import DomainParticipant  # noqa: E402
+from cyclonedds.idl import IdlStruct  # noqa: E402
+from cyclonedds.pub import DataWriter  # noqa: E402
+from cyclonedds.sub import DataReader  # noqa: E402
+from cyclonedds.topic import Topic  # noqa: E402
+
+from cdr_samples import UUID, GoalInfo, GoalStatus, GoalStatusArray, Header, JointState, Time  # noqa: E402
+from cdr_samples import String as StringMsg  # noqa: E402
 
 
 @dataclass
@@ -49,12 +46,10 @@ class GripperFeedbackMessage(IdlStruct, typename="control_msgs::action::dds_::Gr
 def main():
     domain = int(sys.argv[1])
     dp = DomainParticipant(domain)
-    reliable = Qos(Policy.Reliability.Reliable(1_000_000_000), Policy.History.KeepLast(16))
-    latched = Qos(Policy.Reliability.Reliable(1_000_000_000), Policy.Durability.TransientLocal, Policy.History.KeepLast(1))
-    joints = DataWriter(dp, Topic(dp, "rt/joint_states", JointState), qos=reliable)
-    feedback = DataWriter(dp, Topic(dp, "rt/gripper/_action/feedback", GripperFeedbackMessage), qos=reliable)
-    status = DataWriter(dp, Topic(dp, "rt/navigate/_action/status", GoalStatusArray), qos=reliable)
-    state_reader = DataReader(dp, Topic(dp, "rt/situ/state", StringMsg), qos=latched)
+    joints = DataWriter(dp, Topic(dp, "rt/joint_states", JointState), qos=RELIABLE)
+    feedback = DataWriter(dp, Topic(dp, "rt/gripper/_action/feedback", GripperFeedbackMessage), qos=RELIABLE)
+    status = DataWriter(dp, Topic(dp, "rt/navigate/_action/status", GoalStatusArray), qos=RELIABLE)
+    state_reader = DataReader(dp, Topic(dp, "rt/situ/state", StringMsg), qos=LATCHED)
     goal = UUID(list(range(16)))
     state, end = None, time.monotonic() + 20
     while time.monotonic() < end:
