@@ -7,22 +7,11 @@
 use proptest::prelude::*;
 use situ_grammar::diag::FileId;
 use situ_grammar::{parse, ItemCache};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::OnceLock;
 
-/// Every `.situ` file under `dir`, recursively, sorted.
-fn situ_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else { return };
-    let mut paths: Vec<PathBuf> = entries.flatten().map(|e| e.path()).collect();
-    paths.sort();
-    for path in paths {
-        if path.is_dir() {
-            situ_files(&path, out);
-        } else if path.extension().is_some_and(|e| e == "situ") {
-            out.push(path);
-        }
-    }
-}
+mod common;
+use common::situ_files;
 
 /// The texts of the repository's `.situ` files, those that break included.
 fn corpus() -> &'static [String] {

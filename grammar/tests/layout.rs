@@ -10,26 +10,11 @@ use proptest::prelude::*;
 use serde_json::Value;
 use situ_grammar::diag::FileId;
 use situ_grammar::{format, parse};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::OnceLock;
 
-/// Every `.situ` file under `dir`, recursively, sorted; build output and
-/// hidden folders aside.
-fn situ_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else { return };
-    let mut paths: Vec<PathBuf> = entries.flatten().map(|e| e.path()).collect();
-    paths.sort();
-    for path in paths {
-        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        if path.is_dir() {
-            if !name.starts_with('.') && name != "target" && name != "node_modules" {
-                situ_files(&path, out);
-            }
-        } else if name.ends_with(".situ") {
-            out.push(path);
-        }
-    }
-}
+mod common;
+use common::situ_files;
 
 /// The repository's `.situ` files that are UTF-8, as (name, text): the valid
 /// ones and the deliberately broken ones (UI inputs) alike.

@@ -15,21 +15,10 @@
 use situ_grammar::diag::{Diagnostic, FileId};
 use situ_grammar::parse;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-/// Every `.situ` file under `dir`, recursively, sorted.
-fn situ_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else { return };
-    let mut paths: Vec<PathBuf> = entries.flatten().map(|e| e.path()).collect();
-    paths.sort();
-    for path in paths {
-        if path.is_dir() {
-            situ_files(&path, out);
-        } else if path.extension().is_some_and(|e| e == "situ") {
-            out.push(path);
-        }
-    }
-}
+mod common;
+use common::situ_files;
 
 /// The repository's files that parse, as (name, text); `tests/checks/` is
 /// sampled (it is large and alike).

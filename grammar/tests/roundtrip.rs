@@ -9,26 +9,19 @@ use situ_grammar::diag::FileId;
 use situ_grammar::{format, parse};
 use std::path::{Path, PathBuf};
 
-/// The folders whose `.situ` files are checked; any may be missing.
-fn roots() -> Vec<PathBuf> {
-    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
-    vec![manifest.join("../rules"), manifest.join("../tests/ui"), manifest.join("tests/fmt")]
-}
+mod common;
 
 /// Every `.situ` file under `dir`, recursively, sorted; none if it is missing.
 fn situ_files(dir: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();
-    let Ok(entries) = std::fs::read_dir(dir) else { return out };
-    for entry in entries.flatten() {
-        let path = entry.path();
-        if path.is_dir() {
-            out.extend(situ_files(&path));
-        } else if path.extension().is_some_and(|e| e == "situ") {
-            out.push(path);
-        }
-    }
-    out.sort();
+    common::situ_files(dir, &mut out);
     out
+}
+
+/// The folders whose `.situ` files are checked; any may be missing.
+fn roots() -> Vec<PathBuf> {
+    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
+    vec![manifest.join("../rules"), manifest.join("../tests/ui"), manifest.join("tests/fmt")]
 }
 
 /// The AST of a source, as JSON without spans.
