@@ -69,14 +69,22 @@ pub struct Args {
     pub trust: situ_compiler::bundle::Trust,
 }
 
-/// The flag Ctrl-C and SIGTERM raise.
+/// The flag Ctrl-C and SIGTERM raise: one per process, its handler
+/// installed by the first call. Commands call it first thing, before
+/// their set-up (loading, Zenoh's session, the recording): a signal that
+/// comes while a process starts is then a clean stop as soon as it runs,
+/// not the default action's death with a recording half written.
 pub fn stop_flag() -> Arc<AtomicBool> {
-    let stop = Arc::new(AtomicBool::new(false));
-    let s = stop.clone();
-    // A second handler cannot be installed (tests run one command per
-    // process): an error here only means no clean stop on signals.
-    let _ = ctrlc::set_handler(move || s.store(true, Ordering::Release));
-    stop
+    static STOP: std::sync::OnceLock<Arc<AtomicBool>> = std::sync::OnceLock::new();
+    STOP.get_or_init(|| {
+        let stop = Arc::new(AtomicBool::new(false));
+        let s = stop.clone();
+        // An error here (another handler was installed) only means no
+        // clean stop on signals.
+        let _ = ctrlc::set_handler(move || s.store(true, Ordering::Release));
+        stop
+    })
+    .clone()
 }
 
 fn agents_of(stack: Stack, names: &[String]) -> Result<Vec<Box<dyn Agent>>, String> {
@@ -131,6 +139,7 @@ pub fn run(args: Args) -> u8 {
         eprintln!("error: --duration must be a positive number of seconds");
         return USAGE;
     }
+    stop_flag();
     let program = match super::program::load(&args.file, false, &args.trust) {
         Ok(p) => p,
         Err(code) => return code,

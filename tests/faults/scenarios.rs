@@ -107,6 +107,37 @@ pub struct RouterRestart {
     /// stop, and the path the pipeline followed.
     pub board_states: Vec<String>,
     pub pipeline_path: Vec<String>,
+    /// With two boards: the statuses' epochs and boards as the observer
+    /// saw them change (the first status's, then each change), and
+    /// those that came in the last second before the stop.
+    pub epochs: Vec<(Option<u64>, Option<String>)>,
+    pub last_second: Vec<(Option<u64>, Option<String>)>,
+    /// With two boards: the standby's recorded states.
+    pub standby_states: Vec<String>,
+    /// Every process's standard error (what the boards said: who led).
+    pub errs: String,
+}
+
+/// The changes of (epoch, board) in the statuses seen, in order.
+pub fn epoch_changes(seen: &[Seen]) -> Vec<(Option<u64>, Option<String>)> {
+    let mut out: Vec<(Option<u64>, Option<String>)> = Vec::new();
+    for s in seen {
+        let k = (s.epoch, s.board.clone());
+        if out.last() != Some(&k) {
+            out.push(k);
+        }
+    }
+    out
+}
+
+/// The distinct (epoch, board) of the statuses that arrived in `from..to`.
+fn epochs_within(seen: &[Seen], from: u64, to: u64) -> Vec<(Option<u64>, Option<String>)> {
+    epoch_changes(&seen.iter().filter(|s| s.at_ns > from && s.at_ns <= to).cloned().collect::<Vec<_>>())
+}
+
+/// Every process's standard error, named.
+fn errs(lab: &Lab, running: &Running) -> String {
+    running.procs.iter().map(|(n, pid)| format!("--- {n}:\n{}", lab.stderr(*pid))).collect()
 }
 
 /// Fig. 5's processes as clients of a router process, each on its own host
@@ -115,9 +146,18 @@ pub struct RouterRestart {
 /// (SIGKILL) and started again after `down`; the run goes on until the
 /// observer (a client of the router, on the pipeline's host) has had 5
 /// statuses after the restart.
-pub fn restart_router(down: Duration, stale: Option<&str>) -> RouterRestart {
-    let mut lab = Lab::new(&["router", "board", "sensors", "pipeline"]);
-    let procs = fig5_router();
+///
+/// With `two_boards`, a second board process, `standby`, on a host of its
+/// own, is a client of the router too: the router's restart cuts the
+/// boards from each other as well as from the agents.
+pub fn restart_router(down: Duration, stale: Option<&str>, two_boards: bool) -> RouterRestart {
+    let hosts: &[&str] = if two_boards {
+        &["router", "board", "standby", "sensors", "pipeline"]
+    } else {
+        &["router", "board", "sensors", "pipeline"]
+    };
+    let mut lab = Lab::new(hosts);
+    let procs = if two_boards { super::standby::fig5_router_two_boards() } else { fig5_router() };
     let rules = match stale {
         Some(stale) => fig5_rules_with_stale(&lab, stale),
         None => fig5_rules(),
@@ -126,7 +166,7 @@ pub fn restart_router(down: Duration, stale: Option<&str>) -> RouterRestart {
     let mut running = start(&mut lab, &rules, &deploy, &procs);
     let at = format!("tcp/{}:7447", lab.addr("router"));
     running.observer = Some(observe(&mut lab, "pipeline", &at, "client", "fig5"));
-    for p in ["board", "sensors", "pipeline"] {
+    for p in ["sensors", "pipeline"] {
         wait_state(&mut lab, &running, p, "RO", LONG);
     }
     std::thread::sleep(Duration::from_millis(500));
@@ -137,6 +177,11 @@ pub fn restart_router(down: Duration, stale: Option<&str>) -> RouterRestart {
     let again = lab.spawn("router", "router-again", situ_run(&lab, &rules, &deploy, "router"));
     running.procs.insert("router".into(), again);
     wait_statuses(&mut lab, &running, restarted_ns, 5);
+    if two_boards {
+        // Time for the boards to hear each other again and the lower
+        // epoch to step down (what the last second then shows).
+        std::thread::sleep(Duration::from_secs(2));
+    }
     let stopped = stop_all(&mut lab, &running);
     let seen = seen(&lab, running.observer.unwrap());
     check_monotonic(&seen).unwrap();
@@ -153,6 +198,10 @@ pub fn restart_router(down: Duration, stale: Option<&str>) -> RouterRestart {
         pipeline_out: lab.stdout(running.procs["pipeline"]),
         board_states: recorded_states(&recording(&lab, "board"), stopped),
         pipeline_path: path(&lab.stdout(running.procs["pipeline"])),
+        epochs: epoch_changes(&seen),
+        last_second: epochs_within(&seen, stopped.saturating_sub(1_000_000_000), stopped),
+        standby_states: if two_boards { recorded_states(&recording(&lab, "standby"), stopped) } else { Vec::new() },
+        errs: errs(&lab, &running),
     }
 }
 
@@ -176,6 +225,11 @@ pub struct Lossy {
     /// stop, and the path the pipeline followed.
     pub board_states: Vec<String>,
     pub pipeline_path: Vec<String>,
+    /// The (epoch, board) of the statuses seen, as they changed over the
+    /// whole run (one entry: one leader throughout).
+    pub epochs: Vec<(Option<u64>, Option<String>)>,
+    /// The boards' lines on leading and stepping down (standard error).
+    pub leadership: Vec<String>,
 }
 
 /// The settings of [`delay_and_loss`].
@@ -189,14 +243,15 @@ pub struct LossySettings {
     /// The rules: examples/fig5 with this `stale after` for the sensors
     /// (`None`: the file's 500 ms).
     pub stale: Option<&'static str>,
+    /// A second board, `standby`, on a host of its own: a standby group
+    /// whose boards talk through the relay too.
+    pub two_boards: bool,
 }
 
-const HOSTS: [&str; 3] = ["board", "sensors", "pipeline"];
-
 /// The TCP counters of the hosts and the switch (the relay), summed.
-fn tcp_total(lab: &Lab) -> BTreeMap<String, u64> {
+fn tcp_total(lab: &Lab, hosts: &[&str]) -> BTreeMap<String, u64> {
     let mut sum = BTreeMap::new();
-    for counters in HOSTS.iter().map(|h| lab.tcp_counters(h)).chain([lab.switch_tcp_counters()]) {
+    for counters in hosts.iter().map(|h| lab.tcp_counters(h)).chain([lab.switch_tcp_counters()]) {
         for (k, v) in counters {
             *sum.entry(k).or_insert(0) += v;
         }
@@ -207,11 +262,18 @@ fn tcp_total(lab: &Lab) -> BTreeMap<String, u64> {
 /// Fig. 5 on three hosts whose every link crosses a relay that delays
 /// each way by `delay_ms`; once every process follows RO, each host drops
 /// `loss_percent` % of what it sends to the others, for `lasting`.
+///
+/// With `two_boards` ([`super::standby::fig5_two_boards`]) the boards' log,
+/// acknowledgements and beats cross the relay and the loss as well: a
+/// follower that misses the leader's beats for its lease would lead (a
+/// false takeover), which [`Lossy::epochs`] shows.
 pub fn delay_and_loss(s: &LossySettings) -> Lossy {
-    let mut lab = Lab::new(&HOSTS);
-    let procs = fig5_peers();
+    let hosts: &[&str] =
+        if s.two_boards { &["board", "standby", "sensors", "pipeline"] } else { &["board", "sensors", "pipeline"] };
+    let mut lab = Lab::new(hosts);
+    let procs = if s.two_boards { super::standby::fig5_two_boards() } else { fig5_peers() };
     let relay = lab.relay(s.delay_ms, &relay_targets(&procs));
-    for h in HOSTS {
+    for &h in hosts {
         lab.only_through_switch(h);
     }
     if let Some(ms) = s.rto_min_ms {
@@ -225,20 +287,20 @@ pub fn delay_and_loss(s: &LossySettings) -> Lossy {
     let mut running = start(&mut lab, &rules, &deploy, &procs);
     let at = format!("tcp/{}:7449", lab.addr("pipeline"));
     running.observer = Some(observe(&mut lab, "pipeline", &at, "client", "fig5"));
-    for p in HOSTS {
+    for p in ["sensors", "pipeline"] {
         wait_state(&mut lab, &running, p, "RO", LONG);
     }
-    let before = tcp_total(&lab);
+    let before = tcp_total(&lab, hosts);
     let from_ns = now_ns();
-    for h in HOSTS {
+    for &h in hosts {
         lab.loss(h, s.loss_percent);
     }
     std::thread::sleep(s.lasting);
-    for h in HOSTS {
+    for &h in hosts {
         lab.loss(h, 0);
     }
     let to_ns = now_ns();
-    let after = tcp_total(&lab);
+    let after = tcp_total(&lab, hosts);
     std::thread::sleep(Duration::from_millis(500));
     let stopped = stop_all(&mut lab, &running);
     let seen = seen(&lab, running.observer.unwrap());
@@ -257,7 +319,23 @@ pub fn delay_and_loss(s: &LossySettings) -> Lossy {
         board_out: lab.stdout(running.procs["board"]),
         board_states: recorded_states(&recording(&lab, "board"), stopped),
         pipeline_path: path(&lab.stdout(running.procs["pipeline"])),
+        epochs: epoch_changes(&seen),
+        leadership: leadership(&lab, &running),
     }
+}
+
+/// The boards' lines on leading and stepping down, from their standard
+/// error, each prefixed with its process.
+pub fn leadership(lab: &Lab, running: &Running) -> Vec<String> {
+    let mut lines = Vec::new();
+    for b in &running.boards {
+        if let Some(pid) = running.procs.get(b) {
+            for l in lab.stderr(*pid).lines().filter(|l| l.contains(" leads at epoch ") || l.contains(" steps down")) {
+                lines.push(format!("{b}: {l}"));
+            }
+        }
+    }
+    lines
 }
 
 impl Lossy {
@@ -292,8 +370,8 @@ impl Lossy {
         let k = |name: &str| self.tcp.get(name).copied().unwrap_or(0);
         format!(
             "{} statuses in {:.1} s; gaps p50 {p50:.0} ms, p99 {p99:.0} ms, max {max:.0} ms; over 300 ms: {}, over 450 ms: {}, \
-             over 600 ms: {}; safe mode entered {} time(s); board: {}; TCP (hosts and relay): {} segments \
-             retransmitted, {} timeouts (RTO), {} loss probes (TLP), {} fast retransmits",
+             over 600 ms: {}; safe mode entered {} time(s); board: {}; leaders seen (epoch, board): {:?}; TCP (hosts \
+             and relay): {} segments retransmitted, {} timeouts (RTO), {} loss probes (TLP), {} fast retransmits",
             self.statuses,
             (self.to_ns - self.from_ns) as f64 / 1e9,
             over(300.0),
@@ -301,6 +379,7 @@ impl Lossy {
             over(600.0),
             self.safe.len(),
             self.board_states.join(" -> "),
+            self.epochs,
             k("TcpRetransSegs"),
             k("TcpExtTCPTimeouts"),
             k("TcpExtTCPLossProbes"),

@@ -34,6 +34,17 @@ pub fn fig5_two_boards() -> Vec<Proc> {
     procs
 }
 
+/// Fig. 5's processes as clients of a router ([`fig5_router`]) with a
+/// second board, `standby`, on a host of its own, a client of the router
+/// too.
+pub fn fig5_router_two_boards() -> Vec<Proc> {
+    let mut procs = fig5_router();
+    let mut standby = procs.iter().find(|p| p.name == "board").expect("the board").clone();
+    (standby.name, standby.host) = ("standby", "standby");
+    procs.insert(2, standby);
+    procs
+}
+
 /// What killing the leading board did.
 #[derive(Debug)]
 pub struct Takeover {
