@@ -26,6 +26,7 @@
 //! # [standby]                        # optional, with two boards or more
 //! # lease_ms = 400                   # a follower leads after this long without the leader
 //! # replicate_within_ms = 100        # a change waits this long at most for the followers
+//! # give_up_ms = 5000                # a follower that lacks a decision waits this long, then starts afresh
 //!
 //! [[process]]
 //! name = "sensors"
@@ -79,6 +80,12 @@ pub struct StandbySettings {
     /// its entries before it is broadcast (ms; default 100).
     #[serde(default)]
     pub replicate_within_ms: Option<u64>,
+    /// A follower whose log lacks a decision the agents were told does not
+    /// lead at its lease; it waits this long more for a board that has it,
+    /// then leads from the rules' initial state (ms; default 25 status
+    /// periods, 5000).
+    #[serde(default)]
+    pub give_up_ms: Option<u64>,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -252,6 +259,9 @@ impl Deployment {
             if s.replicate_within_ms.is_some_and(|ms| ms > 10_000) {
                 return Err(DeployError("`[standby] replicate_within_ms`: at most 10000".into()));
             }
+            if s.give_up_ms.is_some_and(|ms| ms > 3_600_000) {
+                return Err(DeployError("`[standby] give_up_ms`: at most 3600000 (an hour)".into()));
+            }
         }
         let mut seen: Vec<(&str, &str)> = Vec::new();
         for p in &d.processes {
@@ -360,6 +370,31 @@ impl Deployment {
     /// Whether the boards form a standby group (two or more).
     pub fn has_standby(&self) -> bool {
         self.processes.iter().filter(|p| p.board).count() > 1
+    }
+
+    /// How `process`, a board of a standby group, hands over: the
+    /// defaults for a status period of `status_every`, with the file's
+    /// `[standby]` settings over them. `None`: no standby group, or not
+    /// one of its boards.
+    pub fn standby_config(
+        &self,
+        process: &str,
+        status_every: std::time::Duration,
+    ) -> Option<situ_runtime::standby::StandbyConfig> {
+        let rank = self.rank(process).filter(|_| self.has_standby())?;
+        let mut config = situ_runtime::standby::StandbyConfig::new(process, rank, status_every);
+        let s = self.standby.clone().unwrap_or_default();
+        let ms = std::time::Duration::from_millis;
+        if let Some(v) = s.lease_ms {
+            config.lease = ms(v);
+        }
+        if let Some(v) = s.replicate_within_ms {
+            config.replicate_within = ms(v);
+        }
+        if let Some(v) = s.give_up_ms {
+            config.give_up = ms(v);
+        }
+        Some(config)
     }
 
     /// A board's place among the boards (0 leads at start), if it is one.

@@ -45,6 +45,10 @@ pub struct BatchWire {
     pub board: String,
     pub first: u64,
     pub prev_epoch: u64,
+    /// The index of the last entry behind a state the leader broadcast
+    /// (absent: 0, as a board of before it sends).
+    #[serde(default)]
+    pub decided: u64,
     #[serde(default)]
     pub entries: Vec<EntryWire>,
 }
@@ -85,13 +89,28 @@ pub fn batch_wire(c: &Content, b: &Batch) -> BatchWire {
             },
         })
         .collect();
-    BatchWire { v: VERSION, epoch: b.epoch, board: b.board.clone(), first: b.first, prev_epoch: b.prev_epoch, entries }
+    BatchWire {
+        v: VERSION,
+        epoch: b.epoch,
+        board: b.board.clone(),
+        first: b.first,
+        prev_epoch: b.prev_epoch,
+        decided: b.decided,
+        entries,
+    }
 }
 
 /// A batch from the wire, checked against the bundle.
 pub fn batch_of(c: &Content, w: &BatchWire) -> Result<Batch, wire::WireError> {
     if w.first == 0 {
         return Err(wire::WireError::Meaning("a batch that starts at entry 0 (the first is 1)".into()));
+    }
+    let last = (w.first - 1).saturating_add(w.entries.len() as u64);
+    if w.decided > last {
+        return Err(wire::WireError::Meaning(format!(
+            "a batch that says entry {} is decided, past its last entry ({last})",
+            w.decided
+        )));
     }
     let mut entries = Vec::with_capacity(w.entries.len());
     for e in &w.entries {
@@ -106,7 +125,14 @@ pub fn batch_of(c: &Content, w: &BatchWire) -> Result<Batch, wire::WireError> {
         };
         entries.push(Logged { epoch: e.epoch, entry });
     }
-    Ok(Batch { epoch: w.epoch, board: w.board.clone(), first: w.first, prev_epoch: w.prev_epoch, entries })
+    Ok(Batch {
+        epoch: w.epoch,
+        board: w.board.clone(),
+        first: w.first,
+        prev_epoch: w.prev_epoch,
+        decided: w.decided,
+        entries,
+    })
 }
 
 /// How this process's board belongs to a standby group.

@@ -245,3 +245,90 @@ fn dla_through_a_router_keeps_its_state_when_the_leading_board_goes_silent() {
     assert_eq!(b.path, ["Planning", "Following"], "board-b applied the log, then led from Following: {:?}", b.path);
     assert_eq!(reactive.path, ["Planning", "Following"], "the agents never went back: {:?}", reactive.path);
 }
+
+/// A follower that lacks a decision the agents were told. The leader's
+/// beats say its log has 100 entries, all behind a broadcast state
+/// (`decided`), and it answers no catch-up (it is not the leader on this
+/// bus: a leader killed while the follower catches up); then the beats
+/// stop. The follower must not lead from its empty log at its lease: it
+/// says it waits, and after `give_up` leads from the rules' initial state.
+/// With `decided` 0 (no state broadcast yet) it leads at its lease.
+fn follower_behind(decided: u64) -> Vec<String> {
+    use situ_runtime::realtime::{self, RealtimeConfig};
+    use situ_runtime::standby::{Standby, StandbyConfig};
+    let checked = situ_compiler::check_source("t.situ", RULES);
+    let content = Arc::new(situ_compiler::bundle::build(&checked));
+    let (a, b) = (port(), port());
+    let text = format!(
+        "robot = \"sb{a}\"\n[[process]]\nname = \"a\"\nboard = true\nlisten = [\"tcp/127.0.0.1:{a}\"]\n\
+         [[process]]\nname = \"b\"\nboard = true\nlisten = [\"tcp/127.0.0.1:{b}\"]\nconnect = [\"tcp/127.0.0.1:{a}\"]\n"
+    );
+    let d = Deployment::parse(&text, &["S".to_string()]).unwrap();
+    let leader = open(&d, "a", &content, SharedLog::default());
+    let lp = leader.peers().unwrap();
+    let told: Arc<std::sync::Mutex<Vec<String>>> = Arc::default();
+    let t = told.clone();
+    let mut config = StandbyConfig::new("b", 1, Duration::from_millis(200));
+    config.give_up = Duration::from_millis(1500);
+    let log = SharedLog::default();
+    let p = d.process("b").unwrap();
+    let group = BoardGroup { name: "b".into(), lease: config.lease, log: log.clone() };
+    let placement = Placement { robot: d.robot.clone(), local: vec![false; content.agents.len()], board: true };
+    let bus = ZenohBus::open_in_group(content.clone(), placement, &d.zenoh_config(p), Capacity::default(), Some(group))
+        .unwrap();
+    let peers = bus.peers().unwrap();
+    let fp = peers.clone();
+    let tell: situ_runtime::standby::Tell = Arc::new(move |s: &str| t.lock().unwrap().push(s.to_string()));
+    let standby = Standby { config, peers, log, tell: Some(tell) };
+    let follower = std::thread::spawn({
+        let content = content.clone();
+        move || {
+            let config = RealtimeConfig {
+                board: true,
+                stop_on_final: false,
+                standby: Some(standby),
+                ..RealtimeConfig::default()
+            };
+            let bound = situ_runtime::agent::bind(&content, Vec::new(), false).unwrap();
+            realtime::run_on(content, bound, None, config, Duration::from_secs(6), Arc::new(bus), &mut |_| {})
+        }
+    });
+    // The leader's beats until the follower has heard them for a second:
+    // a log of 100 entries of epoch 7·256, up to `decided` behind a state.
+    let beat = Batch { epoch: 7 << 8, board: "a".into(), first: 101, prev_epoch: 7 << 8, decided, entries: Vec::new() };
+    let start = Instant::now();
+    let mut heard_since = None;
+    while heard_since.is_none_or(|h: Instant| h.elapsed() < Duration::from_secs(1)) {
+        assert!(start.elapsed() < Duration::from_secs(30), "the follower never heard the leader");
+        lp.publish(&beat);
+        if heard_since.is_none() && fp.heard().is_some_and(|(e, _)| e == 7 << 8) {
+            heard_since = Some(Instant::now());
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    assert!(told.lock().unwrap().is_empty(), "the follower led while it heard the leader: {:?}", told.lock().unwrap());
+    // The leader falls silent (killed).
+    drop(leader);
+    let summary = follower.join().unwrap();
+    assert!(summary.board.cascade_errors == 0);
+    let told = told.lock().unwrap().clone();
+    told
+}
+
+#[test]
+fn a_follower_that_lacks_a_decision_waits_then_leads_from_the_initial_state() {
+    let told = follower_behind(100);
+    let at = |what: &str| told.iter().position(|s| s.contains(what));
+    let (waits, afresh, leads) = (at("cannot lead yet"), at("starts from the initial state"), at("leads at epoch"));
+    assert!(waits.is_some(), "it said it waits: {told:#?}");
+    assert!(waits < afresh && afresh < leads, "it waited, then started afresh and led: {told:#?}");
+    assert!(told[waits.unwrap()].contains("the agents were told the state of entry 100"), "{told:#?}");
+    assert!(told[leads.unwrap()].contains("from entry 0 of the log"), "{told:#?}");
+}
+
+#[test]
+fn a_follower_behind_on_entries_no_state_was_broadcast_from_leads_at_its_lease() {
+    let told = follower_behind(0);
+    assert!(told.iter().any(|s| s.contains("leads at epoch")), "{told:#?}");
+    assert!(!told.iter().any(|s| s.contains("cannot lead") || s.contains("initial state")), "{told:#?}");
+}

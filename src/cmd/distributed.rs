@@ -261,17 +261,9 @@ fn zenoh(args: &Args, content: Arc<Content>, file: Option<&[u8]>, checked: Optio
     let placement = Placement { robot: d.robot.clone(), local, board: process.board };
     // A board of a standby group: its log, shared with the bus that answers
     // the other boards' catch-up requests.
-    let standby = d.rank(&process.name).filter(|_| d.has_standby()).map(|rank| {
-        let settings = d.standby.clone().unwrap_or_default();
-        let mut config = situ_runtime::standby::StandbyConfig::new(&process.name, rank, STATUS_EVERY);
-        if let Some(ms) = settings.lease_ms {
-            config.lease = Duration::from_millis(ms);
-        }
-        if let Some(ms) = settings.replicate_within_ms {
-            config.replicate_within = Duration::from_millis(ms);
-        }
-        (config, situ_runtime::standby::SharedLog::default())
-    });
+    let standby = d
+        .standby_config(&process.name, STATUS_EVERY)
+        .map(|config| (config, situ_runtime::standby::SharedLog::default()));
     let group = standby.as_ref().map(|(config, log)| situ_bus_zenoh::standby::BoardGroup {
         name: config.name.clone(),
         lease: config.lease,

@@ -66,6 +66,10 @@ pub struct Batch {
     pub board: String,
     pub first: u64,
     pub prev_epoch: u64,
+    /// The index of the last entry behind a state the leader broadcast (0:
+    /// none): a follower whose log is shorter lacks a decision the agents
+    /// were told, and must not lead from it.
+    pub decided: u64,
     pub entries: Vec<Logged>,
 }
 
@@ -81,6 +85,9 @@ impl Batch {
 #[derive(Debug, Default)]
 pub struct LogStore {
     entries: Vec<Logged>,
+    /// While this board leads: the index of the last entry behind a state
+    /// it broadcast ([`Batch::decided`]).
+    decided: u64,
 }
 
 impl LogStore {
@@ -100,10 +107,19 @@ impl LogStore {
     pub fn push(&mut self, logged: Logged) {
         self.entries.push(logged);
     }
+    /// The leader: the entries up to `index` are behind a state it
+    /// broadcast (or is about to).
+    pub fn decide(&mut self, index: u64) {
+        self.decided = self.decided.max(index.min(self.len()));
+    }
+    pub fn decided(&self) -> u64 {
+        self.decided
+    }
     /// Forgets everything (a board that diverged starts again from the
     /// leader's log).
     pub fn clear(&mut self) {
         self.entries.clear();
+        self.decided = 0;
     }
     /// Entries `from..` (at most `max`) as a batch of `epoch`'s leader.
     pub fn batch_from(&self, from: u64, max: usize, epoch: u64, board: &str) -> Batch {
@@ -115,6 +131,7 @@ impl LogStore {
             board: board.to_string(),
             first: start as u64 + 1,
             prev_epoch: self.epoch_at(start as u64).unwrap_or(0),
+            decided: self.decided,
             entries: self.entries[start..end].to_vec(),
         }
     }
@@ -141,6 +158,11 @@ pub struct StandbyConfig {
     /// How long the leader waits for the followers to have a change's
     /// entries before it broadcasts the change anyway.
     pub replicate_within: Duration,
+    /// How long a follower that lacks a decision the agents were told
+    /// (its log is shorter than the leader's [`Batch::decided`]) waits,
+    /// past its lease, for a board that has it to lead; then it leads
+    /// from the rules' initial state, as a single board that restarts.
+    pub give_up: Duration,
 }
 
 impl StandbyConfig {
@@ -159,6 +181,7 @@ impl StandbyConfig {
             stagger: status_every / 4,
             beat: status_every / 4,
             replicate_within: Duration::from_millis(100),
+            give_up: status_every * 25,
         }
     }
 }

@@ -160,6 +160,7 @@ mod tests {
             board: "a".into(),
             first,
             prev_epoch,
+            decided: 0,
             entries: epochs.iter().map(|e| logged(*e, 0)).collect(),
         }
     }

@@ -60,7 +60,9 @@ impl LogOut for ToFollowers {
             (first, prev_epoch, log.len())
         };
         if !logged.is_empty() {
-            let batch = Batch { epoch: self.epoch, board: self.name.clone(), first, prev_epoch, entries: logged };
+            let decided = self.log.lock().unwrap_or_else(|p| p.into_inner()).decided();
+            let batch =
+                Batch { epoch: self.epoch, board: self.name.clone(), first, prev_epoch, decided, entries: logged };
             self.peers.publish(&batch);
         }
         if change && last > self.waited {
@@ -68,6 +70,11 @@ impl LogOut for ToFollowers {
                 self.unacknowledged.fetch_add(1, Ordering::Relaxed);
             }
             self.waited = last;
+        }
+        if change {
+            // The change is broadcast when this returns: the entries up to
+            // here are behind a decision (the next batch or beat says so).
+            self.log.lock().unwrap_or_else(|p| p.into_inner()).decide(last);
         }
     }
 }
@@ -90,6 +97,10 @@ pub fn run(standby: &Standby, l: BoardLoop<'_>, deliver: &mut dyn FnMut(&[StateC
     let mut next_tick = Instant::now() + heartbeat;
     // A catch-up request in flight: from where, and when it was sent.
     let mut asked: Option<(u64, Instant)> = None;
+    // The highest epoch's last word on its decisions (`Batch::decided`): a
+    // log shorter than this lacks a state the agents were told.
+    let mut decided: (u64, u64) = (0, 0);
+    let mut told_waiting = false;
     let say = |level: Level, text: String| shared.record(|s| s.diagnostic(clock(), level, &text));
     let tell = |text: String| {
         if let Some(t) = &standby.tell {
@@ -163,6 +174,11 @@ pub fn run(standby: &Standby, l: BoardLoop<'_>, deliver: &mut dyn FnMut(&[StateC
                         continue; // an old leader's
                     }
                     election.heard(b.epoch, ns(Instant::now()));
+                    decided = match decided {
+                        (e, d) if e == b.epoch => (e, d.max(b.decided)),
+                        (e, _) if b.epoch > e => (b.epoch, b.decided),
+                        kept => kept,
+                    };
                     let offer = {
                         let log = standby.log.lock().unwrap_or_else(|p| p.into_inner());
                         replica.offer(&b, &log)
@@ -216,7 +232,35 @@ pub fn run(standby: &Standby, l: BoardLoop<'_>, deliver: &mut dyn FnMut(&[StateC
                 if !linked {
                     continue;
                 }
-                if let Some(Decision::Lead(epoch)) = election.poll(ns(Instant::now()), clock() / 1_000_000) {
+                let applied = standby.log.lock().unwrap_or_else(|p| p.into_inner()).len();
+                let ready = applied >= decided.1;
+                let decision = election.poll(ns(Instant::now()), clock() / 1_000_000, ready);
+                if election.waiting() && !told_waiting {
+                    told_waiting = true;
+                    tell(format!(
+                        "board `{}` cannot lead yet: it has {applied} entries of the log, and the agents were told \
+                         the state of entry {}; it waits {:?} for a board that has them, then leads from the initial \
+                         state",
+                        cfg.name, decided.1, cfg.give_up
+                    ));
+                }
+                if !election.waiting() {
+                    told_waiting = false;
+                }
+                let afresh = matches!(decision, Some(Decision::LeadFromStart(_)));
+                if let Some(Decision::Lead(epoch) | Decision::LeadFromStart(epoch)) = decision {
+                    if afresh {
+                        // No board that holds the decisions led: this one
+                        // starts the group again from the rules' initial
+                        // state (the events it holds are taken after).
+                        standby.log.lock().unwrap_or_else(|p| p.into_inner()).clear();
+                        board.start_again(shared, clock());
+                        tell(format!(
+                            "board `{}` starts from the initial state: no board that has the log up to entry {} led \
+                             within {:?}",
+                            cfg.name, decided.1, cfg.give_up
+                        ));
+                    }
                     // What came in since the last look is held too: the
                     // held events go first, in the order they came.
                     let _ = shared.bus.recv_events(&mut events);
@@ -264,7 +308,14 @@ fn take_over(
     unacknowledged: &Arc<std::sync::atomic::AtomicU64>,
 ) -> Vec<EventMsg> {
     standby.peers.set_leading(Some(epoch));
-    let waited = standby.log.lock().unwrap_or_else(|p| p.into_inner()).len();
+    let waited = {
+        let mut log = standby.log.lock().unwrap_or_else(|p| p.into_inner());
+        // The state the log gives is broadcast at once: all of it is
+        // behind a decision.
+        let len = log.len();
+        log.decide(len);
+        len
+    };
     board.set_log_out(Some(Box::new(ToFollowers {
         waited,
         log: standby.log.clone(),
