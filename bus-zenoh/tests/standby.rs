@@ -61,6 +61,9 @@ fn a_follower_catches_up_on_a_long_log_and_the_leader_waits_for_its_acknowledgem
         };
         leader_log.lock().unwrap().push(Logged { epoch: 7 << 8, entry });
     }
+    // All of it behind a state the agents were told: every chunk of the
+    // answer says so, past its own last entry.
+    leader_log.lock().unwrap().decide(1500);
     let leader = open(&d, "a", &content, leader_log.clone());
     let follower = open(&d, "b", &content, SharedLog::default());
     let (lp, fp) = (leader.peers().unwrap(), follower.peers().unwrap());
@@ -84,6 +87,7 @@ fn a_follower_catches_up_on_a_long_log_and_the_leader_waits_for_its_acknowledgem
             entries.extend(b.entries.iter().cloned());
         }
     }
+    assert!(got.iter().all(|b| b.decided == 1500), "{:?}", got.iter().map(|b| b.decided).collect::<Vec<_>>());
     assert_eq!(
         entries.len(),
         1500,
