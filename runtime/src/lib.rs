@@ -17,6 +17,7 @@
 //!   shared by both schedulers;
 //! - [`sched`]: the simulated-time scheduler (one thread, deterministic);
 //! - [`realtime`]: the real-time scheduler (worker threads, the wall clock);
+//!   [`priority`]: its threads under `SCHED_FIFO` when asked;
 //! - [`script`]: scripted runs of any rules file (stand-in agents, the
 //!   guided random generator, the timeline and the chart);
 //! - [`demo`]: the scripted agents of the example of Fig. 5;
@@ -42,6 +43,7 @@ pub mod demo;
 pub mod journal;
 pub mod local;
 pub mod organise;
+pub mod priority;
 pub mod realtime;
 pub mod record;
 pub mod repl;

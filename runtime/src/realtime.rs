@@ -58,6 +58,11 @@ pub struct RealtimeConfig {
     /// holds is applied before the board starts, and the board's log is
     /// written to it ([`crate::journal`]).
     pub journal: Option<crate::journal::Opened>,
+    /// Run the agents' workers and the Bulletinboard's thread (the
+    /// caller's, given back its policy at the end) under `SCHED_FIFO` at
+    /// this priority ([`crate::priority`]). Refused by the kernel, it is
+    /// said once in the recording and the run goes on.
+    pub priority: Option<i32>,
 }
 
 impl Default for RealtimeConfig {
@@ -75,6 +80,7 @@ impl Default for RealtimeConfig {
             max_skew: Duration::from_nanos(crate::runner::DEFAULT_MAX_SKEW),
             standby: None,
             journal: None,
+            priority: None,
         }
     }
 }
@@ -146,6 +152,23 @@ pub fn run_on(
         k += 1;
     }
     let local: Vec<u32> = groups.iter().flatten().map(|s| s.runner.id).collect();
+    // Under SCHED_FIFO when asked: a refusal said once, by the first
+    // thread refused.
+    let refused = &AtomicBool::new(false);
+    let fifo = |whose: &str| -> Option<crate::priority::Previous> {
+        let p = config.priority?;
+        match crate::priority::enter(p) {
+            Ok(previous) => Some(previous),
+            Err(e) => {
+                if !refused.swap(true, Ordering::AcqRel) {
+                    let text = crate::priority::refused(p, whose, &e);
+                    shared.record(|s| s.diagnostic(clock(), crate::record::Level::Warning, &text));
+                }
+                None
+            }
+        }
+    };
+    let board_thread = fifo(if config.board { "the Bulletinboard's thread" } else { "the status's thread" });
 
     std::thread::scope(|scope| {
         for mut group in groups.into_iter().filter(|g| !g.is_empty()) {
@@ -154,7 +177,9 @@ pub fn run_on(
             for slot in &group {
                 shared.bus.set_doorbell(slot.runner.id, bell.clone());
             }
+            let fifo = &fifo;
             scope.spawn(move || {
+                fifo("an agents' worker");
                 while !stop.load(Ordering::Acquire) {
                     let now = Instant::now();
                     for slot in &mut group {
@@ -247,6 +272,9 @@ pub fn run_on(
         }
         shared.bus.close();
     });
+    if let Some(previous) = board_thread {
+        crate::priority::leave(previous);
+    }
     let agents = std::mem::take(&mut *counters.lock().unwrap_or_else(|p| p.into_inner()));
     let state = if config.board { board.board.state() } else { shared.org().state() };
     summary.add_steps(steps.swap(0, Ordering::Relaxed));

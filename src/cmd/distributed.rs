@@ -59,6 +59,8 @@ pub struct Args {
     pub duration: f64,
     /// The board's journal (over a deployment's `journal`).
     pub journal: Option<PathBuf>,
+    /// The threads under SCHED_FIFO at this priority.
+    pub rt_priority: Option<i32>,
     pub record: Option<PathBuf>,
     /// Serve the run live over Foxglove's WebSocket protocol at this address.
     pub foxglove: Option<String>,
@@ -140,6 +142,14 @@ pub fn run(args: Args) -> u8 {
         return USAGE;
     }
     stop_flag();
+    if let Some(p) = args.rt_priority {
+        // Asked of the kernel on a thread of its own, to say a refusal
+        // before the run (which says it in the recording too).
+        let probe = std::thread::spawn(move || situ_runtime::priority::enter(p).map(|_| ()));
+        if let Ok(Err(e)) = probe.join() {
+            eprintln!("warning: {}", situ_runtime::priority::refused(p, "this process's threads", &e));
+        }
+    }
     let program = match super::program::load(&args.file, false, &args.trust) {
         Ok(p) => p,
         Err(code) => return code,
@@ -200,7 +210,8 @@ fn inproc(args: &Args, content: Arc<Content>, file: Option<&[u8]>, checked: Opti
         Ok(j) => j,
         Err(code) => return code,
     };
-    let config = RealtimeConfig { stop: Some(stop_flag()), journal, ..RealtimeConfig::default() };
+    let config =
+        RealtimeConfig { stop: Some(stop_flag()), journal, priority: args.rt_priority, ..RealtimeConfig::default() };
     let summary = realtime::run(content, bound, sink, config, Duration::from_secs_f64(args.duration), &mut |c| {
         eprintln!("state {}", c.to)
     });
@@ -327,6 +338,7 @@ fn zenoh(args: &Args, content: Arc<Content>, file: Option<&[u8]>, checked: Optio
         stop: Some(stop_flag()),
         status_every: STATUS_EVERY,
         standby,
+        priority: args.rt_priority,
         ..RealtimeConfig::default()
     };
     let name = process.name.clone();

@@ -94,6 +94,12 @@ pub struct Args {
     /// Real-time runs (demo, none): how long, in seconds.
     #[arg(long, default_value_t = 10.0)]
     pub duration: f64,
+    /// Real-time runs (demo, none): the agents' workers and the Bulletinboard's thread under
+    /// SCHED_FIFO at this priority (1 to 99; needs CAP_SYS_NICE or an rtprio limit, else said and
+    /// run under the normal scheduler).
+    #[arg(long, value_name = "PRIORITY", value_parser = clap::value_parser!(i32).range(1..=99),
+          conflicts_with_all = ["script", "random", "compare", "missions"])]
+    pub rt_priority: Option<i32>,
     #[command(flatten)]
     pub trust: super::Trust,
 }
@@ -124,6 +130,7 @@ pub fn run(args: Args) -> super::Outcome {
         only,
         duration,
         journal,
+        rt_priority,
         ..
     } = args;
     let local = stack == super::distributed::Stack::Sim && transport == super::distributed::Transport::Inproc;
@@ -144,6 +151,7 @@ pub fn run(args: Args) -> super::Outcome {
             only,
             duration,
             journal,
+            rt_priority,
             record,
             foxglove,
             serve,
