@@ -336,3 +336,78 @@ fn a_follower_behind_on_entries_no_state_was_broadcast_from_leads_at_its_lease()
     assert!(told.iter().any(|s| s.contains("leads at epoch")), "{told:#?}");
     assert!(!told.iter().any(|s| s.contains("cannot lead") || s.contains("initial state")), "{told:#?}");
 }
+
+/// The resident memory of this process (bytes), from /proc/self/statm.
+fn resident() -> u64 {
+    let statm = std::fs::read_to_string("/proc/self/statm").unwrap();
+    let pages: u64 = statm.split_whitespace().nth(1).unwrap().parse().unwrap();
+    pages * 4096
+}
+
+/// What a long log costs: the leader's memory per entry, and how long a
+/// board that returns takes to receive it (one catch-up query; the
+/// answer's chunks of 512 entries). `SITU_LOG_ENTRIES` (200,000): events
+/// with a float field, every third entry a heartbeat.
+#[test]
+#[ignore = "a benchmark: cargo test --release -p situ-bus-zenoh --test standby -- --ignored --nocapture long_log"]
+fn long_log_memory_and_catch_up_time() {
+    let n: u64 = std::env::var("SITU_LOG_ENTRIES").ok().and_then(|s| s.parse().ok()).unwrap_or(200_000);
+    let checked = situ_compiler::check_source("t.situ", RULES);
+    let content = Arc::new(situ_compiler::bundle::build(&checked));
+    let (a, b) = (port(), port());
+    let text = format!(
+        "robot = \"sb{a}\"\n[[process]]\nname = \"a\"\nboard = true\nlisten = [\"tcp/127.0.0.1:{a}\"]\n\
+         [[process]]\nname = \"b\"\nboard = true\nlisten = [\"tcp/127.0.0.1:{b}\"]\nconnect = [\"tcp/127.0.0.1:{a}\"]\n"
+    );
+    let d = Deployment::parse(&text, &["S".to_string()]).unwrap();
+    let leader_log = SharedLog::default();
+    let before = resident();
+    {
+        let mut log = leader_log.lock().unwrap();
+        for i in 0..n {
+            let entry = if i % 3 == 0 {
+                Entry::Tick { time: i }
+            } else {
+                let payload = vec![situ_compiler::bundle::Value::F64(i as f64)];
+                Entry::Event { msg: EventMsg { agent: 0, event: 0, time: i, payload, urgent: false }, accepted: true }
+            };
+            log.push(Logged { epoch: 7 << 8, entry });
+        }
+        log.decide(n);
+    }
+    let per_entry = (resident().saturating_sub(before)) as f64 / n as f64;
+    let leader = open(&d, "a", &content, leader_log.clone());
+    let follower = open(&d, "b", &content, SharedLog::default());
+    let (lp, fp) = (leader.peers().unwrap(), follower.peers().unwrap());
+    lp.set_leading(Some(7 << 8));
+    // Wait until the follower reaches the leader's queryable (a short log).
+    let mut got: Vec<Batch> = Vec::new();
+    let start = Instant::now();
+    let mut received = 0u64;
+    let mut next = 1u64;
+    let mut asked: Option<Instant> = None;
+    while next <= n {
+        assert!(start.elapsed() < Duration::from_secs(300), "caught up to {next} of {n}");
+        if asked.is_none_or(|t| t.elapsed() > Duration::from_secs(6)) {
+            fp.request(next);
+            asked = Some(Instant::now());
+        }
+        std::thread::sleep(Duration::from_millis(5));
+        fp.take_batches(&mut got);
+        got.sort_by_key(|b| b.first);
+        for b in got.drain(..) {
+            if b.first <= next && b.last() >= next {
+                received += b.last() + 1 - next;
+                next = b.last() + 1;
+            }
+        }
+    }
+    let took = start.elapsed();
+    eprintln!(
+        "a log of {n} entries: {per_entry:.0} bytes of the leader's memory per entry ({:.1} MiB); a returning board \
+         received it in {:.2} s ({:.0} entries/s, {received} entries, in one or more catch-up queries)",
+        per_entry * n as f64 / 1048576.0,
+        took.as_secs_f64(),
+        n as f64 / took.as_secs_f64()
+    );
+}
