@@ -25,6 +25,16 @@ fn open(d: &Deployment, name: &str, content: &Arc<situ_compiler::bundle::Content
     ZenohBus::open_in_group(content.clone(), placement, &d.zenoh_config(p), Capacity::default(), Some(group)).unwrap()
 }
 
+/// Two boards, `a` and `b`, on loopback; `b` connects to `a`.
+fn two_boards() -> Deployment {
+    let (a, b) = (port(), port());
+    let text = format!(
+        "robot = \"sb{a}\"\n[[process]]\nname = \"a\"\nboard = true\nlisten = [\"tcp/127.0.0.1:{a}\"]\n\
+         [[process]]\nname = \"b\"\nboard = true\nlisten = [\"tcp/127.0.0.1:{b}\"]\nconnect = [\"tcp/127.0.0.1:{a}\"]\n"
+    );
+    Deployment::parse(&text, &["S".to_string()]).unwrap()
+}
+
 fn until(what: &str, mut ok: impl FnMut() -> bool) {
     let deadline = Instant::now() + Duration::from_secs(20);
     while !ok() {
@@ -37,12 +47,7 @@ fn until(what: &str, mut ok: impl FnMut() -> bool) {
 fn a_follower_catches_up_on_a_long_log_and_the_leader_waits_for_its_acknowledgement() {
     let checked = situ_compiler::check_source("t.situ", RULES);
     let content = Arc::new(situ_compiler::bundle::build(&checked));
-    let (a, b) = (port(), port());
-    let text = format!(
-        "robot = \"sb{a}\"\n[[process]]\nname = \"a\"\nboard = true\nlisten = [\"tcp/127.0.0.1:{a}\"]\n\
-         [[process]]\nname = \"b\"\nboard = true\nlisten = [\"tcp/127.0.0.1:{b}\"]\nconnect = [\"tcp/127.0.0.1:{a}\"]\n"
-    );
-    let d = Deployment::parse(&text, &["S".to_string()]).unwrap();
+    let d = two_boards();
     // The leader's log: 1,500 entries (three answers' worth), NaN included.
     let leader_log = SharedLog::default();
     for i in 0..1500u64 {
@@ -262,12 +267,7 @@ fn follower_behind(decided: u64) -> Vec<String> {
     use situ_runtime::standby::{Standby, StandbyConfig};
     let checked = situ_compiler::check_source("t.situ", RULES);
     let content = Arc::new(situ_compiler::bundle::build(&checked));
-    let (a, b) = (port(), port());
-    let text = format!(
-        "robot = \"sb{a}\"\n[[process]]\nname = \"a\"\nboard = true\nlisten = [\"tcp/127.0.0.1:{a}\"]\n\
-         [[process]]\nname = \"b\"\nboard = true\nlisten = [\"tcp/127.0.0.1:{b}\"]\nconnect = [\"tcp/127.0.0.1:{a}\"]\n"
-    );
-    let d = Deployment::parse(&text, &["S".to_string()]).unwrap();
+    let d = two_boards();
     let leader = open(&d, "a", &content, SharedLog::default());
     let lp = leader.peers().unwrap();
     let told: Arc<std::sync::Mutex<Vec<String>>> = Arc::default();
@@ -354,12 +354,7 @@ fn long_log_memory_and_catch_up_time() {
     let n: u64 = std::env::var("SITU_LOG_ENTRIES").ok().and_then(|s| s.parse().ok()).unwrap_or(200_000);
     let checked = situ_compiler::check_source("t.situ", RULES);
     let content = Arc::new(situ_compiler::bundle::build(&checked));
-    let (a, b) = (port(), port());
-    let text = format!(
-        "robot = \"sb{a}\"\n[[process]]\nname = \"a\"\nboard = true\nlisten = [\"tcp/127.0.0.1:{a}\"]\n\
-         [[process]]\nname = \"b\"\nboard = true\nlisten = [\"tcp/127.0.0.1:{b}\"]\nconnect = [\"tcp/127.0.0.1:{a}\"]\n"
-    );
-    let d = Deployment::parse(&text, &["S".to_string()]).unwrap();
+    let d = two_boards();
     let leader_log = SharedLog::default();
     let before = resident();
     {
