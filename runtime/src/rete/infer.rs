@@ -66,35 +66,44 @@ impl Engine {
                 let firings = self.last_change().firings;
                 return Err(PostError::Cascade { limit: self.cascade_limit, firings });
             }
-            let rule = &self.content.rules[r as usize];
-            let to = rule.target;
-            let facts0 = self.record.facts.len() as u32;
-            for &a in &rule.matches {
-                let slot = self.slots[a as usize];
-                let n = self.content.events.get(slot.event as usize).map_or(0, |e| e.fields.len());
-                let at = self.net.payload_at[a as usize] as usize;
-                let v0 = self.record.values.len() as u32;
-                self.record.values.extend_from_slice(&self.payload[at..at + n]);
-                let values = (v0, self.record.values.len() as u32);
-                self.record.facts.push(FactRec { agent: a, event: slot.event, time: slot.time, run: slot.run, values });
-            }
-            let stale0 = self.record.stale.len() as u32;
-            for &a in &rule.stale {
-                if self.stale[a as usize] {
-                    self.record.stale.push(a);
-                }
-            }
-            let rec = FiringRec {
-                rule: r,
-                from: self.state,
-                to,
-                time: self.now,
-                facts: (facts0, self.record.facts.len() as u32),
-                stale: (stale0, self.record.stale.len() as u32),
-            };
-            self.record.firings.push(rec);
+            let to = self.record_firing(r);
             self.set_state(to);
         }
         Ok(())
+    }
+
+    /// Records the firing of rule `r` in the current state, with the facts
+    /// its positive patterns matched and the agents its `stale` tests found
+    /// stale; returns its target (the caller sets the state). The
+    /// interpreter and the fast path record through it alike.
+    pub(super) fn record_firing(&mut self, r: u32) -> u32 {
+        let rule = &self.content.rules[r as usize];
+        let to = rule.target;
+        let facts0 = self.record.facts.len() as u32;
+        for &a in &rule.matches {
+            let slot = self.slots[a as usize];
+            let n = self.content.events.get(slot.event as usize).map_or(0, |e| e.fields.len());
+            let at = self.net.payload_at[a as usize] as usize;
+            let v0 = self.record.values.len() as u32;
+            self.record.values.extend_from_slice(&self.payload[at..at + n]);
+            let values = (v0, self.record.values.len() as u32);
+            self.record.facts.push(FactRec { agent: a, event: slot.event, time: slot.time, run: slot.run, values });
+        }
+        let stale0 = self.record.stale.len() as u32;
+        for &a in &rule.stale {
+            if self.stale[a as usize] {
+                self.record.stale.push(a);
+            }
+        }
+        let rec = FiringRec {
+            rule: r,
+            from: self.state,
+            to,
+            time: self.now,
+            facts: (facts0, self.record.facts.len() as u32),
+            stale: (stale0, self.record.stale.len() as u32),
+        };
+        self.record.firings.push(rec);
+        to
     }
 }

@@ -30,6 +30,7 @@
 
 mod admit;
 mod eval;
+mod fast;
 mod infer;
 mod net;
 mod report;
@@ -43,6 +44,8 @@ pub use report::{describe_fact, format_time, show_value, FactView, Firing, Match
 
 /// The default bound of a cascade (§10.4).
 pub const CASCADE_LIMIT: usize = 64;
+
+pub use fast::MAX_LIST_ENTRIES;
 
 /// How far ahead of the Bulletinboard's clock an event may be stamped, by
 /// default (ns): hosts kept in time by NTP on a local network agree within
@@ -102,6 +105,14 @@ pub struct Engine {
     /// The network's memories in the initial state with no facts, which a
     /// [`reset`](Self::reset) restores.
     initial: Arc<Memories>,
+    // The fast path (`fast.rs`): whether it runs, its program (empty when
+    // it does not), per agent the now of its fact's last evaluation, and
+    // the agents whose fact expiry changed since the last rest.
+    fast: bool,
+    fp: Arc<fast::Program>,
+    checked: Vec<u64>,
+    touched: Vec<u32>,
+    declined: Option<&'static str>,
 }
 
 /// The memories of the network (alpha, beta, activated rules).
@@ -114,9 +125,41 @@ struct Memories {
 }
 
 impl Engine {
-    /// The engine of a validated bundle, in its initial state with no facts.
+    /// The engine of a validated bundle, in its initial state with no
+    /// facts, on the fast path (`fast.rs`) unless the fast path declines
+    /// the bundle ([`fast_declined`](Self::fast_declined)): then the
+    /// interpreter.
     pub fn new(content: Arc<Content>) -> Engine {
+        Engine::build(content, true)
+    }
+
+    /// The engine of a validated bundle on the Rete interpreter, the
+    /// reference the fast path is held to (`runtime-tests/tests/differential.rs`).
+    pub fn interpreted(content: Arc<Content>) -> Engine {
+        Engine::build(content, false)
+    }
+
+    /// Whether the engine runs on the fast path.
+    pub fn is_fast(&self) -> bool {
+        self.fast
+    }
+
+    /// Why the fast path declined the bundle, if it did (an engine built
+    /// by [`interpreted`](Self::interpreted) was not offered it).
+    pub fn fast_declined(&self) -> Option<&'static str> {
+        self.declined
+    }
+
+    fn build(content: Arc<Content>, fast: bool) -> Engine {
         let net = Net::new(&content);
+        let (fp, declined) = if fast {
+            match fast::Program::new(&content, &net) {
+                Ok(p) => (Some(p), None),
+                Err(why) => (None, Some(why)),
+            }
+        } else {
+            (None, None)
+        };
         let na = content.agents.len();
         let nb = net.beta.len();
         let mut e = Engine {
@@ -142,10 +185,18 @@ impl Engine {
             cascade_limit: CASCADE_LIMIT,
             record: Record::default(),
             initial: Arc::default(),
+            fast: fp.is_some(),
+            fp: Arc::new(fp.unwrap_or_default()),
+            checked: vec![0; na],
+            touched: Vec::with_capacity(na),
+            declined,
             content,
             net,
         };
         e.recompute();
+        if e.fast {
+            e.fast_activate();
+        }
         e.initial = Arc::new(Memories {
             alpha_mem: e.alpha_mem.clone(),
             beta_tok: e.beta_tok.clone(),
@@ -206,7 +257,7 @@ impl Engine {
     /// reusing `self`'s buffers: the explorer of `verify` copies an engine
     /// per successor it tries.
     pub fn copy_from(&mut self, other: &Engine) {
-        if !Arc::ptr_eq(&self.content, &other.content) {
+        if !Arc::ptr_eq(&self.content, &other.content) || self.fast != other.fast {
             *self = other.clone();
             return;
         }
@@ -230,6 +281,8 @@ impl Engine {
         self.active.clone_from(&other.active);
         self.active_pos.clone_from(&other.active_pos);
         self.cascade_limit = other.cascade_limit;
+        self.checked.clone_from(&other.checked);
+        self.touched.clone_from(&other.touched);
     }
 
     /// Whether the agent's fact has expired.
@@ -237,7 +290,8 @@ impl Engine {
         self.stale.get(agent as usize).copied().unwrap_or(false)
     }
 
-    /// The rules activated now (at rest: none).
+    /// The rules activated now (at rest: none), in no particular order
+    /// (the fast path's in declaration order).
     pub fn activated(&self) -> &[u32] {
         &self.active
     }
@@ -256,6 +310,12 @@ impl Engine {
         self.next_deadline = u64::MAX;
         self.state = self.content.initial;
         let m = &*self.initial;
+        self.touched.clear();
+        if self.fast {
+            // The fast path keeps no network memories: only the activated rules.
+            self.active.clone_from(&m.active);
+            return;
+        }
         self.alpha_mem.copy_from_slice(&m.alpha_mem);
         self.beta_tok.copy_from_slice(&m.beta_tok);
         self.active.clone_from(&m.active);
@@ -277,7 +337,11 @@ impl Engine {
     /// gives the details of the latest step.
     pub fn step(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Step, PostError> {
         self.admit(event, time, payload)?;
-        self.accepted(event, time, payload)
+        if self.fast {
+            self.fast_accepted(event, time, payload)
+        } else {
+            self.accepted(event, time, payload)
+        }
     }
 
     /// Processes an event that [`admit`](Self::admit) accepted.
@@ -311,11 +375,20 @@ impl Engine {
         if now > self.now {
             self.now = now;
         }
-        if self.now > self.next_deadline {
-            self.expire();
-        }
-        if !self.at_rest() {
-            self.rest()?;
+        if self.fast {
+            if self.now > self.next_deadline {
+                self.fast_expire();
+            }
+            if !self.active.is_empty() || !self.touched.is_empty() {
+                self.fast_rest(NONE)?;
+            }
+        } else {
+            if self.now > self.next_deadline {
+                self.expire();
+            }
+            if !self.at_rest() {
+                self.rest()?;
+            }
         }
         Ok((!self.record.firings.is_empty()).then(|| self.last_change()))
     }
@@ -324,7 +397,11 @@ impl Engine {
     /// rules that hold with no facts).
     pub fn settle(&mut self) -> Result<Option<StateChange>, PostError> {
         self.begin();
-        self.rest()?;
+        if self.fast {
+            self.fast_rest(NONE)?;
+        } else {
+            self.rest()?;
+        }
         Ok((!self.record.firings.is_empty()).then(|| self.last_change()))
     }
 
@@ -366,7 +443,13 @@ impl Engine {
 
     /// Sets the state without firing rules (tests' `given`, hot swap).
     pub fn force_state(&mut self, state: u32) {
-        if (state as usize) < self.content.states.len() {
+        if (state as usize) >= self.content.states.len() {
+            return;
+        }
+        if self.fast {
+            self.state = state;
+            self.fast_activate();
+        } else {
             self.set_state(state);
         }
     }
@@ -376,6 +459,13 @@ impl Engine {
     pub fn force_fact(&mut self, event: u32, time: u64, payload: &[Value], run: u64) -> Result<(), PostError> {
         self.validate(event, payload)?;
         self.now = self.now.max(time);
+        if self.fast {
+            self.fast_insert(event, time, payload);
+            let agent = self.content.events[event as usize].agent as usize;
+            self.slots[agent].run = run.max(1);
+            self.fast_activate();
+            return Ok(());
+        }
         self.insert(event, time, payload);
         let agent = self.content.events[event as usize].agent as usize;
         self.slots[agent].run = run.max(1);
@@ -393,6 +483,14 @@ impl Engine {
     pub fn force_stale(&mut self, agent: u32) {
         let a = agent as usize;
         if a >= self.slots.len() {
+            return;
+        }
+        if self.fast {
+            self.slots[a] = EMPTY;
+            self.stale[a] = true;
+            self.stale_at[a] = u64::MAX;
+            self.window_at[a] = u64::MAX;
+            self.fast_activate();
             return;
         }
         let old = self.slots[a].event;

@@ -1,0 +1,498 @@
+//! The fast path: the same engine as the interpreter, the rules tested
+//! directly instead of through the network's memories.
+//!
+//! Each agent has at most one fact, so whether a rule is activated is a
+//! function of the working memory alone: the state, each agent's slot
+//! (event, run length, payload), its stale flag, and, for a window, the
+//! time at which its agent's fact was last evaluated (below). The
+//! interpreter keeps that function's value in the network's memories and
+//! updates it by propagation; the fast path evaluates it, and only where it
+//! can have become true:
+//! - at rest no rule is activated (that is what rest is);
+//! - after agent `a`'s fact becomes an event `e` (a post): the rules that
+//!   can be activated in the state, read `a`, and have no condition on `a`
+//!   that `e` makes false (a positive pattern of another event of `a`, a
+//!   positive `stale a`): `by_event[state][e]`;
+//! - after `a`'s fact expires or one of its windows closes: the rules that
+//!   can be activated in the state and read `a`: `by_agent[state][a]`;
+//! - after a firing sets the state `s`: every rule that can be activated in
+//!   `s`, `by_state[s]`;
+//! - out of rest (a new engine, a `force_*`, a cascade error): the
+//!   activated rules are computed whole into `Engine::active`, which is then
+//!   not empty, and the next rest starts from `by_state[state]`.
+//!
+//! Each list is in the order rules fire in (salience, then specificity,
+//! descending, then declaration order), so that the search for the rule
+//! that fires first stops after the first group of equal salience and
+//! specificity that has an activated rule (recency decides within it, then
+//! declaration order: the interpreter's `best`).
+//!
+//! A rule is flattened from its chain of beta nodes: its state guards (the
+//! guard minus its target) become the states whose lists hold it; every
+//! other node is a [`Cond`]: an agent's event, run length, window and tests
+//! (alpha and join tests together, every field resolved to its place in the
+//! payload arena, as the interpreter reads it), or its staleness, either of
+//! them negated. Firings are recorded by the interpreter's own
+//! `record_firing`, so that steps, recorded firings and explanations are
+//! the same. A bundle is declined (the interpreter runs it) only if a state
+//! or staleness node carries join tests (the compiler writes none) or if
+//! its lists would exceed [`MAX_LIST_ENTRIES`].
+//!
+//! Windows: the interpreter evaluates an event alpha node's window when its
+//! fact is inserted and when expiry refreshes it; in between, now may pass
+//! a deadline without expiry (`advance_clock`, `force_fact`, then
+//! `settle`), and the network's memory keeps the earlier value. The fast
+//! path therefore tests a window against `Engine::checked[a]`, the now of
+//! the agent's last evaluation, which equals now whenever expiry is due
+//! on no deadline.
+
+use super::eval::{compare, in_range};
+use super::net::{Net, NONE};
+use super::{copy_payload, Engine, PostError, Slot, Step, EMPTY};
+use situ_bundle::{AlphaNode, BetaKind, Check, Cmp, Content, Operand, Value};
+
+/// The most entries the candidate lists of a bundle may take (u32 each):
+/// beyond, the bundle is declined and the interpreter runs it.
+pub const MAX_LIST_ENTRIES: usize = 1 << 22;
+
+/// `Cond::event` of a staleness test.
+const STALE: u32 = u32::MAX - 1;
+
+/// An operand: a constant, or a place in the payload arena.
+#[derive(Debug, Clone, Copy)]
+enum Arg {
+    Value(Value),
+    At(u32),
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Check2 {
+    Compare { op: Cmp, rhs: Arg },
+    Range { lo: Arg, hi: Arg, inclusive: bool },
+}
+
+/// A test of the payload value at `x` (a place in the arena).
+#[derive(Debug, Clone, Copy)]
+struct Test {
+    x: u32,
+    check: Check2,
+}
+
+/// One condition of a rule on one agent's fact.
+#[derive(Debug, Clone, Copy)]
+struct Cond {
+    agent: u32,
+    /// The event its fact must be, or `STALE`: the agent must be stale.
+    event: u32,
+    negative: bool,
+    min_run: u64,
+    /// The window, ns (`u64::MAX`: none).
+    within: u64,
+    /// Its tests, in `Program::tests`.
+    tests: (u32, u32),
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Rule {
+    /// Its conditions, in `Program::conds`, in the chain's order.
+    conds: (u32, u32),
+    salience: i64,
+    specificity: u32,
+    /// The agents its positive patterns match (recency), in `Program::agents`.
+    matches: (u32, u32),
+}
+
+/// The rules of a bundle flattened for the fast path.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Program {
+    ne: usize,
+    na: usize,
+    /// Per `state * events + event`, per `state * agents + agent`, per
+    /// state: a list in `lists`.
+    by_event: Vec<(u32, u32)>,
+    by_agent: Vec<(u32, u32)>,
+    by_state: Vec<(u32, u32)>,
+    lists: Vec<u32>,
+    rules: Vec<Rule>,
+    conds: Vec<Cond>,
+    tests: Vec<Test>,
+    agents: Vec<u32>,
+}
+
+/// The best activated rule found so far, with its key.
+#[derive(Debug, Clone, Copy)]
+struct Best {
+    rule: u32,
+    key: (i64, u32, u64),
+}
+
+impl Program {
+    /// The program of a validated bundle, or why the fast path declines it.
+    // The lists are built per state and agent, the tables indexed per rule.
+    #[allow(clippy::needless_range_loop)]
+    pub(super) fn new(c: &Content, net: &Net) -> Result<Program, &'static str> {
+        let ns = c.states.len();
+        let ne = c.events.len();
+        let na = c.agents.len();
+        let n = &c.network;
+        let mut p = Program { ne, na, ..Program::default() };
+        let arg = |o: &Operand, own: u32| -> Result<Arg, &'static str> {
+            Ok(match *o {
+                Operand::Value(v) => Arg::Value(v),
+                Operand::Own { field } => Arg::At(place(net, own, field)?),
+                Operand::Fact { agent, field } => {
+                    let a = agent as usize;
+                    if a >= na {
+                        return Err("a test reads an agent out of range");
+                    }
+                    if field < net.stride[a] {
+                        Arg::At(net.payload_at[a] + field)
+                    } else {
+                        // As the interpreter: a value that matches nothing.
+                        Arg::Value(Value::F64(f64::NAN))
+                    }
+                }
+            })
+        };
+        // Per rule: the states it can be activated in, the agents it reads.
+        let mut ok_states: Vec<Vec<bool>> = Vec::with_capacity(c.rules.len());
+        let mut reads: Vec<Vec<bool>> = Vec::with_capacity(c.rules.len());
+        let mut terminal = vec![NONE; c.rules.len()];
+        for t in &n.terminals {
+            terminal[t.rule as usize] = t.beta;
+        }
+        for (r, rule) in c.rules.iter().enumerate() {
+            let mut chain = Vec::new();
+            let mut b = terminal[r];
+            while b != NONE {
+                if chain.len() > n.beta.len() {
+                    return Err("a chain of beta nodes loops");
+                }
+                chain.push(b);
+                b = n.beta[b as usize].parent.unwrap_or(NONE);
+            }
+            if chain.is_empty() {
+                return Err("a rule without a terminal");
+            }
+            chain.reverse();
+            let mut ok = vec![true; ns];
+            let mut read = vec![false; na];
+            let c0 = p.conds.len();
+            for &b in &chain {
+                let beta = &n.beta[b as usize];
+                let negative = beta.kind == BetaKind::Negative;
+                match &n.alpha[beta.alpha as usize] {
+                    AlphaNode::State { states } => {
+                        if !beta.tests.is_empty() {
+                            return Err("join tests on a state node");
+                        }
+                        for (s, o) in ok.iter_mut().enumerate() {
+                            *o &= states.contains(&(s as u32)) != negative;
+                        }
+                    }
+                    AlphaNode::Stale { agent } => {
+                        if !beta.tests.is_empty() {
+                            return Err("join tests on a staleness node");
+                        }
+                        read[*agent as usize] = true;
+                        p.conds.push(Cond {
+                            agent: *agent,
+                            event: STALE,
+                            negative,
+                            min_run: 0,
+                            within: u64::MAX,
+                            tests: (0, 0),
+                        });
+                    }
+                    AlphaNode::Event { event, tests, min_run, within_ns } => {
+                        let agent = c.events[*event as usize].agent;
+                        read[agent as usize] = true;
+                        let own = net.payload_at[agent as usize];
+                        let t0 = p.tests.len() as u32;
+                        for t in tests.iter().chain(&beta.tests) {
+                            let x = place(net, own, t.field)?;
+                            let check = match &t.check {
+                                Check::Compare { op, rhs } => Check2::Compare { op: *op, rhs: arg(rhs, own)? },
+                                Check::Range { lo, hi, inclusive } => {
+                                    Check2::Range { lo: arg(lo, own)?, hi: arg(hi, own)?, inclusive: *inclusive }
+                                }
+                            };
+                            for o in operands(&t.check) {
+                                if let Operand::Fact { agent, .. } = o {
+                                    read[*agent as usize] = true;
+                                }
+                            }
+                            p.tests.push(Test { x, check });
+                        }
+                        p.conds.push(Cond {
+                            agent,
+                            event: *event,
+                            negative,
+                            min_run: *min_run,
+                            within: within_ns.unwrap_or(u64::MAX),
+                            tests: (t0, p.tests.len() as u32),
+                        });
+                    }
+                }
+            }
+            let m0 = p.agents.len() as u32;
+            p.agents.extend_from_slice(&rule.matches);
+            p.rules.push(Rule {
+                conds: (c0 as u32, p.conds.len() as u32),
+                salience: rule.salience,
+                specificity: rule.specificity,
+                matches: (m0, p.agents.len() as u32),
+            });
+            ok_states.push(ok);
+            reads.push(read);
+        }
+
+        // The rules in the order they fire in, all else equal.
+        let mut order: Vec<u32> = (0..c.rules.len() as u32).collect();
+        order.sort_by_key(|&r| {
+            let rule = &p.rules[r as usize];
+            (std::cmp::Reverse(rule.salience), std::cmp::Reverse(rule.specificity), r)
+        });
+        // Whether `e` (of agent `a`) makes a condition of `r` on `a` false.
+        let excluded = |p: &Program, r: u32, a: u32, e: u32| {
+            let (s, t) = p.rules[r as usize].conds;
+            p.conds[s as usize..t as usize].iter().any(|c| c.agent == a && !c.negative && c.event != e)
+        };
+        let push = |p: &mut Program, keep: &dyn Fn(&Program, u32) -> bool| -> Result<(u32, u32), &'static str> {
+            let s = p.lists.len();
+            for &r in &order {
+                if keep(p, r) {
+                    p.lists.push(r);
+                }
+            }
+            if p.lists.len() > MAX_LIST_ENTRIES {
+                return Err("its candidate lists are too large");
+            }
+            Ok((s as u32, p.lists.len() as u32))
+        };
+        for s in 0..ns {
+            let l = push(&mut p, &|_, r| ok_states[r as usize][s])?;
+            p.by_state.push(l);
+            for a in 0..na {
+                let l = push(&mut p, &|_, r| ok_states[r as usize][s] && reads[r as usize][a])?;
+                p.by_agent.push(l);
+            }
+            for e in 0..ne {
+                let a = c.events[e].agent;
+                let l = push(&mut p, &|p, r| {
+                    ok_states[r as usize][s] && reads[r as usize][a as usize] && !excluded(p, r, a, e as u32)
+                })?;
+                p.by_event.push(l);
+            }
+        }
+        Ok(p)
+    }
+}
+
+/// The place in the arena of field `field` of the agent whose payload starts
+/// at `own`, if the arena has it (the interpreter reads the same place).
+fn place(net: &Net, own: u32, field: u32) -> Result<u32, &'static str> {
+    let x = own as usize + field as usize;
+    if x < net.payload_len {
+        Ok(x as u32)
+    } else {
+        Err("a test reads a field out of the payload arena")
+    }
+}
+
+fn operands(c: &Check) -> Vec<&Operand> {
+    match c {
+        Check::Compare { rhs, .. } => vec![rhs],
+        Check::Range { lo, hi, .. } => vec![lo, hi],
+    }
+}
+
+impl Engine {
+    /// [`accepted`](Self::accepted) on the fast path.
+    #[inline(always)]
+    pub(super) fn fast_accepted(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Step, PostError> {
+        self.begin();
+        if time > self.now {
+            self.now = time;
+        }
+        if self.now > self.next_deadline {
+            self.fast_expire();
+        }
+        if !self.active.is_empty() || !self.touched.is_empty() {
+            self.fast_rest(NONE)?;
+        }
+        self.fast_insert(event, time, payload);
+        if self.now > self.next_deadline {
+            // The fact came late: it may be expired already.
+            self.fast_expire();
+        }
+        self.fast_rest(event)?;
+        Ok(Step { from: self.record.from, to: self.state, firings: self.record.firings.len() })
+    }
+
+    /// [`insert`](Self::insert) without the network.
+    #[inline(always)]
+    pub(super) fn fast_insert(&mut self, event: u32, time: u64, payload: &[Value]) {
+        let ev = self.net.event[event as usize];
+        let a = ev.agent as usize;
+        let old = self.slots[a];
+        self.seq += 1;
+        let run = if old.event == event { old.run + 1 } else { 1 };
+        self.slots[a] = Slot { event, time, run, seq: self.seq };
+        self.last[a] = self.last[a].max(time);
+        copy_payload(&mut self.payload[ev.payload_at as usize..], payload);
+        self.stale[a] = false;
+        self.checked[a] = self.now;
+        let stale_at = if ev.stale_after == u64::MAX { u64::MAX } else { time.saturating_add(ev.stale_after) };
+        let window_at = self.next_window(ev.windows, time);
+        self.stale_at[a] = stale_at;
+        self.window_at[a] = window_at;
+        self.next_deadline = self.next_deadline.min(stale_at).min(window_at);
+    }
+
+    /// [`expire`](Self::expire) without the network: the agents whose fact
+    /// expired or whose window closed are noted in `touched`.
+    pub(super) fn fast_expire(&mut self) {
+        let mut next = u64::MAX;
+        for i in 0..self.net.timed_agents.len() {
+            let a = self.net.timed_agents[i] as usize;
+            if self.stale_at[a] < self.now {
+                self.slots[a] = EMPTY;
+                self.stale[a] = true;
+                self.stale_at[a] = u64::MAX;
+                self.window_at[a] = u64::MAX;
+                self.touched.push(a as u32);
+            } else if self.window_at[a] < self.now {
+                self.checked[a] = self.now;
+                let slot = self.slots[a];
+                self.window_at[a] = self.next_window(self.net.event[slot.event as usize].windows, slot.time);
+                self.touched.push(a as u32);
+            }
+            next = next.min(self.stale_at[a]).min(self.window_at[a]);
+        }
+        self.next_deadline = next;
+    }
+
+    /// [`rest`](Self::rest) on the fast path. The first search covers what
+    /// changed since the last rest: every rule of the state if the engine
+    /// was not at rest (`active` not empty), else the rules of `event`'s new
+    /// fact (`NONE`: none) and of the agents in `touched`.
+    pub(super) fn fast_rest(&mut self, event: u32) -> Result<(), PostError> {
+        let mut best = None;
+        let st = self.state as usize;
+        if !self.active.is_empty() {
+            self.fast_best_in(self.fp.by_state[st], &mut best);
+        } else {
+            if event != NONE {
+                self.fast_best_in(self.fp.by_event[st * self.fp.ne + event as usize], &mut best);
+            }
+            for i in 0..self.touched.len() {
+                let a = self.touched[i] as usize;
+                self.fast_best_in(self.fp.by_agent[st * self.fp.na + a], &mut best);
+            }
+        }
+        self.touched.clear();
+        self.active.clear();
+        while let Some(b) = best {
+            if self.record.firings.len() == self.cascade_limit {
+                self.fast_activate();
+                let firings = self.last_change().firings;
+                return Err(PostError::Cascade { limit: self.cascade_limit, firings });
+            }
+            self.state = self.record_firing(b.rule);
+            best = None;
+            self.fast_best_in(self.fp.by_state[self.state as usize], &mut best);
+        }
+        Ok(())
+    }
+
+    /// The activated rule of the list `(s, e)` that fires first, if it fires
+    /// before `best` (§10.4: salience, specificity, recency, declaration
+    /// order, as [`best`](Self::best)).
+    #[inline]
+    fn fast_best_in(&self, (s, e): (u32, u32), best: &mut Option<Best>) {
+        for i in s as usize..e as usize {
+            let r = self.fp.lists[i];
+            let rule = &self.fp.rules[r as usize];
+            if let Some(b) = best {
+                // The list is in firing order: no later rule can come first.
+                if (rule.salience, rule.specificity) < (b.key.0, b.key.1) {
+                    return;
+                }
+            }
+            if !self.fast_holds(rule) {
+                continue;
+            }
+            let key = (rule.salience, rule.specificity, self.fast_recency(rule));
+            let better = match best {
+                None => true,
+                Some(b) => key > b.key || (key == b.key && r < b.rule),
+            };
+            if better {
+                *best = Some(Best { rule: r, key });
+            }
+        }
+    }
+
+    fn fast_recency(&self, rule: &Rule) -> u64 {
+        let (s, e) = rule.matches;
+        self.fp.agents[s as usize..e as usize].iter().map(|&a| self.slots[a as usize].seq).max().unwrap_or(0)
+    }
+
+    /// Whether the rule's conditions hold (its state guard is its lists').
+    #[inline]
+    fn fast_holds(&self, rule: &Rule) -> bool {
+        let (s, e) = rule.conds;
+        self.fp.conds[s as usize..e as usize].iter().all(|c| self.fast_cond(c))
+    }
+
+    #[inline]
+    fn fast_cond(&self, c: &Cond) -> bool {
+        let a = c.agent as usize;
+        let pos = if c.event == STALE {
+            self.stale[a]
+        } else {
+            let slot = &self.slots[a];
+            slot.event == c.event
+                && slot.run >= c.min_run
+                && self.checked[a].saturating_sub(slot.time) <= c.within
+                && self.fast_tests(c.tests)
+        };
+        pos != c.negative
+    }
+
+    #[inline]
+    fn fast_tests(&self, (s, e): (u32, u32)) -> bool {
+        self.fp.tests[s as usize..e as usize].iter().all(|t| {
+            let x = self.payload[t.x as usize];
+            match t.check {
+                Check2::Compare { op, rhs } => compare(op, x, self.arg(rhs)),
+                Check2::Range { lo, hi, inclusive } => in_range(x, self.arg(lo), self.arg(hi), inclusive),
+            }
+        })
+    }
+
+    #[inline]
+    fn arg(&self, a: Arg) -> Value {
+        match a {
+            Arg::Value(v) => v,
+            Arg::At(i) => self.payload[i as usize],
+        }
+    }
+
+    /// Out of rest: the activated rules, whole, into `active` (in
+    /// declaration order), which the next rest starts from.
+    pub(super) fn fast_activate(&mut self) {
+        let mut active = std::mem::take(&mut self.active);
+        active.clear();
+        let (s, e) = self.fp.by_state[self.state as usize];
+        for i in s as usize..e as usize {
+            let r = self.fp.lists[i];
+            if self.fast_holds(&self.fp.rules[r as usize]) {
+                active.push(r);
+            }
+        }
+        active.sort_unstable();
+        self.active = active;
+    }
+}
