@@ -46,7 +46,7 @@
 //! the agent's last evaluation, which equals now whenever expiry is due
 //! on no deadline.
 
-use super::eval::{compare, in_range};
+use super::eval::{compare, float, in_range};
 use super::net::{Net, NONE};
 use super::{copy_payload, Engine, PostError, Slot, Step, EMPTY};
 use situ_bundle::{AlphaNode, BetaKind, Check, Cmp, Content, Operand, Value};
@@ -71,11 +71,15 @@ enum Check2 {
     Range { lo: Arg, hi: Arg, inclusive: bool },
 }
 
-/// A test of the payload value at `x` (a place in the arena).
+/// A test of the payload value at a place `x` of the arena. A float field
+/// against float constants, the usual test, has its own shape (the field's
+/// type is known from its event; a value of another type, which the
+/// payload check keeps out, would go to `compare` all the same).
 #[derive(Debug, Clone, Copy)]
-struct Test {
-    x: u32,
-    check: Check2,
+enum Test {
+    F64 { x: u32, op: Cmp, c: f64 },
+    F64Range { x: u32, lo: f64, hi: f64, inclusive: bool },
+    Any { x: u32, check: Check2 },
 }
 
 /// One condition of a rule on one agent's fact.
@@ -96,8 +100,12 @@ struct Cond {
 struct Rule {
     /// Its conditions, in `Program::conds`, in the chain's order.
     conds: (u32, u32),
-    salience: i64,
-    specificity: u32,
+    /// The rank of its (salience, specificity) among the rules': a larger
+    /// one fires first.
+    group: u32,
+    /// The events (below 64) its positive patterns need as facts, as bits:
+    /// the rule cannot hold unless `Engine::have` has them all.
+    need: u64,
     /// The agents its positive patterns match (recency), in `Program::agents`.
     matches: (u32, u32),
 }
@@ -119,11 +127,37 @@ pub(super) struct Program {
     agents: Vec<u32>,
 }
 
-/// The best activated rule found so far, with its key.
+/// The activated rule that fires first among those seen so far (`rule`:
+/// `NONE` before one), its group, and its recency once needed (`u64::MAX`:
+/// not yet computed).
 #[derive(Debug, Clone, Copy)]
 struct Best {
     rule: u32,
-    key: (i64, u32, u64),
+    group: u32,
+    recency: u64,
+}
+
+/// An event's bit in [`Engine::have`] (`0` from event 64 on: no bit).
+#[inline(always)]
+pub(super) fn bit(event: u32) -> u64 {
+    1u64.checked_shl(event).unwrap_or(0)
+}
+
+/// `v[i]` without the bounds check.
+///
+/// # Safety
+/// `i < v.len()`. Every index this module takes from the program (lists,
+/// rules, conditions, tests, agents, places in the arena) is checked once
+/// by [`Program::check`] when the program is built, against the engine's
+/// tables, whose lengths never change after construction (`slots`,
+/// `stale`, `checked`: one per agent; `payload`: the arena's length); the
+/// state is always a state of the bundle and the event of a step one the
+/// payload check took.
+#[inline(always)]
+unsafe fn at<T>(v: &[T], i: usize) -> &T {
+    debug_assert!(i < v.len(), "{i} >= {}", v.len());
+    // SAFETY: the caller's.
+    unsafe { v.get_unchecked(i) }
 }
 
 impl Program {
@@ -211,18 +245,37 @@ impl Program {
                         let t0 = p.tests.len() as u32;
                         for t in tests.iter().chain(&beta.tests) {
                             let x = place(net, own, t.field)?;
-                            let check = match &t.check {
-                                Check::Compare { op, rhs } => Check2::Compare { op: *op, rhs: arg(rhs, own)? },
-                                Check::Range { lo, hi, inclusive } => {
-                                    Check2::Range { lo: arg(lo, own)?, hi: arg(hi, own)?, inclusive: *inclusive }
+                            let float = c.events[*event as usize]
+                                .fields
+                                .get(t.field as usize)
+                                .is_some_and(|f| f.ty == situ_bundle::FieldType::F64);
+                            let test = match &t.check {
+                                Check::Compare { op, rhs: Operand::Value(Value::F64(c)) } if float => {
+                                    Test::F64 { x, op: *op, c: *c }
                                 }
+                                Check::Range {
+                                    lo: Operand::Value(Value::F64(lo)),
+                                    hi: Operand::Value(Value::F64(hi)),
+                                    inclusive,
+                                } if float => Test::F64Range { x, lo: *lo, hi: *hi, inclusive: *inclusive },
+                                Check::Compare { op, rhs } => {
+                                    Test::Any { x, check: Check2::Compare { op: *op, rhs: arg(rhs, own)? } }
+                                }
+                                Check::Range { lo, hi, inclusive } => Test::Any {
+                                    x,
+                                    check: Check2::Range {
+                                        lo: arg(lo, own)?,
+                                        hi: arg(hi, own)?,
+                                        inclusive: *inclusive,
+                                    },
+                                },
                             };
                             for o in operands(&t.check) {
                                 if let Operand::Fact { agent, .. } = o {
                                     read[*agent as usize] = true;
                                 }
                             }
-                            p.tests.push(Test { x, check });
+                            p.tests.push(test);
                         }
                         p.conds.push(Cond {
                             agent,
@@ -237,22 +290,29 @@ impl Program {
             }
             let m0 = p.agents.len() as u32;
             p.agents.extend_from_slice(&rule.matches);
+            let need =
+                p.conds[c0..].iter().filter(|c| !c.negative && c.event != STALE).fold(0, |m, c| m | bit(c.event));
             p.rules.push(Rule {
                 conds: (c0 as u32, p.conds.len() as u32),
-                salience: rule.salience,
-                specificity: rule.specificity,
+                group: 0,
+                need,
                 matches: (m0, p.agents.len() as u32),
             });
             ok_states.push(ok);
             reads.push(read);
         }
 
-        // The rules in the order they fire in, all else equal.
+        // The rules in the order they fire in, all else equal, and the rank
+        // of each one's (salience, specificity).
+        let prio = |r: u32| (c.rules[r as usize].salience, c.rules[r as usize].specificity);
         let mut order: Vec<u32> = (0..c.rules.len() as u32).collect();
-        order.sort_by_key(|&r| {
-            let rule = &p.rules[r as usize];
-            (std::cmp::Reverse(rule.salience), std::cmp::Reverse(rule.specificity), r)
-        });
+        order.sort_by_key(|&r| (std::cmp::Reverse(prio(r)), r));
+        let mut groups: Vec<(i64, u32)> = order.iter().map(|&r| prio(r)).collect();
+        groups.dedup();
+        for r in 0..c.rules.len() {
+            let rank = groups.len() - 1 - groups.iter().position(|&g| g == prio(r as u32)).unwrap_or(0);
+            p.rules[r].group = rank as u32;
+        }
         // Whether `e` (of agent `a`) makes a condition of `r` on `a` false.
         let excluded = |p: &Program, r: u32, a: u32, e: u32| {
             let (s, t) = p.rules[r as usize].conds;
@@ -285,7 +345,37 @@ impl Program {
                 p.by_event.push(l);
             }
         }
+        p.check(ns, net.payload_len)?;
         Ok(p)
+    }
+
+    /// Checks every index of the program against the tables it indexes:
+    /// the invariant under which the engine reads them unchecked ([`at`]).
+    fn check(&self, ns: usize, payload_len: usize) -> Result<(), &'static str> {
+        let range = |(s, e): (u32, u32), len: usize| s <= e && e as usize <= len;
+        let lists = self.by_state.len() == ns
+            && self.by_agent.len() == ns * self.na
+            && self.by_event.len() == ns * self.ne
+            && self.by_state.iter().chain(&self.by_agent).chain(&self.by_event).all(|&l| range(l, self.lists.len()))
+            && self.lists.iter().all(|&r| (r as usize) < self.rules.len());
+        let rules = self.rules.iter().all(|r| range(r.conds, self.conds.len()) && range(r.matches, self.agents.len()))
+            && self.agents.iter().all(|&a| (a as usize) < self.na);
+        let conds = self.conds.iter().all(|c| (c.agent as usize) < self.na && range(c.tests, self.tests.len()));
+        let place = |i: u32| (i as usize) < payload_len;
+        let arg = |a: Arg| match a {
+            Arg::Value(_) => true,
+            Arg::At(i) => place(i),
+        };
+        let tests = self.tests.iter().all(|t| match *t {
+            Test::F64 { x, .. } | Test::F64Range { x, .. } => place(x),
+            Test::Any { x, check: Check2::Compare { rhs, .. } } => place(x) && arg(rhs),
+            Test::Any { x, check: Check2::Range { lo, hi, .. } } => place(x) && arg(lo) && arg(hi),
+        });
+        if lists && rules && conds && tests {
+            Ok(())
+        } else {
+            Err("an index of the program out of its table")
+        }
     }
 }
 
@@ -338,6 +428,7 @@ impl Engine {
         let old = self.slots[a];
         self.seq += 1;
         let run = if old.event == event { old.run + 1 } else { 1 };
+        self.have = (self.have & !bit(old.event)) | bit(event);
         self.slots[a] = Slot { event, time, run, seq: self.seq };
         self.last[a] = self.last[a].max(time);
         copy_payload(&mut self.payload[ev.payload_at as usize..], payload);
@@ -357,6 +448,7 @@ impl Engine {
         for i in 0..self.net.timed_agents.len() {
             let a = self.net.timed_agents[i] as usize;
             if self.stale_at[a] < self.now {
+                self.have &= !bit(self.slots[a].event);
                 self.slots[a] = EMPTY;
                 self.stale[a] = true;
                 self.stale_at[a] = u64::MAX;
@@ -377,30 +469,47 @@ impl Engine {
     /// changed since the last rest: every rule of the state if the engine
     /// was not at rest (`active` not empty), else the rules of `event`'s new
     /// fact (`NONE`: none) and of the agents in `touched`.
+    #[inline(always)]
     pub(super) fn fast_rest(&mut self, event: u32) -> Result<(), PostError> {
-        let mut best = None;
+        let mut best = Best { rule: NONE, group: 0, recency: u64::MAX };
         let st = self.state as usize;
         if !self.active.is_empty() {
-            self.fast_best_in(self.fp.by_state[st], &mut best);
+            // SAFETY (`at`): the state is a state of the bundle.
+            self.fast_best_in(unsafe { *at(&self.fp.by_state, st) }, &mut best);
+            self.active.clear();
         } else {
             if event != NONE {
-                self.fast_best_in(self.fp.by_event[st * self.fp.ne + event as usize], &mut best);
+                // SAFETY (`at`): the state and the event (taken by the
+                // payload check) are the bundle's: `st * ne + event < ns * ne`.
+                let list = unsafe { *at(&self.fp.by_event, st * self.fp.ne + event as usize) };
+                self.fast_best_in(list, &mut best);
             }
-            for i in 0..self.touched.len() {
-                let a = self.touched[i] as usize;
-                self.fast_best_in(self.fp.by_agent[st * self.fp.na + a], &mut best);
+            if !self.touched.is_empty() {
+                for i in 0..self.touched.len() {
+                    let a = self.touched[i] as usize;
+                    self.fast_best_in(self.fp.by_agent[st * self.fp.na + a], &mut best);
+                }
+                self.touched.clear();
             }
         }
-        self.touched.clear();
-        self.active.clear();
-        while let Some(b) = best {
+        if best.rule == NONE {
+            return Ok(());
+        }
+        self.fast_fire(best)
+    }
+
+    /// Fires `best`, then the rule that fires first in each new state,
+    /// until none is activated; the bound counts the firings of the step.
+    #[inline(never)]
+    fn fast_fire(&mut self, mut best: Best) -> Result<(), PostError> {
+        while best.rule != NONE {
             if self.record.firings.len() == self.cascade_limit {
                 self.fast_activate();
                 let firings = self.last_change().firings;
                 return Err(PostError::Cascade { limit: self.cascade_limit, firings });
             }
-            self.state = self.record_firing(b.rule);
-            best = None;
+            self.state = self.record_firing(best.rule);
+            best = Best { rule: NONE, group: 0, recency: u64::MAX };
             self.fast_best_in(self.fp.by_state[self.state as usize], &mut best);
         }
         Ok(())
@@ -410,26 +519,31 @@ impl Engine {
     /// before `best` (§10.4: salience, specificity, recency, declaration
     /// order, as [`best`](Self::best)).
     #[inline]
-    fn fast_best_in(&self, (s, e): (u32, u32), best: &mut Option<Best>) {
+    fn fast_best_in(&self, (s, e): (u32, u32), best: &mut Best) {
+        let p = &*self.fp;
         for i in s as usize..e as usize {
-            let r = self.fp.lists[i];
-            let rule = &self.fp.rules[r as usize];
-            if let Some(b) = best {
-                // The list is in firing order: no later rule can come first.
-                if (rule.salience, rule.specificity) < (b.key.0, b.key.1) {
-                    return;
-                }
+            // SAFETY (`at`): lists and their entries are checked.
+            let r = unsafe { *at(&p.lists, i) };
+            let rule = unsafe { at(&p.rules, r as usize) };
+            if best.rule != NONE && rule.group < best.group {
+                // The list is in firing order: no later rule comes first.
+                return;
             }
-            if !self.fast_holds(rule) {
+            if rule.need & self.have != rule.need || !self.fast_holds(rule) {
                 continue;
             }
-            let key = (rule.salience, rule.specificity, self.fast_recency(rule));
-            let better = match best {
-                None => true,
-                Some(b) => key > b.key || (key == b.key && r < b.rule),
-            };
-            if better {
-                *best = Some(Best { rule: r, key });
+            if best.rule == NONE || rule.group > best.group {
+                *best = Best { rule: r, group: rule.group, recency: u64::MAX };
+                continue;
+            }
+            // The same salience and specificity: recency, then the rule
+            // declared first.
+            if best.recency == u64::MAX {
+                best.recency = self.fast_recency(unsafe { at(&p.rules, best.rule as usize) });
+            }
+            let recency = self.fast_recency(rule);
+            if recency > best.recency || (recency == best.recency && r < best.rule) {
+                *best = Best { rule: r, group: rule.group, recency };
             }
         }
     }
@@ -443,19 +557,24 @@ impl Engine {
     #[inline]
     fn fast_holds(&self, rule: &Rule) -> bool {
         let (s, e) = rule.conds;
-        self.fp.conds[s as usize..e as usize].iter().all(|c| self.fast_cond(c))
+        (s as usize..e as usize).all(|i| {
+            // SAFETY (`at`): the rule's conditions are checked.
+            self.fast_cond(unsafe { at(&self.fp.conds, i) })
+        })
     }
 
     #[inline]
     fn fast_cond(&self, c: &Cond) -> bool {
         let a = c.agent as usize;
+        // SAFETY (`at`): a condition's agent is checked, and `slots`,
+        // `stale`, `checked` have one entry per agent.
         let pos = if c.event == STALE {
-            self.stale[a]
+            unsafe { *at(&self.stale, a) }
         } else {
-            let slot = &self.slots[a];
+            let slot = unsafe { at(&self.slots, a) };
             slot.event == c.event
                 && slot.run >= c.min_run
-                && self.checked[a].saturating_sub(slot.time) <= c.within
+                && (c.within == u64::MAX || unsafe { *at(&self.checked, a) }.saturating_sub(slot.time) <= c.within)
                 && self.fast_tests(c.tests)
         };
         pos != c.negative
@@ -463,11 +582,24 @@ impl Engine {
 
     #[inline]
     fn fast_tests(&self, (s, e): (u32, u32)) -> bool {
-        self.fp.tests[s as usize..e as usize].iter().all(|t| {
-            let x = self.payload[t.x as usize];
-            match t.check {
-                Check2::Compare { op, rhs } => compare(op, x, self.arg(rhs)),
-                Check2::Range { lo, hi, inclusive } => in_range(x, self.arg(lo), self.arg(hi), inclusive),
+        (s as usize..e as usize).all(|i| {
+            // SAFETY (`at`): tests and their places in the arena are checked.
+            match unsafe { *at(&self.fp.tests, i) } {
+                Test::F64 { x, op, c } => match unsafe { *at(&self.payload, x as usize) } {
+                    Value::F64(v) => float(op, v, c),
+                    other => compare(op, other, Value::F64(c)),
+                },
+                Test::F64Range { x, lo, hi, inclusive } => match unsafe { *at(&self.payload, x as usize) } {
+                    Value::F64(v) => v >= lo && if inclusive { v <= hi } else { v < hi },
+                    other => in_range(other, Value::F64(lo), Value::F64(hi), inclusive),
+                },
+                Test::Any { x, check } => {
+                    let x = unsafe { *at(&self.payload, x as usize) };
+                    match check {
+                        Check2::Compare { op, rhs } => compare(op, x, self.arg(rhs)),
+                        Check2::Range { lo, hi, inclusive } => in_range(x, self.arg(lo), self.arg(hi), inclusive),
+                    }
+                }
             }
         })
     }
@@ -476,19 +608,22 @@ impl Engine {
     fn arg(&self, a: Arg) -> Value {
         match a {
             Arg::Value(v) => v,
-            Arg::At(i) => self.payload[i as usize],
+            // SAFETY (`at`): places in the arena are checked.
+            Arg::At(i) => unsafe { *at(&self.payload, i as usize) },
         }
     }
 
     /// Out of rest: the activated rules, whole, into `active` (in
     /// declaration order), which the next rest starts from.
     pub(super) fn fast_activate(&mut self) {
+        debug_assert!(self.slots.len() == self.fp.na && self.checked.len() == self.fp.na);
         let mut active = std::mem::take(&mut self.active);
         active.clear();
         let (s, e) = self.fp.by_state[self.state as usize];
         for i in s as usize..e as usize {
             let r = self.fp.lists[i];
-            if self.fast_holds(&self.fp.rules[r as usize]) {
+            let rule = &self.fp.rules[r as usize];
+            if rule.need & self.have == rule.need && self.fast_holds(rule) {
                 active.push(r);
             }
         }

@@ -113,6 +113,9 @@ pub struct Engine {
     checked: Vec<u64>,
     touched: Vec<u32>,
     declined: Option<&'static str>,
+    /// The events (below 64) that are an agent's fact now, as bits
+    /// (`fast::bit`); kept on the fast path only.
+    have: u64,
 }
 
 /// The memories of the network (alpha, beta, activated rules).
@@ -190,6 +193,7 @@ impl Engine {
             checked: vec![0; na],
             touched: Vec::with_capacity(na),
             declined,
+            have: 0,
             content,
             net,
         };
@@ -283,6 +287,7 @@ impl Engine {
         self.cascade_limit = other.cascade_limit;
         self.checked.clone_from(&other.checked);
         self.touched.clone_from(&other.touched);
+        self.have = other.have;
     }
 
     /// Whether the agent's fact has expired.
@@ -311,6 +316,7 @@ impl Engine {
         self.state = self.content.initial;
         let m = &*self.initial;
         self.touched.clear();
+        self.have = 0;
         if self.fast {
             // The fast path keeps no network memories: only the activated rules.
             self.active.clone_from(&m.active);
@@ -486,6 +492,7 @@ impl Engine {
             return;
         }
         if self.fast {
+            self.have &= !fast::bit(self.slots[a].event);
             self.slots[a] = EMPTY;
             self.stale[a] = true;
             self.stale_at[a] = u64::MAX;
