@@ -60,6 +60,7 @@ impl Engine {
     ///
     /// NaN and the infinities are accepted: §10.3 says what they match.
     /// A refused event changes nothing, not even now.
+    #[inline(always)]
     pub fn admit(&self, event: u32, time: u64, payload: &[Value]) -> Result<(), PostError> {
         let agent = self.validated(event, payload)? as usize;
         let last = self.last[agent];

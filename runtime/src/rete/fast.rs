@@ -160,6 +160,17 @@ unsafe fn at<T>(v: &[T], i: usize) -> &T {
     unsafe { v.get_unchecked(i) }
 }
 
+/// `&mut v[i]` without the bounds check.
+///
+/// # Safety
+/// As [`at`].
+#[inline(always)]
+unsafe fn at_mut<T>(v: &mut [T], i: usize) -> &mut T {
+    debug_assert!(i < v.len(), "{i} >= {}", v.len());
+    // SAFETY: the caller's.
+    unsafe { v.get_unchecked_mut(i) }
+}
+
 impl Program {
     /// The program of a validated bundle, or why the fast path declines it.
     // The lists are built per state and agent, the tables indexed per rule.
@@ -345,13 +356,22 @@ impl Program {
                 p.by_event.push(l);
             }
         }
-        p.check(ns, net.payload_len)?;
+        p.check(ns, net)?;
         Ok(p)
     }
 
     /// Checks every index of the program against the tables it indexes:
     /// the invariant under which the engine reads them unchecked ([`at`]).
-    fn check(&self, ns: usize, payload_len: usize) -> Result<(), &'static str> {
+    fn check(&self, ns: usize, net: &Net) -> Result<(), &'static str> {
+        let payload_len = net.payload_len;
+        // The events' agents, their places and windows (`fast_insert`).
+        let events = net.event.len() == self.ne
+            && net.event.iter().all(|e| {
+                (e.agent as usize) < self.na
+                    && e.payload_at as usize + (e.kinds.1 - e.kinds.0) as usize <= payload_len
+                    && e.windows.0 <= e.windows.1
+                    && e.windows.1 as usize <= net.windows.len()
+            });
         let range = |(s, e): (u32, u32), len: usize| s <= e && e as usize <= len;
         let lists = self.by_state.len() == ns
             && self.by_agent.len() == ns * self.na
@@ -371,7 +391,7 @@ impl Program {
             Test::Any { x, check: Check2::Compare { rhs, .. } } => place(x) && arg(rhs),
             Test::Any { x, check: Check2::Range { lo, hi, .. } } => place(x) && arg(lo) && arg(hi),
         });
-        if lists && rules && conds && tests {
+        if events && lists && rules && conds && tests {
             Ok(())
         } else {
             Err("an index of the program out of its table")
@@ -423,21 +443,30 @@ impl Engine {
     /// [`insert`](Self::insert) without the network.
     #[inline(always)]
     pub(super) fn fast_insert(&mut self, event: u32, time: u64, payload: &[Value]) {
-        let ev = self.net.event[event as usize];
+        // SAFETY (`at`, `at_mut`): the event was taken by the payload check
+        // (it is the bundle's, and `payload` fits it); its agent, its
+        // place and its windows are checked (`Program::check`); the tables
+        // indexed by agent have one entry per agent.
+        let ev = unsafe { *at(&self.net.event, event as usize) };
         let a = ev.agent as usize;
-        let old = self.slots[a];
+        let old = unsafe { *at(&self.slots, a) };
         self.seq += 1;
         let run = if old.event == event { old.run + 1 } else { 1 };
         self.have = (self.have & !bit(old.event)) | bit(event);
-        self.slots[a] = Slot { event, time, run, seq: self.seq };
-        self.last[a] = self.last[a].max(time);
+        unsafe {
+            *at_mut(&mut self.slots, a) = Slot { event, time, run, seq: self.seq };
+            let last = at_mut(&mut self.last, a);
+            *last = (*last).max(time);
+            *at_mut(&mut self.stale, a) = false;
+            *at_mut(&mut self.checked, a) = self.now;
+        }
         copy_payload(&mut self.payload[ev.payload_at as usize..], payload);
-        self.stale[a] = false;
-        self.checked[a] = self.now;
         let stale_at = if ev.stale_after == u64::MAX { u64::MAX } else { time.saturating_add(ev.stale_after) };
-        let window_at = self.next_window(ev.windows, time);
-        self.stale_at[a] = stale_at;
-        self.window_at[a] = window_at;
+        let window_at = if ev.windows.0 == ev.windows.1 { u64::MAX } else { self.next_window(ev.windows, time) };
+        unsafe {
+            *at_mut(&mut self.stale_at, a) = stale_at;
+            *at_mut(&mut self.window_at, a) = window_at;
+        }
         self.next_deadline = self.next_deadline.min(stale_at).min(window_at);
     }
 
@@ -518,13 +547,15 @@ impl Engine {
     /// The activated rule of the list `(s, e)` that fires first, if it fires
     /// before `best` (§10.4: salience, specificity, recency, declaration
     /// order, as [`best`](Self::best)).
-    #[inline]
+    #[inline(always)]
     fn fast_best_in(&self, (s, e): (u32, u32), best: &mut Best) {
         let p = &*self.fp;
-        for i in s as usize..e as usize {
+        let (mut i, e) = (s as usize, e as usize);
+        while i < e {
             // SAFETY (`at`): lists and their entries are checked.
             let r = unsafe { *at(&p.lists, i) };
             let rule = unsafe { at(&p.rules, r as usize) };
+            i += 1;
             if best.rule != NONE && rule.group < best.group {
                 // The list is in firing order: no later rule comes first.
                 return;
@@ -554,16 +585,20 @@ impl Engine {
     }
 
     /// Whether the rule's conditions hold (its state guard is its lists').
-    #[inline]
+    #[inline(always)]
     fn fast_holds(&self, rule: &Rule) -> bool {
-        let (s, e) = rule.conds;
-        (s as usize..e as usize).all(|i| {
+        let (mut i, e) = (rule.conds.0 as usize, rule.conds.1 as usize);
+        while i < e {
             // SAFETY (`at`): the rule's conditions are checked.
-            self.fast_cond(unsafe { at(&self.fp.conds, i) })
-        })
+            if !self.fast_cond(unsafe { at(&self.fp.conds, i) }) {
+                return false;
+            }
+            i += 1;
+        }
+        true
     }
 
-    #[inline]
+    #[inline(always)]
     fn fast_cond(&self, c: &Cond) -> bool {
         let a = c.agent as usize;
         // SAFETY (`at`): a condition's agent is checked, and `slots`,
@@ -575,16 +610,15 @@ impl Engine {
             slot.event == c.event
                 && slot.run >= c.min_run
                 && (c.within == u64::MAX || unsafe { *at(&self.checked, a) }.saturating_sub(slot.time) <= c.within)
-                && self.fast_tests(c.tests)
+                && (c.tests.0 == c.tests.1 || self.fast_tests(c.tests))
         };
         pos != c.negative
     }
 
-    #[inline]
     fn fast_tests(&self, (s, e): (u32, u32)) -> bool {
-        (s as usize..e as usize).all(|i| {
+        for i in s as usize..e as usize {
             // SAFETY (`at`): tests and their places in the arena are checked.
-            match unsafe { *at(&self.fp.tests, i) } {
+            let pass = match unsafe { *at(&self.fp.tests, i) } {
                 Test::F64 { x, op, c } => match unsafe { *at(&self.payload, x as usize) } {
                     Value::F64(v) => float(op, v, c),
                     other => compare(op, other, Value::F64(c)),
@@ -600,8 +634,12 @@ impl Engine {
                         Check2::Range { lo, hi, inclusive } => in_range(x, self.arg(lo), self.arg(hi), inclusive),
                     }
                 }
+            };
+            if !pass {
+                return false;
             }
-        })
+        }
+        true
     }
 
     #[inline]
