@@ -79,6 +79,7 @@ impl Engine {
     /// to the initial state with no facts ([`reset`](Self::reset)) and
     /// true. `situ bench` and its stream generator call it after each event
     /// (after both rests), unless told not to.
+    #[inline]
     pub fn reset_if_final(&mut self) -> bool {
         let fin = self.net.final_state.get(self.state as usize).copied().unwrap_or(false);
         if fin {

@@ -497,12 +497,14 @@ impl Engine {
     /// [`rest`](Self::rest) on the fast path. The first search covers what
     /// changed since the last rest: every rule of the state if the engine
     /// was not at rest (`active` not empty), else the rules of `event`'s new
-    /// fact (`NONE`: none) and of the agents in `touched`.
+    /// fact (`NONE`: none) and of the agents in `touched`. With an event,
+    /// the engine was at rest before its fact was inserted (a rest came
+    /// first, or an error returned).
     #[inline(always)]
     pub(super) fn fast_rest(&mut self, event: u32) -> Result<(), PostError> {
         let mut best = Best { rule: NONE, group: 0, recency: u64::MAX };
         let st = self.state as usize;
-        if !self.active.is_empty() {
+        if event == NONE && !self.active.is_empty() {
             // SAFETY (`at`): the state is a state of the bundle.
             self.fast_best_in(unsafe { *at(&self.fp.by_state, st) }, &mut best);
             self.active.clear();

@@ -82,10 +82,14 @@ impl Engine {
         let facts0 = self.record.facts.len() as u32;
         for &a in &rule.matches {
             let slot = self.slots[a as usize];
-            let n = self.content.events.get(slot.event as usize).map_or(0, |e| e.fields.len());
+            let n = self.net.event.get(slot.event as usize).map_or(0, |e| (e.kinds.1 - e.kinds.0) as usize);
             let at = self.net.payload_at[a as usize] as usize;
             let v0 = self.record.values.len() as u32;
-            self.record.values.extend_from_slice(&self.payload[at..at + n]);
+            // One by one: the usual zero, one or two values without a call
+            // to `memcpy`.
+            for &v in &self.payload[at..at + n] {
+                self.record.values.push(v);
+            }
             let values = (v0, self.record.values.len() as u32);
             self.record.facts.push(FactRec { agent: a, event: slot.event, time: slot.time, run: slot.run, values });
         }

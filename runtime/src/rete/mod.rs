@@ -438,13 +438,17 @@ impl Engine {
         StateChange { from: r.from, to: self.state, time: self.now, firings }
     }
 
+    #[inline]
     fn begin(&mut self) {
         let r = &mut self.record;
         r.from = self.state;
-        r.firings.clear();
-        r.facts.clear();
-        r.values.clear();
-        r.stale.clear();
+        // Facts, values and stale agents are recorded with a firing only.
+        if !r.firings.is_empty() {
+            r.firings.clear();
+            r.facts.clear();
+            r.values.clear();
+            r.stale.clear();
+        }
     }
 
     /// Sets the state without firing rules (tests' `given`, hot swap).
