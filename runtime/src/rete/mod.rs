@@ -27,6 +27,14 @@
 //! state), fire the first by salience, specificity, recency, declaration
 //! order; set the state; repeat. More than [`Engine::cascade_limit`] firings
 //! for one event is a [`PostError::Cascade`].
+//!
+//! [`Engine::new`] runs this on the fast path (`fast.rs`): the same working
+//! memory, acceptance rule, expiry and recording, with each rule's
+//! conditions tested directly from candidate lists instead of through the
+//! network's memories. [`Engine::interpreted`] runs the network, the
+//! reference that `runtime-tests/tests/differential.rs` holds the fast path
+//! to; a bundle the fast path declines ([`Engine::fast_declined`]) runs on
+//! the network too.
 
 mod admit;
 mod eval;
