@@ -349,6 +349,7 @@ impl Engine {
     /// As [`post`](Self::post), without building the [`StateChange`]: no
     /// allocation once the engine has warmed up. [`last_change`](Self::last_change)
     /// gives the details of the latest step.
+    #[inline]
     pub fn step(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Step, PostError> {
         self.admit(event, time, payload)?;
         if self.fast {
