@@ -6,6 +6,9 @@
 //! settling's change — and leave the same working memory (state, now,
 //! each agent's fact, staleness and clock, the activated rules as a set).
 
+// Shared by test binaries that each use a part of it.
+#![allow(dead_code)]
+
 use proptest::prelude::*;
 use situ_compiler::bundle::{Content, Value};
 use situ_runtime::rete::{Engine, PostError};
