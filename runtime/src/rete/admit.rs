@@ -112,10 +112,17 @@ impl Engine {
                 _ => false,
             };
             if !fits {
-                let expected = self.content.events[event as usize].fields[i].ty.clone();
-                return Err(PostError::Type { event, field: i as u32, expected });
+                return Err(self.type_error(event, i));
             }
         }
         Ok(ev.agent)
+    }
+
+    /// The refusal of a field of the wrong type, out of the hot path.
+    #[cold]
+    #[inline(never)]
+    fn type_error(&self, event: u32, i: usize) -> PostError {
+        let expected = self.content.events[event as usize].fields[i].ty.clone();
+        PostError::Type { event, field: i as u32, expected }
     }
 }
