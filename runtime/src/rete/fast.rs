@@ -35,8 +35,9 @@
 //! them negated. Firings are recorded by the interpreter's own
 //! `record_firing`, so that steps, recorded firings and explanations are
 //! the same. A bundle is declined (the interpreter runs it) only if a state
-//! or staleness node carries join tests (the compiler writes none) or if
-//! its lists would exceed [`MAX_LIST_ENTRIES`].
+//! or staleness node carries join tests (the compiler writes none), if its
+//! lists would exceed [`MAX_LIST_ENTRIES`], or if an index of its network
+//! is out of range (`Program::check`; a validated bundle has none).
 //!
 //! Windows: the interpreter evaluates an event alpha node's window when its
 //! fact is inserted and when expiry refreshes it; in between, now may pass
