@@ -11,7 +11,7 @@
 
 use proptest::prelude::*;
 use situ_compiler::bundle::{Content, Value};
-use situ_runtime::rete::{Engine, PostError};
+use situ_runtime::rete::{Engine, StepError};
 use std::sync::Arc;
 
 /// An operation on an engine: every entry point that changes it.
@@ -41,8 +41,10 @@ fn apply(e: &mut Engine, op: &Op) -> String {
             // A refused event records nothing: `last_change` is then the
             // previous step's (and a copy's, `copy_from`, is not copied).
             match e.step(*ev, *t, p) {
-                step @ (Ok(_) | Err(PostError::Cascade { .. })) => format!("{step:?} {:?}", e.last_change()),
-                refused => format!("{refused:?}"),
+                step @ (Ok(_) | Err(StepError::Cascade { .. })) => {
+                    format!("{step:?} {:?} {:?}", e.last_change(), step.map_err(|x| e.post_error(x)))
+                }
+                Err(refused) => format!("{refused:?} {:?}", e.post_error(refused)),
             }
         }
         Op::Clock(c) => {

@@ -4,7 +4,7 @@
 //! arrived at — and the clocks it keeps for that.
 
 use super::net::Kind;
-use super::{Engine, PostError};
+use super::{Engine, PostError, StepError};
 use situ_bundle::Value;
 
 impl Engine {
@@ -60,16 +60,22 @@ impl Engine {
     ///
     /// NaN and the infinities are accepted: §10.3 says what they match.
     /// A refused event changes nothing, not even now.
-    #[inline(always)]
+    #[inline]
     pub fn admit(&self, event: u32, time: u64, payload: &[Value]) -> Result<(), PostError> {
+        self.admitted(event, time, payload).map_err(|e| self.post_error(e))
+    }
+
+    /// [`admit`](Self::admit), its refusal in short.
+    #[inline(always)]
+    pub(super) fn admitted(&self, event: u32, time: u64, payload: &[Value]) -> Result<(), StepError> {
         let agent = self.validated(event, payload)? as usize;
         let last = self.last[agent];
         if time < last {
-            return Err(PostError::OutOfOrder { event, time, last });
+            return Err(StepError::OutOfOrder { event, time, last });
         }
         if let Some(clock) = self.clock {
             if time > clock.saturating_add(self.max_skew) {
-                return Err(PostError::FromTheFuture { event, time, clock, max_skew: self.max_skew });
+                return Err(StepError::FromTheFuture { event, time, clock, max_skew: self.max_skew });
             }
         }
         Ok(())
@@ -91,19 +97,19 @@ impl Engine {
     /// Checks an event against the bundle's schema (a part of
     /// [`admit`](Self::admit), which also checks its time).
     pub fn validate(&self, event: u32, payload: &[Value]) -> Result<(), PostError> {
-        self.validated(event, payload).map(|_| ())
+        self.validated(event, payload).map(|_| ()).map_err(|e| self.post_error(e))
     }
 
     /// [`validate`](Self::validate), giving the event's agent.
     #[inline(always)]
-    fn validated(&self, event: u32, payload: &[Value]) -> Result<u32, PostError> {
+    fn validated(&self, event: u32, payload: &[Value]) -> Result<u32, StepError> {
         let Some(ev) = self.net.event.get(event as usize) else {
-            return Err(PostError::UnknownEvent { event });
+            return Err(StepError::UnknownEvent { event });
         };
         let (s, e) = ev.kinds;
         let kinds = &self.net.kinds[s as usize..e as usize];
         if kinds.len() != payload.len() {
-            return Err(PostError::Arity { event, expected: kinds.len(), found: payload.len() });
+            return Err(StepError::Arity { event, expected: kinds.len(), found: payload.len() });
         }
         for (i, (k, v)) in kinds.iter().zip(payload).enumerate() {
             let fits = match (k, v) {
@@ -112,17 +118,9 @@ impl Engine {
                 _ => false,
             };
             if !fits {
-                return Err(self.type_error(event, i));
+                return Err(StepError::Type { event, field: i as u32 });
             }
         }
         Ok(ev.agent)
-    }
-
-    /// The refusal of a field of the wrong type, out of the hot path.
-    #[cold]
-    #[inline(never)]
-    fn type_error(&self, event: u32, i: usize) -> PostError {
-        let expected = self.content.events[event as usize].fields[i].ty.clone();
-        PostError::Type { event, field: i as u32, expected }
     }
 }

@@ -49,7 +49,7 @@
 
 use super::eval::{compare, float, in_range};
 use super::net::{Net, NONE};
-use super::{copy_payload, Engine, PostError, Slot, Step, EMPTY};
+use super::{copy_payload, Engine, Slot, Step, StepError, EMPTY};
 use situ_bundle::{AlphaNode, BetaKind, Check, Cmp, Content, Operand, Value};
 
 /// The most entries the candidate lists of a bundle may take (u32 each):
@@ -421,7 +421,7 @@ fn operands(c: &Check) -> Vec<&Operand> {
 impl Engine {
     /// [`accepted`](Self::accepted) on the fast path.
     #[inline(always)]
-    pub(super) fn fast_accepted(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Step, PostError> {
+    pub(super) fn fast_accepted(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Step, StepError> {
         self.begin();
         if time > self.now {
             self.now = time;
@@ -502,7 +502,7 @@ impl Engine {
     /// the engine was at rest before its fact was inserted (a rest came
     /// first, or an error returned).
     #[inline(always)]
-    pub(super) fn fast_rest(&mut self, event: u32) -> Result<(), PostError> {
+    pub(super) fn fast_rest(&mut self, event: u32) -> Result<(), StepError> {
         let mut best = Best { rule: NONE, group: 0, recency: u64::MAX };
         let st = self.state as usize;
         if event == NONE && !self.active.is_empty() {
@@ -533,12 +533,11 @@ impl Engine {
     /// Fires `best`, then the rule that fires first in each new state,
     /// until none is activated; the bound counts the firings of the step.
     #[inline(never)]
-    fn fast_fire(&mut self, mut best: Best) -> Result<(), PostError> {
+    fn fast_fire(&mut self, mut best: Best) -> Result<(), StepError> {
         while best.rule != NONE {
             if self.record.firings.len() == self.cascade_limit {
                 self.fast_activate();
-                let firings = self.last_change().firings;
-                return Err(PostError::Cascade { limit: self.cascade_limit, firings });
+                return Err(StepError::Cascade { limit: self.cascade_limit });
             }
             self.state = self.record_firing(best.rule);
             best = Best { rule: NONE, group: 0, recency: u64::MAX };

@@ -3,7 +3,7 @@
 //! firing until no rule is activated, each firing recorded with the facts
 //! it matched (for explanations) in the buffers of the step.
 
-use super::{Engine, FactRec, FiringRec, PostError};
+use super::{Engine, FactRec, FiringRec, StepError};
 
 impl Engine {
     pub(super) fn set_state(&mut self, state: u32) {
@@ -59,12 +59,11 @@ impl Engine {
 
     /// Fires until no rule is activated; the bound counts the firings of
     /// the whole step.
-    pub(super) fn rest(&mut self) -> Result<(), PostError> {
+    pub(super) fn rest(&mut self) -> Result<(), StepError> {
         self.propagate();
         while let Some(r) = self.best() {
             if self.record.firings.len() == self.cascade_limit {
-                let firings = self.last_change().firings;
-                return Err(PostError::Cascade { limit: self.cascade_limit, firings });
+                return Err(StepError::Cascade { limit: self.cascade_limit });
             }
             let to = self.record_firing(r);
             self.set_state(to);

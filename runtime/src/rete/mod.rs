@@ -49,7 +49,9 @@ use situ_bundle::{Content, Value};
 use std::sync::Arc;
 
 pub use eval::{compare, in_range, passes, passes_with};
-pub use report::{describe_fact, format_time, show_value, FactView, Firing, MatchedFact, PostError, StateChange};
+pub use report::{
+    describe_fact, format_time, show_value, FactView, Firing, MatchedFact, PostError, StateChange, StepError,
+};
 
 /// The default bound of a cascade (§10.4).
 pub const CASCADE_LIMIT: usize = 64;
@@ -343,16 +345,17 @@ impl Engine {
     /// Processes one event: expiry, rest, the new fact, rest. Returns the
     /// firings, if any rule fired.
     pub fn post(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Option<StateChange>, PostError> {
-        let step = self.step(event, time, payload)?;
+        let step = self.step(event, time, payload).map_err(|e| self.post_error(e))?;
         Ok((step.firings > 0).then(|| self.last_change()))
     }
 
     /// As [`post`](Self::post), without building the [`StateChange`]: no
     /// allocation once the engine has warmed up. [`last_change`](Self::last_change)
-    /// gives the details of the latest step.
+    /// gives the details of the latest step, [`post_error`](Self::post_error)
+    /// those of an error.
     #[inline]
-    pub fn step(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Step, PostError> {
-        self.admit(event, time, payload)?;
+    pub fn step(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Step, StepError> {
+        self.admitted(event, time, payload)?;
         if self.fast {
             self.fast_accepted(event, time, payload)
         } else {
@@ -361,7 +364,7 @@ impl Engine {
     }
 
     /// Processes an event that [`admit`](Self::admit) accepted.
-    fn accepted(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Step, PostError> {
+    fn accepted(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Step, StepError> {
         self.begin();
         if time > self.now {
             self.now = time;
@@ -396,14 +399,14 @@ impl Engine {
                 self.fast_expire();
             }
             if !self.active.is_empty() || !self.touched.is_empty() {
-                self.fast_rest(NONE)?;
+                self.fast_rest(NONE).map_err(|e| self.post_error(e))?;
             }
         } else {
             if self.now > self.next_deadline {
                 self.expire();
             }
             if !self.at_rest() {
-                self.rest()?;
+                self.rest().map_err(|e| self.post_error(e))?;
             }
         }
         Ok((!self.record.firings.is_empty()).then(|| self.last_change()))
@@ -414,11 +417,30 @@ impl Engine {
     pub fn settle(&mut self) -> Result<Option<StateChange>, PostError> {
         self.begin();
         if self.fast {
-            self.fast_rest(NONE)?;
+            self.fast_rest(NONE).map_err(|e| self.post_error(e))?;
         } else {
-            self.rest()?;
+            self.rest().map_err(|e| self.post_error(e))?;
         }
         Ok((!self.record.firings.is_empty()).then(|| self.last_change()))
+    }
+
+    /// The details of an error of the latest step: a field's type, a
+    /// cascade's firings (those recorded by the step).
+    #[cold]
+    pub fn post_error(&self, e: StepError) -> PostError {
+        match e {
+            StepError::UnknownEvent { event } => PostError::UnknownEvent { event },
+            StepError::Arity { event, expected, found } => PostError::Arity { event, expected, found },
+            StepError::Type { event, field } => {
+                let expected = self.content.events[event as usize].fields[field as usize].ty.clone();
+                PostError::Type { event, field, expected }
+            }
+            StepError::OutOfOrder { event, time, last } => PostError::OutOfOrder { event, time, last },
+            StepError::FromTheFuture { event, time, clock, max_skew } => {
+                PostError::FromTheFuture { event, time, clock, max_skew }
+            }
+            StepError::Cascade { limit } => PostError::Cascade { limit, firings: self.last_change().firings },
+        }
     }
 
     /// What the latest step fired, with the facts that made each rule hold.
