@@ -461,8 +461,12 @@ impl Engine {
             *at_mut(&mut self.stale, a) = false;
             *at_mut(&mut self.checked, a) = self.now;
         }
-        copy_payload(&mut self.payload[ev.payload_at as usize..], payload);
-        let stale_at = if ev.stale_after == u64::MAX { u64::MAX } else { time.saturating_add(ev.stale_after) };
+        // SAFETY: the event's place and its fields fit in the arena
+        // (`Program::check`), and `payload` has as many values as it has
+        // fields (the payload check).
+        copy_payload(unsafe { self.payload.get_unchecked_mut(ev.payload_at as usize..) }, payload);
+        // `u64::MAX` (never) stays `u64::MAX`.
+        let stale_at = time.saturating_add(ev.stale_after);
         let window_at = if ev.windows.0 == ev.windows.1 { u64::MAX } else { self.next_window(ev.windows, time) };
         unsafe {
             *at_mut(&mut self.stale_at, a) = stale_at;
