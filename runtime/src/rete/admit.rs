@@ -21,14 +21,14 @@ impl Engine {
     /// The stamp of the agent's latest accepted event (0 before its first):
     /// an event of the agent stamped earlier is refused.
     pub fn agent_time(&self, agent: u32) -> u64 {
-        self.last.get(agent as usize).copied().unwrap_or(0)
+        self.agents.get(agent as usize).map_or(0, |r| r.last)
     }
 
     /// Moves the agent's clock forward to `time` (a carried-over clock, at
     /// hot swap): its events stamped earlier are refused from then on.
     pub fn advance_agent_time(&mut self, agent: u32, time: u64) {
-        if let Some(t) = self.last.get_mut(agent as usize) {
-            *t = (*t).max(time);
+        if let Some(r) = self.agents.get_mut(agent as usize) {
+            r.last = r.last.max(time);
         }
     }
 
@@ -69,7 +69,7 @@ impl Engine {
     #[inline(always)]
     pub(super) fn admitted(&self, event: u32, time: u64, payload: &[Value]) -> Result<(), StepError> {
         let agent = self.validated(event, payload)? as usize;
-        let last = self.last[agent];
+        let last = self.agents[agent].last;
         if time < last {
             return Err(StepError::OutOfOrder { event, time, last });
         }

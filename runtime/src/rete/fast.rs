@@ -49,7 +49,7 @@
 
 use super::eval::{compare, float, in_range};
 use super::net::{Net, NONE};
-use super::{copy_payload, Engine, Slot, Step, StepError, EMPTY};
+use super::{copy_payload, AgentRec, Engine, Slot, Step, StepError, AGENT};
 use situ_bundle::{AlphaNode, BetaKind, Check, Cmp, Content, Operand, Value};
 
 /// The most entries the candidate lists of a bundle may take (u32 each):
@@ -150,8 +150,8 @@ pub(super) fn bit(event: u32) -> u64 {
 /// `i < v.len()`. Every index this module takes from the program (lists,
 /// rules, conditions, tests, agents, places in the arena) is checked once
 /// by [`Program::check`] when the program is built, against the engine's
-/// tables, whose lengths never change after construction (`slots`,
-/// `stale`, `checked`: one per agent; `payload`: the arena's length); the
+/// tables, whose lengths never change after construction
+/// `agents`: one per agent; `payload`: the arena's length); the
 /// state is always a state of the bundle and the event of a step one the
 /// payload check took.
 #[inline(always)]
@@ -450,28 +450,25 @@ impl Engine {
         // indexed by agent have one entry per agent.
         let ev = unsafe { *at(&self.net.event, event as usize) };
         let a = ev.agent as usize;
-        let old = unsafe { *at(&self.slots, a) };
+        // `u64::MAX` (never) stays `u64::MAX`.
+        let stale_at = time.saturating_add(ev.stale_after);
+        let window_at = if ev.windows.0 == ev.windows.1 { u64::MAX } else { self.next_window(ev.windows, time) };
         self.seq += 1;
+        let (seq, now) = (self.seq, self.now);
+        let r = unsafe { at_mut(&mut self.agents, a) };
+        let old = r.slot;
         let run = if old.event == event { old.run + 1 } else { 1 };
+        r.slot = Slot { event, time, run, seq };
+        r.last = r.last.max(time);
+        r.stale = false;
+        r.checked = now;
+        r.stale_at = stale_at;
+        r.window_at = window_at;
         self.have = (self.have & !bit(old.event)) | bit(event);
-        unsafe {
-            *at_mut(&mut self.slots, a) = Slot { event, time, run, seq: self.seq };
-            let last = at_mut(&mut self.last, a);
-            *last = (*last).max(time);
-            *at_mut(&mut self.stale, a) = false;
-            *at_mut(&mut self.checked, a) = self.now;
-        }
         // SAFETY: the event's place and its fields fit in the arena
         // (`Program::check`), and `payload` has as many values as it has
         // fields (the payload check).
         copy_payload(unsafe { self.payload.get_unchecked_mut(ev.payload_at as usize..) }, payload);
-        // `u64::MAX` (never) stays `u64::MAX`.
-        let stale_at = time.saturating_add(ev.stale_after);
-        let window_at = if ev.windows.0 == ev.windows.1 { u64::MAX } else { self.next_window(ev.windows, time) };
-        unsafe {
-            *at_mut(&mut self.stale_at, a) = stale_at;
-            *at_mut(&mut self.window_at, a) = window_at;
-        }
         self.next_deadline = self.next_deadline.min(stale_at).min(window_at);
     }
 
@@ -481,20 +478,18 @@ impl Engine {
         let mut next = u64::MAX;
         for i in 0..self.net.timed_agents.len() {
             let a = self.net.timed_agents[i] as usize;
-            if self.stale_at[a] < self.now {
-                self.have &= !bit(self.slots[a].event);
-                self.slots[a] = EMPTY;
-                self.stale[a] = true;
-                self.stale_at[a] = u64::MAX;
-                self.window_at[a] = u64::MAX;
+            let r = self.agents[a];
+            if r.stale_at < self.now {
+                self.have &= !bit(r.slot.event);
+                self.agents[a] = AgentRec { last: r.last, checked: r.checked, stale: true, ..AGENT };
                 self.touched.push(a as u32);
-            } else if self.window_at[a] < self.now {
-                self.checked[a] = self.now;
-                let slot = self.slots[a];
-                self.window_at[a] = self.next_window(self.net.event[slot.event as usize].windows, slot.time);
+            } else if r.window_at < self.now {
+                let window_at = self.next_window(self.net.event[r.slot.event as usize].windows, r.slot.time);
+                self.agents[a].checked = self.now;
+                self.agents[a].window_at = window_at;
                 self.touched.push(a as u32);
             }
-            next = next.min(self.stale_at[a]).min(self.window_at[a]);
+            next = next.min(self.agents[a].stale_at).min(self.agents[a].window_at);
         }
         self.next_deadline = next;
     }
@@ -587,7 +582,7 @@ impl Engine {
 
     fn fast_recency(&self, rule: &Rule) -> u64 {
         let (s, e) = rule.matches;
-        self.fp.agents[s as usize..e as usize].iter().map(|&a| self.slots[a as usize].seq).max().unwrap_or(0)
+        self.fp.agents[s as usize..e as usize].iter().map(|&a| self.agents[a as usize].slot.seq).max().unwrap_or(0)
     }
 
     /// Whether the rule's conditions hold (its state guard is its lists').
@@ -607,15 +602,16 @@ impl Engine {
     #[inline(always)]
     fn fast_cond(&self, c: &Cond) -> bool {
         let a = c.agent as usize;
-        // SAFETY (`at`): a condition's agent is checked, and `slots`,
-        // `stale`, `checked` have one entry per agent.
+        // SAFETY (`at`): a condition's agent is checked, and `agents` has
+        // one record per agent.
+        let r = unsafe { at(&self.agents, a) };
         let pos = if c.event == STALE {
-            unsafe { *at(&self.stale, a) }
+            r.stale
         } else {
-            let slot = unsafe { at(&self.slots, a) };
+            let slot = &r.slot;
             slot.event == c.event
                 && slot.run >= c.min_run
-                && (c.within == u64::MAX || unsafe { *at(&self.checked, a) }.saturating_sub(slot.time) <= c.within)
+                && (c.within == u64::MAX || r.checked.saturating_sub(slot.time) <= c.within)
                 && (c.tests.0 == c.tests.1 || self.fast_tests(c.tests))
         };
         pos != c.negative
@@ -660,7 +656,7 @@ impl Engine {
     /// Out of rest: the activated rules, whole, into `active` (in
     /// declaration order), which the next rest starts from.
     pub(super) fn fast_activate(&mut self) {
-        debug_assert!(self.slots.len() == self.fp.na && self.checked.len() == self.fp.na);
+        debug_assert!(self.agents.len() == self.fp.na);
         let mut active = std::mem::take(&mut self.active);
         active.clear();
         let (s, e) = self.fp.by_state[self.state as usize];

@@ -35,7 +35,7 @@ impl Engine {
             let (s, e) = rule.matches;
             let recency = self.net.rule_agents[s as usize..e as usize]
                 .iter()
-                .map(|&a| self.slots[a as usize].seq)
+                .map(|&a| self.agents[a as usize].slot.seq)
                 .max()
                 .unwrap_or(0);
             let key = (rule.salience, rule.specificity, recency);
@@ -80,7 +80,7 @@ impl Engine {
         let to = rule.target;
         let facts0 = self.record.facts.len() as u32;
         for &a in &rule.matches {
-            let slot = self.slots[a as usize];
+            let slot = self.agents[a as usize].slot;
             let n = self.net.event.get(slot.event as usize).map_or(0, |e| (e.kinds.1 - e.kinds.0) as usize);
             let at = self.net.payload_at[a as usize] as usize;
             let v0 = self.record.values.len() as u32;
@@ -94,7 +94,7 @@ impl Engine {
         }
         let stale0 = self.record.stale.len() as u32;
         for &a in &rule.stale {
-            if self.stale[a as usize] {
+            if self.agents[a as usize].stale {
                 self.record.stale.push(a);
             }
         }

@@ -78,6 +78,26 @@ struct Slot {
 
 const EMPTY: Slot = Slot { event: NONE, time: 0, run: 0, seq: 0 };
 
+/// An agent's part of the working memory, in one record (one address for
+/// the insert and the conditions instead of one per table).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct AgentRec {
+    slot: Slot,
+    /// Timers: the time its fact expires and the next window that closes
+    /// (`u64::MAX`: none).
+    stale_at: u64,
+    window_at: u64,
+    /// The fast path's now of its fact's last evaluation (`fast.rs`).
+    checked: u64,
+    /// The stamp of its latest accepted event (kept by a reset: an agent's
+    /// clock does not go back with a new mission).
+    last: u64,
+    stale: bool,
+}
+
+const AGENT: AgentRec =
+    AgentRec { slot: EMPTY, stale_at: u64::MAX, window_at: u64::MAX, checked: 0, last: 0, stale: false };
+
 /// The Rete network of a bundle with its working memory.
 #[derive(Debug, Clone)]
 pub struct Engine {
@@ -85,22 +105,16 @@ pub struct Engine {
     net: Net,
     // Working memory.
     state: u32,
-    slots: Vec<Slot>,
+    /// Per agent: its fact, staleness, clock and timers, in one record.
+    agents: Vec<AgentRec>,
     payload: Vec<Value>,
-    stale: Vec<bool>,
     now: u64,
     seq: u64,
-    /// Per agent, the stamp of its latest accepted event (kept by a reset:
-    /// an agent's clock does not go back with a new mission).
-    last: Vec<u64>,
     max_skew: u64,
     /// The Bulletinboard's clock the next events arrive at (`None`: at
     /// their stamps).
     clock: Option<u64>,
-    // Timers: per agent the time its fact expires and the next window that
-    // closes (u64::MAX: none); the earliest of all, possibly too early.
-    stale_at: Vec<u64>,
-    window_at: Vec<u64>,
+    /// The earliest of the agents' timers, possibly too early.
     next_deadline: u64,
     // Network memories.
     alpha_mem: Vec<bool>,
@@ -117,11 +131,10 @@ pub struct Engine {
     /// [`reset`](Self::reset) restores.
     initial: Arc<Memories>,
     // The fast path (`fast.rs`): whether it runs, its program (empty when
-    // it does not), per agent the now of its fact's last evaluation, and
-    // the agents whose fact expiry changed since the last rest.
+    // it does not), and the agents whose fact expiry changed since the
+    // last rest.
     fast: bool,
     fp: Arc<fast::Program>,
-    checked: Vec<u64>,
     touched: Vec<u32>,
     declined: Option<&'static str>,
     /// The events (below 64) that are an agent's fact now, as bits
@@ -178,16 +191,12 @@ impl Engine {
         let nb = net.beta.len();
         let mut e = Engine {
             state: content.initial,
-            slots: vec![EMPTY; na],
+            agents: vec![AGENT; na],
             payload: vec![Value::Bool(false); net.payload_len],
-            stale: vec![false; na],
             now: 0,
             seq: 0,
-            last: vec![0; na],
             max_skew: DEFAULT_MAX_SKEW,
             clock: None,
-            stale_at: vec![u64::MAX; na],
-            window_at: vec![u64::MAX; na],
             next_deadline: u64::MAX,
             alpha_mem: vec![false; net.alpha.len()],
             beta_tok: vec![false; nb],
@@ -201,7 +210,6 @@ impl Engine {
             initial: Arc::default(),
             fast: fp.is_some(),
             fp: Arc::new(fp.unwrap_or_default()),
-            checked: vec![0; na],
             touched: Vec::with_capacity(na),
             declined,
             have: 0,
@@ -246,14 +254,14 @@ impl Engine {
 
     /// An agent's live fact: event, payload, time, run length.
     pub fn fact(&self, agent: u32) -> Option<MatchedFact> {
-        let slot = self.slots.get(agent as usize)?;
+        let slot = &self.agents.get(agent as usize)?.slot;
         (slot.event != NONE).then(|| self.snapshot(agent))
     }
 
     /// An agent's live fact without copying it: event, payload, time, run
     /// length and posting sequence number (recency).
     pub fn fact_view(&self, agent: u32) -> Option<FactView<'_>> {
-        let slot = self.slots.get(agent as usize)?;
+        let slot = &self.agents.get(agent as usize)?.slot;
         if slot.event == NONE {
             return None;
         }
@@ -277,16 +285,12 @@ impl Engine {
             return;
         }
         self.state = other.state;
-        self.slots.clone_from(&other.slots);
+        self.agents.clone_from(&other.agents);
         self.payload.clone_from(&other.payload);
-        self.stale.clone_from(&other.stale);
         self.now = other.now;
         self.seq = other.seq;
-        self.last.clone_from(&other.last);
         self.max_skew = other.max_skew;
         self.clock = other.clock;
-        self.stale_at.clone_from(&other.stale_at);
-        self.window_at.clone_from(&other.window_at);
         self.next_deadline = other.next_deadline;
         self.alpha_mem.clone_from(&other.alpha_mem);
         self.beta_tok.clone_from(&other.beta_tok);
@@ -296,14 +300,13 @@ impl Engine {
         self.active.clone_from(&other.active);
         self.active_pos.clone_from(&other.active_pos);
         self.cascade_limit = other.cascade_limit;
-        self.checked.clone_from(&other.checked);
         self.touched.clone_from(&other.touched);
         self.have = other.have;
     }
 
     /// Whether the agent's fact has expired.
     pub fn is_stale(&self, agent: u32) -> bool {
-        self.stale.get(agent as usize).copied().unwrap_or(false)
+        self.agents.get(agent as usize).is_some_and(|r| r.stale)
     }
 
     /// The rules activated now (at rest: none), in no particular order
@@ -319,10 +322,10 @@ impl Engine {
     /// copied back from the engine's construction, not propagated (no
     /// allocation: the buffers keep their capacity).
     pub fn reset(&mut self) {
-        self.slots.fill(EMPTY);
-        self.stale.fill(false);
-        self.stale_at.fill(u64::MAX);
-        self.window_at.fill(u64::MAX);
+        for r in &mut self.agents {
+            // The agent's clock and the now of its last evaluation are kept.
+            *r = AgentRec { last: r.last, checked: r.checked, ..AGENT };
+        }
         self.next_deadline = u64::MAX;
         self.state = self.content.initial;
         let m = &*self.initial;
@@ -504,13 +507,13 @@ impl Engine {
         if self.fast {
             self.fast_insert(event, time, payload);
             let agent = self.content.events[event as usize].agent as usize;
-            self.slots[agent].run = run.max(1);
+            self.agents[agent].slot.run = run.max(1);
             self.fast_activate();
             return Ok(());
         }
         self.insert(event, time, payload);
         let agent = self.content.events[event as usize].agent as usize;
-        self.slots[agent].run = run.max(1);
+        self.agents[agent].slot.run = run.max(1);
         self.refresh_alpha(agent as u32);
         self.propagate();
         Ok(())
@@ -524,26 +527,26 @@ impl Engine {
     /// Marks an agent stale without firing rules (its fact, if any, is gone).
     pub fn force_stale(&mut self, agent: u32) {
         let a = agent as usize;
-        if a >= self.slots.len() {
+        if a >= self.agents.len() {
             return;
         }
         if self.fast {
-            self.have &= !fast::bit(self.slots[a].event);
-            self.slots[a] = EMPTY;
-            self.stale[a] = true;
-            self.stale_at[a] = u64::MAX;
-            self.window_at[a] = u64::MAX;
+            self.have &= !fast::bit(self.agents[a].slot.event);
+            self.agents[a].slot = EMPTY;
+            self.agents[a].stale = true;
+            self.agents[a].stale_at = u64::MAX;
+            self.agents[a].window_at = u64::MAX;
             self.fast_activate();
             return;
         }
-        let old = self.slots[a].event;
+        let old = self.agents[a].slot.event;
         if old != NONE {
             self.clear_event_alpha(old);
         }
-        self.slots[a] = EMPTY;
-        self.stale[a] = true;
-        self.stale_at[a] = u64::MAX;
-        self.window_at[a] = u64::MAX;
+        self.agents[a].slot = EMPTY;
+        self.agents[a].stale = true;
+        self.agents[a].stale_at = u64::MAX;
+        self.agents[a].window_at = u64::MAX;
         self.set_stale_alpha(agent, true);
         self.propagate();
     }
@@ -551,7 +554,7 @@ impl Engine {
     // ─── Working memory ────────────────────────────────────────────────
 
     fn snapshot(&self, agent: u32) -> MatchedFact {
-        let slot = self.slots[agent as usize];
+        let slot = self.agents[agent as usize].slot;
         let n = self.content.events.get(slot.event as usize).map_or(0, |e| e.fields.len());
         let at = self.net.payload_at[agent as usize] as usize;
         MatchedFact {
@@ -569,14 +572,14 @@ impl Engine {
         let ev = self.net.event[event as usize];
         let agent = ev.agent;
         let a = agent as usize;
-        let old = self.slots[a];
+        let old = self.agents[a].slot;
         self.seq += 1;
         let run = if old.event == event { old.run + 1 } else { 1 };
-        self.slots[a] = Slot { event, time, run, seq: self.seq };
-        self.last[a] = self.last[a].max(time);
+        self.agents[a].slot = Slot { event, time, run, seq: self.seq };
+        self.agents[a].last = self.agents[a].last.max(time);
         copy_payload(&mut self.payload[ev.payload_at as usize..], payload);
-        if self.stale[a] {
-            self.stale[a] = false;
+        if self.agents[a].stale {
+            self.agents[a].stale = false;
             self.set_stale_alpha(agent, false);
         }
         if old.event != NONE && old.event != event {
@@ -586,8 +589,8 @@ impl Engine {
         // Timers.
         let stale_at = if ev.stale_after == u64::MAX { u64::MAX } else { time.saturating_add(ev.stale_after) };
         let window_at = self.next_window(ev.windows, time);
-        self.stale_at[a] = stale_at;
-        self.window_at[a] = window_at;
+        self.agents[a].stale_at = stale_at;
+        self.agents[a].window_at = window_at;
         self.next_deadline = self.next_deadline.min(stale_at).min(window_at);
     }
 
@@ -612,21 +615,21 @@ impl Engine {
         let mut next = u64::MAX;
         for i in 0..self.net.timed_agents.len() {
             let a = self.net.timed_agents[i] as usize;
-            if self.stale_at[a] < self.now {
+            if self.agents[a].stale_at < self.now {
                 // `now - t > stale after`: the fact expires.
-                let old = self.slots[a].event;
-                self.slots[a] = EMPTY;
+                let old = self.agents[a].slot.event;
+                self.agents[a].slot = EMPTY;
                 self.clear_event_alpha(old);
-                self.stale[a] = true;
+                self.agents[a].stale = true;
                 self.set_stale_alpha(a as u32, true);
-                self.stale_at[a] = u64::MAX;
-                self.window_at[a] = u64::MAX;
-            } else if self.window_at[a] < self.now {
+                self.agents[a].stale_at = u64::MAX;
+                self.agents[a].window_at = u64::MAX;
+            } else if self.agents[a].window_at < self.now {
                 self.refresh_alpha(a as u32);
-                let slot = self.slots[a];
-                self.window_at[a] = self.next_window(self.net.event[slot.event as usize].windows, slot.time);
+                let slot = self.agents[a].slot;
+                self.agents[a].window_at = self.next_window(self.net.event[slot.event as usize].windows, slot.time);
             }
-            next = next.min(self.stale_at[a]).min(self.window_at[a]);
+            next = next.min(self.agents[a].stale_at).min(self.agents[a].window_at);
         }
         self.next_deadline = next;
     }

@@ -41,7 +41,7 @@ impl Engine {
     /// Re-evaluates the alpha nodes of an agent's current event (windows,
     /// forced run lengths); marks successors only where the result changes.
     pub(super) fn refresh_alpha(&mut self, agent: u32) {
-        let event = self.slots[agent as usize].event;
+        let event = self.agents[agent as usize].slot.event;
         if event == NONE {
             return;
         }
@@ -68,7 +68,7 @@ impl Engine {
         let node = &self.net.alpha[a];
         match node.kind {
             AlphaKind::State => self.net.state_in(node, self.state),
-            AlphaKind::Stale => self.stale[node.agent as usize],
+            AlphaKind::Stale => self.agents[node.agent as usize].stale,
             AlphaKind::Event => self.event_alpha_passes(node),
         }
     }
@@ -77,7 +77,7 @@ impl Engine {
     /// length, the window, the payload tests.
     #[inline]
     pub(super) fn event_alpha_passes(&self, node: &net::AlphaRt) -> bool {
-        let slot = &self.slots[node.agent as usize];
+        let slot = &self.agents[node.agent as usize].slot;
         if slot.event != node.key || slot.run < node.min_run {
             return false;
         }
