@@ -106,12 +106,16 @@ impl Engine {
         let Some(ev) = self.net.event.get(event as usize) else {
             return Err(StepError::UnknownEvent { event });
         };
-        let (s, e) = ev.kinds;
-        let kinds = &self.net.kinds[s as usize..e as usize];
-        if kinds.len() != payload.len() {
-            return Err(StepError::Arity { event, expected: kinds.len(), found: payload.len() });
+        let (s, e) = (ev.kinds.0 as usize, ev.kinds.1 as usize);
+        let n = e.wrapping_sub(s);
+        if n != payload.len() {
+            return Err(StepError::Arity { event, expected: n, found: payload.len() });
         }
-        for (i, (k, v)) in kinds.iter().zip(payload).enumerate() {
+        let mut i = 0;
+        while i < n {
+            // SAFETY: `Net::new` builds each event's range of kinds inside
+            // `kinds` (`s <= e <= kinds.len()`), and `payload` has `n` values.
+            let (k, v) = unsafe { (*self.net.kinds.get_unchecked(s + i), *payload.get_unchecked(i)) };
             let fits = match (k, v) {
                 (Kind::F64, Value::F64(_)) | (Kind::I64, Value::I64(_)) | (Kind::Bool, Value::Bool(_)) => true,
                 (Kind::Symbol(n), Value::Symbol(x)) => x < n,
@@ -120,6 +124,7 @@ impl Engine {
             if !fits {
                 return Err(StepError::Type { event, field: i as u32 });
             }
+            i += 1;
         }
         Ok(ev.agent)
     }

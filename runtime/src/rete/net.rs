@@ -81,7 +81,8 @@ pub struct EventRt {
     pub agent: u32,
     /// Its agent's payload offset.
     pub payload_at: u32,
-    /// Its fields' kinds, in `kinds`.
+    /// Its fields' kinds, in `kinds` (always inside it: `Net::new`
+    /// builds them so, and the payload check reads them unchecked).
     pub kinds: (u32, u32),
     /// Its alpha nodes, in `event_alpha`.
     pub alpha: (u32, u32),
