@@ -464,7 +464,7 @@ impl Engine {
         r.checked = now;
         r.stale_at = stale_at;
         r.window_at = window_at;
-        self.have = (self.have & !bit(old.event)) | bit(event);
+        self.have = (self.have & !bit(old.event)) | ev.bit;
         // SAFETY: the event's place and its fields fit in the arena
         // (`Program::check`), and `payload` has as many values as it has
         // fields (the payload check).

@@ -90,6 +90,8 @@ pub struct EventRt {
     pub windows: (u32, u32),
     /// Its agent's `stale after`, ns (`u64::MAX`: never).
     pub stale_after: u64,
+    /// Its bit in the fast path's `Engine::have` (`fast::bit`).
+    pub bit: u64,
 }
 
 #[derive(Debug, Clone)]
@@ -359,6 +361,7 @@ impl Net {
                     alpha: event_alpha_at[e],
                     windows: event_windows_at[e],
                     stale_after: stale_after[agent as usize],
+                    bit: super::fast::bit(e as u32),
                 }
             })
             .collect();
