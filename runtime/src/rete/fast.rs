@@ -367,6 +367,7 @@ impl Program {
         let payload_len = net.payload_len;
         // The events' agents, their places and windows (`fast_insert`).
         let events = net.event.len() == self.ne
+            && net.timed_agents.iter().all(|&a| (a as usize) < self.na)
             && net.event.iter().all(|e| {
                 (e.agent as usize) < self.na
                     && e.payload_at as usize + (e.kinds.1 - e.kinds.0) as usize <= payload_len
@@ -459,12 +460,13 @@ impl Engine {
         let old = r.slot;
         let run = if old.event == event { old.run + 1 } else { 1 };
         r.slot = Slot { event, time, run, seq };
+        let old_bit = std::mem::replace(&mut r.bit, ev.bit);
         r.last = r.last.max(time);
         r.stale = false;
         r.checked = now;
         r.stale_at = stale_at;
         r.window_at = window_at;
-        self.have = (self.have & !bit(old.event)) | ev.bit;
+        self.have = (self.have & !old_bit) | ev.bit;
         // SAFETY: the event's place and its fields fit in the arena
         // (`Program::check`), and `payload` has as many values as it has
         // fields (the payload check).
@@ -475,21 +477,26 @@ impl Engine {
     /// [`expire`](Self::expire) without the network: the agents whose fact
     /// expired or whose window closed are noted in `touched`.
     pub(super) fn fast_expire(&mut self) {
-        let mut next = u64::MAX;
+        let (now, mut next) = (self.now, u64::MAX);
         for i in 0..self.net.timed_agents.len() {
-            let a = self.net.timed_agents[i] as usize;
-            let r = self.agents[a];
-            if r.stale_at < self.now {
-                self.have &= !bit(r.slot.event);
-                self.agents[a] = AgentRec { last: r.last, checked: r.checked, stale: true, ..AGENT };
+            // SAFETY (`at`, `at_mut`): the timed agents are agents
+            // (`Program::check`), `agents` has one record per agent.
+            let a = unsafe { *at(&self.net.timed_agents, i) } as usize;
+            let r = unsafe { at_mut(&mut self.agents, a) };
+            if r.stale_at < now {
+                self.have &= !r.bit;
+                *r = AgentRec { last: r.last, checked: r.checked, stale: true, ..AGENT };
                 self.touched.push(a as u32);
-            } else if r.window_at < self.now {
-                let window_at = self.next_window(self.net.event[r.slot.event as usize].windows, r.slot.time);
-                self.agents[a].checked = self.now;
-                self.agents[a].window_at = window_at;
+            } else if r.window_at < now {
+                let slot = r.slot;
+                let window_at = self.next_window(self.net.event[slot.event as usize].windows, slot.time);
+                let r = unsafe { at_mut(&mut self.agents, a) };
+                r.checked = now;
+                r.window_at = window_at;
                 self.touched.push(a as u32);
             }
-            next = next.min(self.agents[a].stale_at).min(self.agents[a].window_at);
+            let r = unsafe { at(&self.agents, a) };
+            next = next.min(r.stale_at).min(r.window_at);
         }
         self.next_deadline = next;
     }

@@ -83,6 +83,8 @@ const EMPTY: Slot = Slot { event: NONE, time: 0, run: 0, seq: 0 };
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 struct AgentRec {
     slot: Slot,
+    /// `fast::bit(slot.event)`: its fact's bit of `Engine::have`.
+    bit: u64,
     /// Timers: the time its fact expires and the next window that closes
     /// (`u64::MAX`: none).
     stale_at: u64,
@@ -96,7 +98,7 @@ struct AgentRec {
 }
 
 const AGENT: AgentRec =
-    AgentRec { slot: EMPTY, stale_at: u64::MAX, window_at: u64::MAX, checked: 0, last: 0, stale: false };
+    AgentRec { slot: EMPTY, bit: 0, stale_at: u64::MAX, window_at: u64::MAX, checked: 0, last: 0, stale: false };
 
 /// The Rete network of a bundle with its working memory.
 #[derive(Debug, Clone)]
@@ -533,6 +535,7 @@ impl Engine {
         if self.fast {
             self.have &= !fast::bit(self.agents[a].slot.event);
             self.agents[a].slot = EMPTY;
+            self.agents[a].bit = 0;
             self.agents[a].stale = true;
             self.agents[a].stale_at = u64::MAX;
             self.agents[a].window_at = u64::MAX;
@@ -544,6 +547,7 @@ impl Engine {
             self.clear_event_alpha(old);
         }
         self.agents[a].slot = EMPTY;
+        self.agents[a].bit = 0;
         self.agents[a].stale = true;
         self.agents[a].stale_at = u64::MAX;
         self.agents[a].window_at = u64::MAX;
@@ -576,6 +580,7 @@ impl Engine {
         self.seq += 1;
         let run = if old.event == event { old.run + 1 } else { 1 };
         self.agents[a].slot = Slot { event, time, run, seq: self.seq };
+        self.agents[a].bit = ev.bit;
         self.agents[a].last = self.agents[a].last.max(time);
         copy_payload(&mut self.payload[ev.payload_at as usize..], payload);
         if self.agents[a].stale {
@@ -619,6 +624,7 @@ impl Engine {
                 // `now - t > stale after`: the fact expires.
                 let old = self.agents[a].slot.event;
                 self.agents[a].slot = EMPTY;
+                self.agents[a].bit = 0;
                 self.clear_event_alpha(old);
                 self.agents[a].stale = true;
                 self.set_stale_alpha(a as u32, true);
