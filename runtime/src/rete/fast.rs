@@ -430,7 +430,8 @@ impl Engine {
         if self.now > self.next_deadline {
             self.fast_expire();
         }
-        if !self.active.is_empty() || !self.touched.is_empty() {
+        // Not at rest, or facts expired: one test for both.
+        if (self.active.len() | self.touched.len()) != 0 {
             self.fast_rest(NONE)?;
         }
         self.fast_insert(event, time, payload);
