@@ -69,7 +69,10 @@ impl Engine {
     #[inline(always)]
     pub(super) fn admitted(&self, event: u32, time: u64, payload: &[Value]) -> Result<(), StepError> {
         let agent = self.validated(event, payload)? as usize;
-        let last = self.agents[agent].last;
+        // SAFETY: an event's agent is an agent: `Net::new` reads each
+        // event's agent's `stale after` from a table of one entry per
+        // agent, and `agents` has one record per agent.
+        let last = unsafe { self.agents.get_unchecked(agent) }.last;
         if time < last {
             return Err(StepError::OutOfOrder { event, time, last });
         }
