@@ -90,7 +90,11 @@ impl Engine {
     /// (after both rests), unless told not to.
     #[inline]
     pub fn reset_if_final(&mut self) -> bool {
-        let fin = self.net.final_state.get(self.state as usize).copied().unwrap_or(false);
+        debug_assert!((self.state as usize) < self.net.final_state.len());
+        // SAFETY: `Net::new` gives `final_state` an entry for every state
+        // the engine can be in: the initial one, a rule's target, one
+        // `force_state` checked.
+        let fin = unsafe { *self.net.final_state.get_unchecked(self.state as usize) };
         if fin {
             self.reset();
         }

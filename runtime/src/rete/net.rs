@@ -138,7 +138,8 @@ pub struct Net {
     pub kinds: Vec<Kind>,
     /// Per event, what a step needs of it (the tables above, gathered).
     pub event: Vec<EventRt>,
-    /// Per state: whether it is final.
+    /// Per state: whether it is final (and `false` for any other state a
+    /// bundle that was not validated names: see `Net::new`).
     pub final_state: Vec<bool>,
 }
 
@@ -365,7 +366,15 @@ impl Net {
                 }
             })
             .collect();
-        let final_state = c.states.iter().map(|s| s.is_final).collect();
+        let mut final_state: Vec<bool> = c.states.iter().map(|s| s.is_final).collect();
+        // An entry for every state the engine can be in (the initial one,
+        // a rule's target, one `force_state` checked), which
+        // `reset_if_final` reads unchecked: a bundle that was not validated
+        // may name others, which are not final.
+        let top = c.rules.iter().map(|r| r.target).chain([c.initial]).max().map_or(0, |s| s as usize + 1);
+        if final_state.len() < top {
+            final_state.resize(top, false);
+        }
         Net {
             event,
             final_state,
