@@ -8,6 +8,7 @@
 #   EVENTS=100000 SEED=7 bash bench/instructions.sh
 #   TOP=25 bash bench/instructions.sh          # and situ's 25 costliest functions
 #   KEEP=DIR bash bench/instructions.sh        # keep the callgrind files in DIR
+#   INTERPRETED=1 bash bench/instructions.sh   # situ's Rete interpreter instead of its fast path
 #
 # 1. builds in release `situ`, `situ-handwritten` and the example
 #    `instructions` of situ-runtime (valgrind: scripts/install-capi-tools.sh);

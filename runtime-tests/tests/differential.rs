@@ -1,17 +1,25 @@
-//! Differential test of the Rete engine against the naive evaluator of
+//! Differential test of the Rete interpreter against the naive evaluator of
 //! `naive/mod.rs`: on the same event streams they must fire the same rules
-//! in the same order and reach the same states, event after event.
+//! in the same order and reach the same states, event after event; and of
+//! the engine's fast path (`Engine::new`) against the interpreter
+//! (`Engine::interpreted`, `twin/mod.rs`): same answers to every operation
+//! (steps, refusals, cascade errors, recorded firings with their facts,
+//! heartbeats, settling, forced facts and states, resets) and the same
+//! working memory after each.
 //!
 //! - `rules/outdoor.situ` and `rules/ugv.situ` on the benchmark's seeded
 //!   streams (missions reset on final states, as `situ bench` does);
 //! - random event sequences (proptest, shrinking) on both files;
 //! - random rule sets with every condition kind (guards, payload tests,
 //!   ranges, run lengths, windows, staleness, negations, variables) on random
-//!   event sequences.
+//!   event sequences, and (fast path only) on random operations;
+//! - (fast path only) every `.situ` file of the repository that builds, on
+//!   seeded streams: each must go the fast way.
 //!
 //! Shrunk counterexamples are kept in `differential.proptest-regressions`.
 
 mod naive;
+mod twin;
 
 use naive::Naive;
 use proptest::prelude::*;
@@ -20,6 +28,7 @@ use situ_compiler::Checked;
 use situ_runtime::rete::{Engine, PostError};
 use situ_runtime::stream::Generator;
 use std::sync::Arc;
+use twin::{ops, posts, twins};
 
 fn compile(checked: &Checked) -> Arc<Content> {
     let front: Vec<_> = checked.diagnostics.iter().filter(|d| d.code < "E0300").collect();
@@ -41,7 +50,7 @@ fn agree(
     events: &[(u32, u64, Vec<Value>)],
     reset_on_final: bool,
 ) -> Result<(), String> {
-    let mut engine = Engine::new(content.clone());
+    let mut engine = Engine::interpreted(content.clone());
     let mut naive = Naive::new(&checked.model);
     for (i, (event, time, payload)) in events.iter().enumerate() {
         // `None`: refused (out of order, §10.4).
@@ -89,7 +98,9 @@ fn the_papers_stacks_on_seeded_streams() {
             let events: Vec<(u32, u64, Vec<Value>)> =
                 (0..4000).filter_map(|_| g.next_event()).map(|e| (e.event, e.time, e.payload)).collect();
             agree(&checked, &content, &events, true).unwrap_or_else(|e| panic!("{file}, seed {seed}: {e}"));
+            twins(&content, &posts(&events, true)).unwrap_or_else(|e| panic!("{file}, seed {seed}, fast path: {e}"));
             let mut engine = Engine::new(content.clone());
+            assert!(engine.is_fast(), "{file}: {:?}", engine.fast_declined());
             for (ev, t, p) in &events {
                 if let Ok(Some(c)) = engine.post(*ev, *t, p) {
                     fired += c.firings.len();
@@ -188,6 +199,7 @@ proptest! {
         let checked = rules_file("outdoor.situ");
         let content = compile(&checked);
         prop_assert_eq!(agree(&checked, &content, &evs, false), Ok(()));
+        prop_assert!(twins(&content, &posts(&evs, false)).is_ok(), "{:?}", twins(&content, &posts(&evs, false)));
     }
 
     #[test]
@@ -195,6 +207,7 @@ proptest! {
         let checked = rules_file("ugv.situ");
         let content = compile(&checked);
         prop_assert_eq!(agree(&checked, &content, &evs, false), Ok(()));
+        prop_assert!(twins(&content, &posts(&evs, false)).is_ok(), "{:?}", twins(&content, &posts(&evs, false)));
     }
 }
 
@@ -329,5 +342,89 @@ proptest! {
             })
             .collect();
         prop_assert_eq!(agree(&checked, &content, &evs, false), Ok(()), "{}", src);
+        let fast = twins(&content, &posts(&evs, false));
+        prop_assert!(fast.is_ok(), "{}\n{:?}", src, fast);
     }
+}
+
+// ─── The fast path against the interpreter ─────────────────────────────────
+
+/// The time steps of the random operations (ms): as `GEN_GAPS_MS`, and the
+/// files' stale times and windows.
+const OP_GAPS_MS: [i64; 12] = [0, 1, 10, 20, 30, 31, 50, 51, -30, 250, 501, 1001];
+
+fn rule_set_and_ops() -> impl Strategy<Value = (String, Arc<Content>, Vec<twin::Op>)> {
+    rule_set().prop_flat_map(|src| {
+        let content = compile(&situ_compiler::check_source("gen.situ", &src));
+        (Just(src), Just(content.clone()), ops(content, &OP_GAPS_MS, pool, 60))
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 512, ..ProptestConfig::default() })]
+
+    /// Every entry point of the engine, on random rule sets: the fast path
+    /// answers as the interpreter.
+    #[test]
+    fn fast_path_on_random_rule_sets_and_operations((src, content, ops) in rule_set_and_ops()) {
+        let result = twins(&content, &ops);
+        prop_assert!(result.is_ok(), "{}\n{:?}", src, result);
+    }
+
+    #[test]
+    fn fast_path_on_outdoor_operations(ops in ops(compile(&rules_file("outdoor.situ")), &OP_GAPS_MS, pool, 150)) {
+        let content = compile(&rules_file("outdoor.situ"));
+        let result = twins(&content, &ops);
+        prop_assert!(result.is_ok(), "{:?}", result);
+    }
+}
+
+/// The `.situ` files under `dir`, recursively (no build output).
+fn situ_files(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            if !matches!(path.file_name().and_then(|n| n.to_str()), Some("target" | ".git" | "node_modules")) {
+                situ_files(&path, out);
+            }
+        } else if path.extension().is_some_and(|e| e == "situ") {
+            out.push(path);
+        }
+    }
+}
+
+/// Every rules file of the repository that builds (no front-end error)
+/// goes the fast way, and the fast path agrees with the interpreter on
+/// seeded streams over it (the benchmark's generator, missions reset on
+/// final states).
+#[test]
+fn every_rules_file_of_the_repository_on_the_fast_path() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut files = Vec::new();
+    for dir in ["rules", "examples", "tests", "api", "compiler", "lsp", "editors", "grammar"] {
+        situ_files(&root.join(dir), &mut files);
+    }
+    files.sort();
+    let (mut built, mut fired) = (0, 0);
+    for path in &files {
+        let Ok(checked) = situ_compiler::check(path, &situ_compiler::loader::FsLoader) else { continue };
+        if checked.diagnostics.iter().any(|d| d.code < "E0300") || checked.model.initial.is_none() {
+            continue;
+        }
+        let content = Arc::new(situ_compiler::bundle::build(&checked));
+        if situ_compiler::bundle::codec::validate(&content).is_err() {
+            continue;
+        }
+        built += 1;
+        for seed in 0..2u64 {
+            let mut g = Generator::new(content.clone(), seed);
+            let events: Vec<(u32, u64, Vec<Value>)> =
+                (0..1500).filter_map(|_| g.next_event()).map(|e| (e.event, e.time, e.payload)).collect();
+            fired += twins(&content, &posts(&events, true))
+                .unwrap_or_else(|e| panic!("{}, seed {seed}: {e}", path.display()));
+        }
+    }
+    assert!(built >= 100, "only {built} of {} files built: the walk tests little", files.len());
+    assert!(fired > 1000, "the streams fired only {fired} rules");
 }

@@ -358,7 +358,7 @@ fn an_event_from_the_future_is_refused_against_the_clock_it_arrived_at() {
     let ahead = 1_000 * MS + DEFAULT_MAX_SKEW + 1;
     t.e.set_clock(Some(1_000 * MS));
     let err = t.e.step(stobn, ahead, &[]).unwrap_err();
-    assert!(matches!(err, PostError::FromTheFuture { clock, .. } if clock == 1_000 * MS), "{err:?}");
+    assert!(matches!(err, StepError::FromTheFuture { clock, .. } if clock == 1_000 * MS), "{err:?}");
     assert_eq!(t.e.now(), 1_000 * MS, "a refused event never moves now");
     assert!(t.e.fact(1).is_none());
     // At the bound it is taken; so is an event at 2^63 − 1 ns that arrived

@@ -10,7 +10,9 @@
 //! then [`process_stream`], the one function that callgrind counts
 //! (`--toggle-collect=*::process_stream`), steps every event as `situ bench`
 //! does (the event's clock set, `Engine::step`, the state at rest compared,
-//! a mission reset in a final state). Writes the `INDEX STATE` lines of
+//! a mission reset in a final state) on the engine's fast path, or on the
+//! Rete interpreter with `INTERPRETED=1` in the environment (which
+//! `bench/instructions.sh` passes on). Writes the `INDEX STATE` lines of
 //! `situ bench --states-out` to STATES_OUT, so that the script checks the
 //! state sequence against the hand-written matcher's.
 
@@ -88,7 +90,12 @@ fn main() -> ExitCode {
     }
     drop(events);
 
-    let mut engine = Engine::new(content.clone());
+    // `INTERPRETED=1`: the Rete interpreter, the fast path's reference.
+    let mut engine = if std::env::var_os("INTERPRETED").is_some_and(|v| v == "1") {
+        Engine::interpreted(content.clone())
+    } else {
+        Engine::new(content.clone())
+    };
     let mut changes = Vec::with_capacity(flat.events.len());
     let refused = process_stream(&mut engine, &flat, &mut changes);
 

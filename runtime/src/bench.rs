@@ -18,7 +18,7 @@
 //! buffer, the histogram and the engine are of fixed size, so the peak
 //! resident memory of 10,000,000 events is that of 1,000.
 
-use crate::rete::{Engine, PostError};
+use crate::rete::{Engine, StepError};
 use crate::stream::{self, Event, Generator};
 use serde::Serialize;
 use situ_bundle::{Content, Value};
@@ -68,7 +68,7 @@ pub struct Report {
     /// Events the acceptance rule refused (`Engine::admit`): a payload that
     /// does not fit, out of order, from the future. They change nothing.
     pub refused: u64,
-    /// The refused events by reason ([`PostError::key`]: `payload`, `out of
+    /// The refused events by reason ([`crate::rete::PostError::key`]: `payload`, `out of
     /// order`, `from the future`, `unknown event`), as a running stack
     /// counts them.
     pub refused_by_reason: BTreeMap<String, u64>,
@@ -183,7 +183,7 @@ impl Chunk {
 
     /// Posts event `i` through the engine's acceptance rule
     /// ([`Engine::admit`]), at its clock when the stream gives one.
-    fn step(&self, engine: &mut Engine, i: usize) -> Result<crate::rete::Step, PostError> {
+    fn step(&self, engine: &mut Engine, i: usize) -> Result<crate::rete::Step, StepError> {
         let (event, time, _, _) = self.events[i];
         engine.set_clock(self.clocks[i]);
         engine.step(event, time, self.payload(i))
@@ -267,8 +267,9 @@ pub fn run(content: Arc<Content>, mut opts: Options) -> Report {
             by_state[at_rest as usize] += 1;
             match chunk.step(&mut engine, i) {
                 Ok(step) => firings += step.firings as u64,
-                Err(PostError::Cascade { .. }) => cascades += 1,
+                Err(StepError::Cascade { .. }) => cascades += 1,
                 Err(e) => {
+                    let e = engine.post_error(e);
                     // Counted as a running stack counts it; the run goes on.
                     refused += 1;
                     *by_reason.entry(e.key()).or_default() += 1;

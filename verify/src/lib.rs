@@ -69,7 +69,7 @@ impl System {
         self.engine.admit(event, time, payload)?;
         let agent = self.content().events[event as usize].agent;
         self.org.on_event(agent, event);
-        let step = self.engine.step(event, time, payload);
+        let step = self.engine.step(event, time, payload).map_err(|e| self.engine.post_error(e));
         let state = self.engine.state();
         if state != self.org.state() {
             self.org.on_state(state);

@@ -4,7 +4,7 @@
 //! arrived at — and the clocks it keeps for that.
 
 use super::net::Kind;
-use super::{Engine, PostError};
+use super::{Engine, PostError, StepError};
 use situ_bundle::Value;
 
 impl Engine {
@@ -21,14 +21,14 @@ impl Engine {
     /// The stamp of the agent's latest accepted event (0 before its first):
     /// an event of the agent stamped earlier is refused.
     pub fn agent_time(&self, agent: u32) -> u64 {
-        self.last.get(agent as usize).copied().unwrap_or(0)
+        self.agents.get(agent as usize).map_or(0, |r| r.last)
     }
 
     /// Moves the agent's clock forward to `time` (a carried-over clock, at
     /// hot swap): its events stamped earlier are refused from then on.
     pub fn advance_agent_time(&mut self, agent: u32, time: u64) {
-        if let Some(t) = self.last.get_mut(agent as usize) {
-            *t = (*t).max(time);
+        if let Some(r) = self.agents.get_mut(agent as usize) {
+            r.last = r.last.max(time);
         }
     }
 
@@ -60,15 +60,25 @@ impl Engine {
     ///
     /// NaN and the infinities are accepted: §10.3 says what they match.
     /// A refused event changes nothing, not even now.
+    #[inline]
     pub fn admit(&self, event: u32, time: u64, payload: &[Value]) -> Result<(), PostError> {
+        self.admitted(event, time, payload).map_err(|e| self.post_error(e))
+    }
+
+    /// [`admit`](Self::admit), its refusal in short.
+    #[inline(always)]
+    pub(super) fn admitted(&self, event: u32, time: u64, payload: &[Value]) -> Result<(), StepError> {
         let agent = self.validated(event, payload)? as usize;
-        let last = self.last[agent];
+        // SAFETY: an event's agent is an agent: `Net::new` reads each
+        // event's agent's `stale after` from a table of one entry per
+        // agent, and `agents` has one record per agent.
+        let last = unsafe { self.agents.get_unchecked(agent) }.last;
         if time < last {
-            return Err(PostError::OutOfOrder { event, time, last });
+            return Err(StepError::OutOfOrder { event, time, last });
         }
         if let Some(clock) = self.clock {
             if time > clock.saturating_add(self.max_skew) {
-                return Err(PostError::FromTheFuture { event, time, clock, max_skew: self.max_skew });
+                return Err(StepError::FromTheFuture { event, time, clock, max_skew: self.max_skew });
             }
         }
         Ok(())
@@ -78,8 +88,13 @@ impl Engine {
     /// to the initial state with no facts ([`reset`](Self::reset)) and
     /// true. `situ bench` and its stream generator call it after each event
     /// (after both rests), unless told not to.
+    #[inline]
     pub fn reset_if_final(&mut self) -> bool {
-        let fin = self.net.final_state.get(self.state as usize).copied().unwrap_or(false);
+        debug_assert!((self.state as usize) < self.net.final_state.len());
+        // SAFETY: `Net::new` gives `final_state` an entry for every state
+        // the engine can be in: the initial one, a rule's target, one
+        // `force_state` checked.
+        let fin = unsafe { *self.net.final_state.get_unchecked(self.state as usize) };
         if fin {
             self.reset();
         }
@@ -89,30 +104,34 @@ impl Engine {
     /// Checks an event against the bundle's schema (a part of
     /// [`admit`](Self::admit), which also checks its time).
     pub fn validate(&self, event: u32, payload: &[Value]) -> Result<(), PostError> {
-        self.validated(event, payload).map(|_| ())
+        self.validated(event, payload).map(|_| ()).map_err(|e| self.post_error(e))
     }
 
     /// [`validate`](Self::validate), giving the event's agent.
     #[inline(always)]
-    fn validated(&self, event: u32, payload: &[Value]) -> Result<u32, PostError> {
+    fn validated(&self, event: u32, payload: &[Value]) -> Result<u32, StepError> {
         let Some(ev) = self.net.event.get(event as usize) else {
-            return Err(PostError::UnknownEvent { event });
+            return Err(StepError::UnknownEvent { event });
         };
-        let (s, e) = ev.kinds;
-        let kinds = &self.net.kinds[s as usize..e as usize];
-        if kinds.len() != payload.len() {
-            return Err(PostError::Arity { event, expected: kinds.len(), found: payload.len() });
+        let (s, e) = (ev.kinds.0 as usize, ev.kinds.1 as usize);
+        let n = e.wrapping_sub(s);
+        if n != payload.len() {
+            return Err(StepError::Arity { event, expected: n, found: payload.len() });
         }
-        for (i, (k, v)) in kinds.iter().zip(payload).enumerate() {
+        let mut i = 0;
+        while i < n {
+            // SAFETY: `Net::new` builds each event's range of kinds inside
+            // `kinds` (`s <= e <= kinds.len()`), and `payload` has `n` values.
+            let (k, v) = unsafe { (*self.net.kinds.get_unchecked(s + i), *payload.get_unchecked(i)) };
             let fits = match (k, v) {
                 (Kind::F64, Value::F64(_)) | (Kind::I64, Value::I64(_)) | (Kind::Bool, Value::Bool(_)) => true,
                 (Kind::Symbol(n), Value::Symbol(x)) => x < n,
                 _ => false,
             };
             if !fits {
-                let expected = self.content.events[event as usize].fields[i].ty.clone();
-                return Err(PostError::Type { event, field: i as u32, expected });
+                return Err(StepError::Type { event, field: i as u32 });
             }
+            i += 1;
         }
         Ok(ev.agent)
     }

@@ -52,7 +52,7 @@ pub fn passes_with(t: &Test, payload: &[Value], fact: impl Fn(u32, u32) -> Optio
 #[inline]
 // `x < y || x > y` is not `x != y`: it is false for NaN, as the language wants.
 #[allow(clippy::double_comparisons)]
-fn float(op: Cmp, x: f64, y: f64) -> bool {
+pub(super) fn float(op: Cmp, x: f64, y: f64) -> bool {
     match op {
         Cmp::Eq => x == y,
         // IEEE `!=` holds for NaN; the language's does not.

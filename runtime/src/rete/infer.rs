@@ -3,7 +3,7 @@
 //! firing until no rule is activated, each firing recorded with the facts
 //! it matched (for explanations) in the buffers of the step.
 
-use super::{Engine, FactRec, FiringRec, PostError};
+use super::{Engine, FactRec, FiringRec, StepError};
 
 impl Engine {
     pub(super) fn set_state(&mut self, state: u32) {
@@ -35,7 +35,7 @@ impl Engine {
             let (s, e) = rule.matches;
             let recency = self.net.rule_agents[s as usize..e as usize]
                 .iter()
-                .map(|&a| self.slots[a as usize].seq)
+                .map(|&a| self.agents[a as usize].slot.seq)
                 .max()
                 .unwrap_or(0);
             let key = (rule.salience, rule.specificity, recency);
@@ -59,42 +59,54 @@ impl Engine {
 
     /// Fires until no rule is activated; the bound counts the firings of
     /// the whole step.
-    pub(super) fn rest(&mut self) -> Result<(), PostError> {
+    pub(super) fn rest(&mut self) -> Result<(), StepError> {
         self.propagate();
         while let Some(r) = self.best() {
             if self.record.firings.len() == self.cascade_limit {
-                let firings = self.last_change().firings;
-                return Err(PostError::Cascade { limit: self.cascade_limit, firings });
+                return Err(StepError::Cascade { limit: self.cascade_limit });
             }
-            let rule = &self.content.rules[r as usize];
-            let to = rule.target;
-            let facts0 = self.record.facts.len() as u32;
-            for &a in &rule.matches {
-                let slot = self.slots[a as usize];
-                let n = self.content.events.get(slot.event as usize).map_or(0, |e| e.fields.len());
-                let at = self.net.payload_at[a as usize] as usize;
-                let v0 = self.record.values.len() as u32;
-                self.record.values.extend_from_slice(&self.payload[at..at + n]);
-                let values = (v0, self.record.values.len() as u32);
-                self.record.facts.push(FactRec { agent: a, event: slot.event, time: slot.time, run: slot.run, values });
-            }
-            let stale0 = self.record.stale.len() as u32;
-            for &a in &rule.stale {
-                if self.stale[a as usize] {
-                    self.record.stale.push(a);
-                }
-            }
-            let rec = FiringRec {
-                rule: r,
-                from: self.state,
-                to,
-                time: self.now,
-                facts: (facts0, self.record.facts.len() as u32),
-                stale: (stale0, self.record.stale.len() as u32),
-            };
-            self.record.firings.push(rec);
+            let to = self.record_firing(r);
             self.set_state(to);
         }
         Ok(())
+    }
+
+    /// Records the firing of rule `r` in the current state, with the facts
+    /// its positive patterns matched and the agents its `stale` tests found
+    /// stale; returns its target (the caller sets the state). The
+    /// interpreter and the fast path record through it alike.
+    pub(super) fn record_firing(&mut self, r: u32) -> u32 {
+        let rule = &self.content.rules[r as usize];
+        let to = rule.target;
+        let facts0 = self.record.facts.len() as u32;
+        for &a in &rule.matches {
+            let slot = self.agents[a as usize].slot;
+            let n = self.net.event.get(slot.event as usize).map_or(0, |e| (e.kinds.1 - e.kinds.0) as usize);
+            let at = self.net.payload_at[a as usize] as usize;
+            let v0 = self.record.values.len() as u32;
+            // One by one: the usual zero, one or two values without a call
+            // to `memcpy`.
+            for &v in &self.payload[at..at + n] {
+                self.record.values.push(v);
+            }
+            let values = (v0, self.record.values.len() as u32);
+            self.record.facts.push(FactRec { agent: a, event: slot.event, time: slot.time, run: slot.run, values });
+        }
+        let stale0 = self.record.stale.len() as u32;
+        for &a in &rule.stale {
+            if self.agents[a as usize].stale {
+                self.record.stale.push(a);
+            }
+        }
+        let rec = FiringRec {
+            rule: r,
+            from: self.state,
+            to,
+            time: self.now,
+            facts: (facts0, self.record.facts.len() as u32),
+            stale: (stale0, self.record.stale.len() as u32),
+        };
+        self.record.firings.push(rec);
+        to
     }
 }

@@ -27,22 +27,36 @@
 //! state), fire the first by salience, specificity, recency, declaration
 //! order; set the state; repeat. More than [`Engine::cascade_limit`] firings
 //! for one event is a [`PostError::Cascade`].
+//!
+//! [`Engine::new`] runs this on the fast path (`fast.rs`): the same working
+//! memory, acceptance rule, expiry and recording, with each rule's
+//! conditions tested directly from candidate lists instead of through the
+//! network's memories. [`Engine::interpreted`] runs the network, the
+//! reference that `runtime-tests/tests/differential.rs` holds the fast path
+//! to; a bundle the fast path declines ([`Engine::fast_declined`]) runs on
+//! the network too.
 
 mod admit;
 mod eval;
+mod fast;
 mod infer;
 mod net;
+mod network;
 mod report;
 
-use net::{AlphaKind, Net, OperandRt, TestKind, TestRt, NONE};
+use net::{Net, NONE};
 use situ_bundle::{Content, Value};
 use std::sync::Arc;
 
 pub use eval::{compare, in_range, passes, passes_with};
-pub use report::{describe_fact, format_time, show_value, FactView, Firing, MatchedFact, PostError, StateChange};
+pub use report::{
+    describe_fact, format_time, show_value, FactView, Firing, MatchedFact, PostError, StateChange, StepError,
+};
 
 /// The default bound of a cascade (§10.4).
 pub const CASCADE_LIMIT: usize = 64;
+
+pub use fast::MAX_LIST_ENTRIES;
 
 /// How far ahead of the Bulletinboard's clock an event may be stamped, by
 /// default (ns): hosts kept in time by NTP on a local network agree within
@@ -64,6 +78,28 @@ struct Slot {
 
 const EMPTY: Slot = Slot { event: NONE, time: 0, run: 0, seq: 0 };
 
+/// An agent's part of the working memory, in one record (one address for
+/// the insert and the conditions instead of one per table).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct AgentRec {
+    slot: Slot,
+    /// `fast::bit(slot.event)`: its fact's bit of `Engine::have`.
+    bit: u64,
+    /// Timers: the time its fact expires and the next window that closes
+    /// (`u64::MAX`: none).
+    stale_at: u64,
+    window_at: u64,
+    /// The fast path's now of its fact's last evaluation (`fast.rs`).
+    checked: u64,
+    /// The stamp of its latest accepted event (kept by a reset: an agent's
+    /// clock does not go back with a new mission).
+    last: u64,
+    stale: bool,
+}
+
+const AGENT: AgentRec =
+    AgentRec { slot: EMPTY, bit: 0, stale_at: u64::MAX, window_at: u64::MAX, checked: 0, last: 0, stale: false };
+
 /// The Rete network of a bundle with its working memory.
 #[derive(Debug, Clone)]
 pub struct Engine {
@@ -71,22 +107,16 @@ pub struct Engine {
     net: Net,
     // Working memory.
     state: u32,
-    slots: Vec<Slot>,
+    /// Per agent: its fact, staleness, clock and timers, in one record.
+    agents: Vec<AgentRec>,
     payload: Vec<Value>,
-    stale: Vec<bool>,
     now: u64,
     seq: u64,
-    /// Per agent, the stamp of its latest accepted event (kept by a reset:
-    /// an agent's clock does not go back with a new mission).
-    last: Vec<u64>,
     max_skew: u64,
     /// The Bulletinboard's clock the next events arrive at (`None`: at
     /// their stamps).
     clock: Option<u64>,
-    // Timers: per agent the time its fact expires and the next window that
-    // closes (u64::MAX: none); the earliest of all, possibly too early.
-    stale_at: Vec<u64>,
-    window_at: Vec<u64>,
+    /// The earliest of the agents' timers, possibly too early.
     next_deadline: u64,
     // Network memories.
     alpha_mem: Vec<bool>,
@@ -102,6 +132,16 @@ pub struct Engine {
     /// The network's memories in the initial state with no facts, which a
     /// [`reset`](Self::reset) restores.
     initial: Arc<Memories>,
+    // The fast path (`fast.rs`): whether it runs, its program (empty when
+    // it does not), and the agents whose fact expiry changed since the
+    // last rest.
+    fast: bool,
+    fp: Arc<fast::Program>,
+    touched: Vec<u32>,
+    declined: Option<&'static str>,
+    /// The events (below 64) that are an agent's fact now, as bits
+    /// (`fast::bit`); kept on the fast path only.
+    have: u64,
 }
 
 /// The memories of the network (alpha, beta, activated rules).
@@ -114,23 +154,51 @@ struct Memories {
 }
 
 impl Engine {
-    /// The engine of a validated bundle, in its initial state with no facts.
+    /// The engine of a validated bundle, in its initial state with no
+    /// facts, on the fast path (`fast.rs`) unless the fast path declines
+    /// the bundle ([`fast_declined`](Self::fast_declined)): then the
+    /// interpreter.
     pub fn new(content: Arc<Content>) -> Engine {
+        Engine::build(content, true)
+    }
+
+    /// The engine of a validated bundle on the Rete interpreter, the
+    /// reference the fast path is held to (`runtime-tests/tests/differential.rs`).
+    pub fn interpreted(content: Arc<Content>) -> Engine {
+        Engine::build(content, false)
+    }
+
+    /// Whether the engine runs on the fast path.
+    pub fn is_fast(&self) -> bool {
+        self.fast
+    }
+
+    /// Why the fast path declined the bundle, if it did (an engine built
+    /// by [`interpreted`](Self::interpreted) was not offered it).
+    pub fn fast_declined(&self) -> Option<&'static str> {
+        self.declined
+    }
+
+    fn build(content: Arc<Content>, fast: bool) -> Engine {
         let net = Net::new(&content);
+        let (fp, declined) = if fast {
+            match fast::Program::new(&content, &net) {
+                Ok(p) => (Some(p), None),
+                Err(why) => (None, Some(why)),
+            }
+        } else {
+            (None, None)
+        };
         let na = content.agents.len();
         let nb = net.beta.len();
         let mut e = Engine {
             state: content.initial,
-            slots: vec![EMPTY; na],
+            agents: vec![AGENT; na],
             payload: vec![Value::Bool(false); net.payload_len],
-            stale: vec![false; na],
             now: 0,
             seq: 0,
-            last: vec![0; na],
             max_skew: DEFAULT_MAX_SKEW,
             clock: None,
-            stale_at: vec![u64::MAX; na],
-            window_at: vec![u64::MAX; na],
             next_deadline: u64::MAX,
             alpha_mem: vec![false; net.alpha.len()],
             beta_tok: vec![false; nb],
@@ -142,10 +210,18 @@ impl Engine {
             cascade_limit: CASCADE_LIMIT,
             record: Record::default(),
             initial: Arc::default(),
+            fast: fp.is_some(),
+            fp: Arc::new(fp.unwrap_or_default()),
+            touched: Vec::with_capacity(na),
+            declined,
+            have: 0,
             content,
             net,
         };
         e.recompute();
+        if e.fast {
+            e.fast_activate();
+        }
         e.initial = Arc::new(Memories {
             alpha_mem: e.alpha_mem.clone(),
             beta_tok: e.beta_tok.clone(),
@@ -180,14 +256,14 @@ impl Engine {
 
     /// An agent's live fact: event, payload, time, run length.
     pub fn fact(&self, agent: u32) -> Option<MatchedFact> {
-        let slot = self.slots.get(agent as usize)?;
+        let slot = &self.agents.get(agent as usize)?.slot;
         (slot.event != NONE).then(|| self.snapshot(agent))
     }
 
     /// An agent's live fact without copying it: event, payload, time, run
     /// length and posting sequence number (recency).
     pub fn fact_view(&self, agent: u32) -> Option<FactView<'_>> {
-        let slot = self.slots.get(agent as usize)?;
+        let slot = &self.agents.get(agent as usize)?.slot;
         if slot.event == NONE {
             return None;
         }
@@ -206,21 +282,17 @@ impl Engine {
     /// reusing `self`'s buffers: the explorer of `verify` copies an engine
     /// per successor it tries.
     pub fn copy_from(&mut self, other: &Engine) {
-        if !Arc::ptr_eq(&self.content, &other.content) {
+        if !Arc::ptr_eq(&self.content, &other.content) || self.fast != other.fast {
             *self = other.clone();
             return;
         }
         self.state = other.state;
-        self.slots.clone_from(&other.slots);
+        self.agents.clone_from(&other.agents);
         self.payload.clone_from(&other.payload);
-        self.stale.clone_from(&other.stale);
         self.now = other.now;
         self.seq = other.seq;
-        self.last.clone_from(&other.last);
         self.max_skew = other.max_skew;
         self.clock = other.clock;
-        self.stale_at.clone_from(&other.stale_at);
-        self.window_at.clone_from(&other.window_at);
         self.next_deadline = other.next_deadline;
         self.alpha_mem.clone_from(&other.alpha_mem);
         self.beta_tok.clone_from(&other.beta_tok);
@@ -230,14 +302,17 @@ impl Engine {
         self.active.clone_from(&other.active);
         self.active_pos.clone_from(&other.active_pos);
         self.cascade_limit = other.cascade_limit;
+        self.touched.clone_from(&other.touched);
+        self.have = other.have;
     }
 
     /// Whether the agent's fact has expired.
     pub fn is_stale(&self, agent: u32) -> bool {
-        self.stale.get(agent as usize).copied().unwrap_or(false)
+        self.agents.get(agent as usize).is_some_and(|r| r.stale)
     }
 
-    /// The rules activated now (at rest: none).
+    /// The rules activated now (at rest: none), in no particular order
+    /// (the fast path's in declaration order).
     pub fn activated(&self) -> &[u32] {
         &self.active
     }
@@ -249,13 +324,20 @@ impl Engine {
     /// copied back from the engine's construction, not propagated (no
     /// allocation: the buffers keep their capacity).
     pub fn reset(&mut self) {
-        self.slots.fill(EMPTY);
-        self.stale.fill(false);
-        self.stale_at.fill(u64::MAX);
-        self.window_at.fill(u64::MAX);
+        for r in &mut self.agents {
+            // The agent's clock and the now of its last evaluation are kept.
+            *r = AgentRec { last: r.last, checked: r.checked, ..AGENT };
+        }
         self.next_deadline = u64::MAX;
         self.state = self.content.initial;
         let m = &*self.initial;
+        self.touched.clear();
+        self.have = 0;
+        if self.fast {
+            // The fast path keeps no network memories: only the activated rules.
+            self.active.clone_from(&m.active);
+            return;
+        }
         self.alpha_mem.copy_from_slice(&m.alpha_mem);
         self.beta_tok.copy_from_slice(&m.beta_tok);
         self.active.clone_from(&m.active);
@@ -268,20 +350,26 @@ impl Engine {
     /// Processes one event: expiry, rest, the new fact, rest. Returns the
     /// firings, if any rule fired.
     pub fn post(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Option<StateChange>, PostError> {
-        let step = self.step(event, time, payload)?;
+        let step = self.step(event, time, payload).map_err(|e| self.post_error(e))?;
         Ok((step.firings > 0).then(|| self.last_change()))
     }
 
     /// As [`post`](Self::post), without building the [`StateChange`]: no
     /// allocation once the engine has warmed up. [`last_change`](Self::last_change)
-    /// gives the details of the latest step.
-    pub fn step(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Step, PostError> {
-        self.admit(event, time, payload)?;
-        self.accepted(event, time, payload)
+    /// gives the details of the latest step, [`post_error`](Self::post_error)
+    /// those of an error.
+    #[inline]
+    pub fn step(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Step, StepError> {
+        self.admitted(event, time, payload)?;
+        if self.fast {
+            self.fast_accepted(event, time, payload)
+        } else {
+            self.accepted(event, time, payload)
+        }
     }
 
     /// Processes an event that [`admit`](Self::admit) accepted.
-    fn accepted(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Step, PostError> {
+    fn accepted(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Step, StepError> {
         self.begin();
         if time > self.now {
             self.now = time;
@@ -311,11 +399,20 @@ impl Engine {
         if now > self.now {
             self.now = now;
         }
-        if self.now > self.next_deadline {
-            self.expire();
-        }
-        if !self.at_rest() {
-            self.rest()?;
+        if self.fast {
+            if self.now > self.next_deadline {
+                self.fast_expire();
+            }
+            if !self.active.is_empty() || !self.touched.is_empty() {
+                self.fast_rest(NONE).map_err(|e| self.post_error(e))?;
+            }
+        } else {
+            if self.now > self.next_deadline {
+                self.expire();
+            }
+            if !self.at_rest() {
+                self.rest().map_err(|e| self.post_error(e))?;
+            }
         }
         Ok((!self.record.firings.is_empty()).then(|| self.last_change()))
     }
@@ -324,8 +421,31 @@ impl Engine {
     /// rules that hold with no facts).
     pub fn settle(&mut self) -> Result<Option<StateChange>, PostError> {
         self.begin();
-        self.rest()?;
+        if self.fast {
+            self.fast_rest(NONE).map_err(|e| self.post_error(e))?;
+        } else {
+            self.rest().map_err(|e| self.post_error(e))?;
+        }
         Ok((!self.record.firings.is_empty()).then(|| self.last_change()))
+    }
+
+    /// The details of an error of the latest step: a field's type, a
+    /// cascade's firings (those recorded by the step).
+    #[cold]
+    pub fn post_error(&self, e: StepError) -> PostError {
+        match e {
+            StepError::UnknownEvent { event } => PostError::UnknownEvent { event },
+            StepError::Arity { event, expected, found } => PostError::Arity { event, expected, found },
+            StepError::Type { event, field } => {
+                let expected = self.content.events[event as usize].fields[field as usize].ty.clone();
+                PostError::Type { event, field, expected }
+            }
+            StepError::OutOfOrder { event, time, last } => PostError::OutOfOrder { event, time, last },
+            StepError::FromTheFuture { event, time, clock, max_skew } => {
+                PostError::FromTheFuture { event, time, clock, max_skew }
+            }
+            StepError::Cascade { limit } => PostError::Cascade { limit, firings: self.last_change().firings },
+        }
     }
 
     /// What the latest step fired, with the facts that made each rule hold.
@@ -355,18 +475,28 @@ impl Engine {
         StateChange { from: r.from, to: self.state, time: self.now, firings }
     }
 
+    #[inline]
     fn begin(&mut self) {
         let r = &mut self.record;
         r.from = self.state;
-        r.firings.clear();
-        r.facts.clear();
-        r.values.clear();
-        r.stale.clear();
+        // Facts, values and stale agents are recorded with a firing only.
+        if !r.firings.is_empty() {
+            r.firings.clear();
+            r.facts.clear();
+            r.values.clear();
+            r.stale.clear();
+        }
     }
 
     /// Sets the state without firing rules (tests' `given`, hot swap).
     pub fn force_state(&mut self, state: u32) {
-        if (state as usize) < self.content.states.len() {
+        if (state as usize) >= self.content.states.len() {
+            return;
+        }
+        if self.fast {
+            self.state = state;
+            self.fast_activate();
+        } else {
             self.set_state(state);
         }
     }
@@ -376,9 +506,16 @@ impl Engine {
     pub fn force_fact(&mut self, event: u32, time: u64, payload: &[Value], run: u64) -> Result<(), PostError> {
         self.validate(event, payload)?;
         self.now = self.now.max(time);
+        if self.fast {
+            self.fast_insert(event, time, payload);
+            let agent = self.content.events[event as usize].agent as usize;
+            self.agents[agent].slot.run = run.max(1);
+            self.fast_activate();
+            return Ok(());
+        }
         self.insert(event, time, payload);
         let agent = self.content.events[event as usize].agent as usize;
-        self.slots[agent].run = run.max(1);
+        self.agents[agent].slot.run = run.max(1);
         self.refresh_alpha(agent as u32);
         self.propagate();
         Ok(())
@@ -392,17 +529,28 @@ impl Engine {
     /// Marks an agent stale without firing rules (its fact, if any, is gone).
     pub fn force_stale(&mut self, agent: u32) {
         let a = agent as usize;
-        if a >= self.slots.len() {
+        if a >= self.agents.len() {
             return;
         }
-        let old = self.slots[a].event;
+        if self.fast {
+            self.have &= !fast::bit(self.agents[a].slot.event);
+            self.agents[a].slot = EMPTY;
+            self.agents[a].bit = 0;
+            self.agents[a].stale = true;
+            self.agents[a].stale_at = u64::MAX;
+            self.agents[a].window_at = u64::MAX;
+            self.fast_activate();
+            return;
+        }
+        let old = self.agents[a].slot.event;
         if old != NONE {
             self.clear_event_alpha(old);
         }
-        self.slots[a] = EMPTY;
-        self.stale[a] = true;
-        self.stale_at[a] = u64::MAX;
-        self.window_at[a] = u64::MAX;
+        self.agents[a].slot = EMPTY;
+        self.agents[a].bit = 0;
+        self.agents[a].stale = true;
+        self.agents[a].stale_at = u64::MAX;
+        self.agents[a].window_at = u64::MAX;
         self.set_stale_alpha(agent, true);
         self.propagate();
     }
@@ -410,7 +558,7 @@ impl Engine {
     // ─── Working memory ────────────────────────────────────────────────
 
     fn snapshot(&self, agent: u32) -> MatchedFact {
-        let slot = self.slots[agent as usize];
+        let slot = self.agents[agent as usize].slot;
         let n = self.content.events.get(slot.event as usize).map_or(0, |e| e.fields.len());
         let at = self.net.payload_at[agent as usize] as usize;
         MatchedFact {
@@ -428,14 +576,15 @@ impl Engine {
         let ev = self.net.event[event as usize];
         let agent = ev.agent;
         let a = agent as usize;
-        let old = self.slots[a];
+        let old = self.agents[a].slot;
         self.seq += 1;
         let run = if old.event == event { old.run + 1 } else { 1 };
-        self.slots[a] = Slot { event, time, run, seq: self.seq };
-        self.last[a] = self.last[a].max(time);
+        self.agents[a].slot = Slot { event, time, run, seq: self.seq };
+        self.agents[a].bit = ev.bit;
+        self.agents[a].last = self.agents[a].last.max(time);
         copy_payload(&mut self.payload[ev.payload_at as usize..], payload);
-        if self.stale[a] {
-            self.stale[a] = false;
+        if self.agents[a].stale {
+            self.agents[a].stale = false;
             self.set_stale_alpha(agent, false);
         }
         if old.event != NONE && old.event != event {
@@ -445,8 +594,8 @@ impl Engine {
         // Timers.
         let stale_at = if ev.stale_after == u64::MAX { u64::MAX } else { time.saturating_add(ev.stale_after) };
         let window_at = self.next_window(ev.windows, time);
-        self.stale_at[a] = stale_at;
-        self.window_at[a] = window_at;
+        self.agents[a].stale_at = stale_at;
+        self.agents[a].window_at = window_at;
         self.next_deadline = self.next_deadline.min(stale_at).min(window_at);
     }
 
@@ -471,241 +620,24 @@ impl Engine {
         let mut next = u64::MAX;
         for i in 0..self.net.timed_agents.len() {
             let a = self.net.timed_agents[i] as usize;
-            if self.stale_at[a] < self.now {
+            if self.agents[a].stale_at < self.now {
                 // `now - t > stale after`: the fact expires.
-                let old = self.slots[a].event;
-                self.slots[a] = EMPTY;
+                let old = self.agents[a].slot.event;
+                self.agents[a].slot = EMPTY;
+                self.agents[a].bit = 0;
                 self.clear_event_alpha(old);
-                self.stale[a] = true;
+                self.agents[a].stale = true;
                 self.set_stale_alpha(a as u32, true);
-                self.stale_at[a] = u64::MAX;
-                self.window_at[a] = u64::MAX;
-            } else if self.window_at[a] < self.now {
+                self.agents[a].stale_at = u64::MAX;
+                self.agents[a].window_at = u64::MAX;
+            } else if self.agents[a].window_at < self.now {
                 self.refresh_alpha(a as u32);
-                let slot = self.slots[a];
-                self.window_at[a] = self.next_window(self.net.event[slot.event as usize].windows, slot.time);
+                let slot = self.agents[a].slot;
+                self.agents[a].window_at = self.next_window(self.net.event[slot.event as usize].windows, slot.time);
             }
-            next = next.min(self.stale_at[a]).min(self.window_at[a]);
+            next = next.min(self.agents[a].stale_at).min(self.agents[a].window_at);
         }
         self.next_deadline = next;
-    }
-
-    // ─── Alpha network ─────────────────────────────────────────────────
-
-    fn clear_event_alpha(&mut self, event: u32) {
-        let (s, e) = self.net.event[event as usize].alpha;
-        for i in s..e {
-            let a = self.net.event_alpha[i as usize] as usize;
-            if self.alpha_mem[a] {
-                self.alpha_mem[a] = false;
-                self.mark_succ(a);
-            }
-        }
-    }
-
-    /// Re-evaluates the alpha nodes of `event` against its agent's new fact:
-    /// successors are marked where the result changes, and where it stays
-    /// true but join tests below read the replaced fact's values.
-    #[inline]
-    fn eval_event_alpha(&mut self, (s, e): (u32, u32)) {
-        for i in s as usize..e as usize {
-            let a = self.net.event_alpha[i] as usize;
-            let pass = self.event_alpha_passes(&self.net.alpha[a]);
-            if pass != self.alpha_mem[a] || (pass && self.net.alpha[a].refresh) {
-                self.alpha_mem[a] = pass;
-                self.mark_succ(a);
-            }
-        }
-    }
-
-    /// Re-evaluates the alpha nodes of an agent's current event (windows,
-    /// forced run lengths); marks successors only where the result changes.
-    fn refresh_alpha(&mut self, agent: u32) {
-        let event = self.slots[agent as usize].event;
-        if event == NONE {
-            return;
-        }
-        let (s, e) = self.net.event[event as usize].alpha;
-        for i in s..e {
-            let a = self.net.event_alpha[i as usize] as usize;
-            let pass = self.alpha_passes(a);
-            if pass != self.alpha_mem[a] {
-                self.alpha_mem[a] = pass;
-                self.mark_succ(a);
-            }
-        }
-    }
-
-    fn set_stale_alpha(&mut self, agent: u32, stale: bool) {
-        let a = self.net.stale_alpha[agent as usize];
-        if a != NONE && self.alpha_mem[a as usize] != stale {
-            self.alpha_mem[a as usize] = stale;
-            self.mark_succ(a as usize);
-        }
-    }
-
-    fn alpha_passes(&self, a: usize) -> bool {
-        let node = &self.net.alpha[a];
-        match node.kind {
-            AlphaKind::State => self.net.state_in(node, self.state),
-            AlphaKind::Stale => self.stale[node.agent as usize],
-            AlphaKind::Event => self.event_alpha_passes(node),
-        }
-    }
-
-    /// An event alpha node's test of its agent's fact: the event, the run
-    /// length, the window, the payload tests.
-    #[inline]
-    fn event_alpha_passes(&self, node: &net::AlphaRt) -> bool {
-        let slot = &self.slots[node.agent as usize];
-        if slot.event != node.key || slot.run < node.min_run {
-            return false;
-        }
-        if node.within_ns != u64::MAX && self.now.saturating_sub(slot.time) > node.within_ns {
-            return false;
-        }
-        let (s, e) = node.tests;
-        s == e || self.net.alpha_tests[s as usize..e as usize].iter().all(|t| self.test(t, node.at as usize))
-    }
-
-    #[inline]
-    fn operand(&self, o: OperandRt, own: usize) -> Value {
-        match o {
-            OperandRt::Value(v) => v,
-            OperandRt::Own(f) => self.payload[own + f as usize],
-            OperandRt::Fact { agent, field } => {
-                let a = agent as usize;
-                if field < self.net.stride[a] {
-                    self.payload[self.net.payload_at[a] as usize + field as usize]
-                } else {
-                    // Cannot happen in a valid token; a value that matches nothing.
-                    Value::F64(f64::NAN)
-                }
-            }
-        }
-    }
-
-    #[inline]
-    fn test(&self, t: &TestRt, own: usize) -> bool {
-        let x = self.payload[own + t.field as usize];
-        match t.kind {
-            TestKind::Compare { op, rhs } => compare(op, x, self.operand(rhs, own)),
-            TestKind::Range { lo, hi, inclusive } => {
-                in_range(x, self.operand(lo, own), self.operand(hi, own), inclusive)
-            }
-        }
-    }
-
-    // ─── Beta network ──────────────────────────────────────────────────
-
-    #[inline(always)]
-    fn mark(&mut self, b: usize) {
-        let w = b / 64;
-        self.dirty[w] |= 1 << (b % 64);
-        self.dirty_lo = self.dirty_lo.min(w);
-        self.dirty_hi = self.dirty_hi.max(w);
-    }
-
-    /// No `#[inline]`: with it, inlined into `insert`'s alpha loop, a step
-    /// cost 29 instructions more (`bench/instructions.sh`: 602 against 573
-    /// per event: the loop's set-up loaded its tables on every event);
-    /// `#[inline(never)]` cost 4 more than the compiler's choice.
-    fn mark_succ(&mut self, a: usize) {
-        let (s, e) = self.net.alpha[a].succ;
-        for i in s..e {
-            let b = self.net.succ[i as usize] as usize;
-            self.mark(b);
-        }
-    }
-
-    /// Re-evaluates the marked beta nodes, parents before children.
-    fn propagate(&mut self) {
-        if self.dirty_lo == usize::MAX {
-            return;
-        }
-        let mut w = self.dirty_lo;
-        while w <= self.dirty_hi {
-            let bits = self.dirty[w];
-            if bits == 0 {
-                w += 1;
-                continue;
-            }
-            let bit = bits.trailing_zeros() as usize;
-            self.dirty[w] &= !(1u64 << bit);
-            self.eval_beta(w * 64 + bit);
-        }
-        self.dirty_lo = usize::MAX;
-        self.dirty_hi = 0;
-    }
-
-    fn eval_beta(&mut self, b: usize) {
-        let node = &self.net.beta[b];
-        let parent_ok = node.parent == NONE || self.beta_tok[node.parent as usize];
-        let tok = parent_ok && {
-            let right = self.alpha_mem[node.alpha as usize] && self.join_tests(node);
-            right != node.negative
-        };
-        let was = self.beta_tok[b];
-        self.beta_tok[b] = tok;
-        if tok != was || (tok && node.refresh) {
-            // New, gone, or refreshed with join tests below that read the
-            // facts: the children re-evaluate.
-            let (s, e) = node.children;
-            for &c in &self.net.children[s as usize..e as usize] {
-                let c = c as usize;
-                let w = c / 64;
-                self.dirty[w] |= 1 << (c % 64);
-                self.dirty_hi = self.dirty_hi.max(w);
-            }
-        }
-        if tok != was {
-            let (s, e) = node.terminals;
-            for i in s..e {
-                let r = self.net.terminal_rules[i as usize];
-                self.set_active(r, tok);
-            }
-        }
-    }
-
-    #[inline]
-    fn join_tests(&self, node: &net::BetaRt) -> bool {
-        let (s, e) = node.tests;
-        if s == e {
-            return true;
-        }
-        let own = node.at as usize;
-        self.net.beta_tests[s as usize..e as usize].iter().all(|t| self.test(t, own))
-    }
-
-    fn set_active(&mut self, rule: u32, on: bool) {
-        let r = rule as usize;
-        if on && self.active_pos[r] == NONE {
-            self.active_pos[r] = self.active.len() as u32;
-            self.active.push(rule);
-        } else if !on && self.active_pos[r] != NONE {
-            let pos = self.active_pos[r] as usize;
-            self.active.swap_remove(pos);
-            if let Some(&moved) = self.active.get(pos) {
-                self.active_pos[moved as usize] = pos as u32;
-            }
-            self.active_pos[r] = NONE;
-        }
-    }
-
-    /// Every memory from scratch (construction, reset, hot swap).
-    fn recompute(&mut self) {
-        for a in 0..self.net.alpha.len() {
-            self.alpha_mem[a] = self.alpha_passes(a);
-        }
-        for r in std::mem::take(&mut self.active) {
-            self.active_pos[r as usize] = NONE;
-        }
-        self.beta_tok.fill(false);
-        self.dirty.fill(0);
-        for b in 0..self.net.beta.len() {
-            self.mark(b);
-        }
-        self.propagate();
     }
 }
 

@@ -81,7 +81,8 @@ pub struct EventRt {
     pub agent: u32,
     /// Its agent's payload offset.
     pub payload_at: u32,
-    /// Its fields' kinds, in `kinds`.
+    /// Its fields' kinds, in `kinds` (always inside it: `Net::new`
+    /// builds them so, and the payload check reads them unchecked).
     pub kinds: (u32, u32),
     /// Its alpha nodes, in `event_alpha`.
     pub alpha: (u32, u32),
@@ -89,6 +90,8 @@ pub struct EventRt {
     pub windows: (u32, u32),
     /// Its agent's `stale after`, ns (`u64::MAX`: never).
     pub stale_after: u64,
+    /// Its bit in the fast path's `Engine::have` (`fast::bit`).
+    pub bit: u64,
 }
 
 #[derive(Debug, Clone)]
@@ -135,7 +138,8 @@ pub struct Net {
     pub kinds: Vec<Kind>,
     /// Per event, what a step needs of it (the tables above, gathered).
     pub event: Vec<EventRt>,
-    /// Per state: whether it is final.
+    /// Per state: whether it is final (and `false` for any other state a
+    /// bundle that was not validated names: see `Net::new`).
     pub final_state: Vec<bool>,
 }
 
@@ -358,10 +362,19 @@ impl Net {
                     alpha: event_alpha_at[e],
                     windows: event_windows_at[e],
                     stale_after: stale_after[agent as usize],
+                    bit: super::fast::bit(e as u32),
                 }
             })
             .collect();
-        let final_state = c.states.iter().map(|s| s.is_final).collect();
+        let mut final_state: Vec<bool> = c.states.iter().map(|s| s.is_final).collect();
+        // An entry for every state the engine can be in (the initial one,
+        // a rule's target, one `force_state` checked), which
+        // `reset_if_final` reads unchecked: a bundle that was not validated
+        // may name others, which are not final.
+        let top = c.rules.iter().map(|r| r.target).chain([c.initial]).max().map_or(0, |s| s as usize + 1);
+        if final_state.len() < top {
+            final_state.resize(top, false);
+        }
         Net {
             event,
             final_state,

@@ -116,6 +116,30 @@ pub fn format_time(ns: u64) -> String {
     format!("{}.{:03}s", ns / 1_000_000_000, (ns / 1_000_000) % 1000)
 }
 
+/// Why [`Engine::step`](super::Engine::step) did not take an event, or
+/// what went wrong while it was processed: [`PostError`] without what it
+/// owns (a field's type, a cascade's firings), so that the hot path's
+/// result needs no drop and a refusal no allocation.
+/// [`Engine::post_error`](super::Engine::post_error) gives the
+/// [`PostError`] (right after the step: a cascade's firings are the step's
+/// record).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StepError {
+    /// No event has this id in the bundle.
+    UnknownEvent { event: u32 },
+    /// The payload has the wrong number of values.
+    Arity { event: u32, expected: usize, found: usize },
+    /// A value does not fit its field's type.
+    Type { event: u32, field: u32 },
+    /// Stamped before the same agent's latest accepted event.
+    OutOfOrder { event: u32, time: u64, last: u64 },
+    /// Stamped more than the skew bound ahead of the clock it arrived at.
+    FromTheFuture { event: u32, time: u64, clock: u64, max_skew: u64 },
+    /// The network did not come to rest within the bound (the firings are
+    /// the step's: [`Engine::last_change`](super::Engine::last_change)).
+    Cascade { limit: usize },
+}
+
 /// Why an event was not taken, or what went wrong while it was processed.
 #[derive(Debug, Clone, PartialEq)]
 pub enum PostError {

@@ -1,0 +1,681 @@
+//! The fast path: the same engine as the interpreter, the rules tested
+//! directly instead of through the network's memories.
+//!
+//! Each agent has at most one fact, so whether a rule is activated is a
+//! function of the working memory alone: the state, each agent's slot
+//! (event, run length, payload), its stale flag, and, for a window, the
+//! time at which its agent's fact was last evaluated (below). The
+//! interpreter keeps that function's value in the network's memories and
+//! updates it by propagation; the fast path evaluates it, and only where it
+//! can have become true:
+//! - at rest no rule is activated (that is what rest is);
+//! - after agent `a`'s fact becomes an event `e` (a post): the rules that
+//!   can be activated in the state, read `a`, and have no condition on `a`
+//!   that `e` makes false (a positive pattern of another event of `a`, a
+//!   positive `stale a`): `by_event[state][e]`;
+//! - after `a`'s fact expires or one of its windows closes: the rules that
+//!   can be activated in the state and read `a`: `by_agent[state][a]`;
+//! - after a firing sets the state `s`: every rule that can be activated in
+//!   `s`, `by_state[s]`;
+//! - out of rest (a new engine, a `force_*`, a cascade error): the
+//!   activated rules are computed whole into `Engine::active`, which is then
+//!   not empty, and the next rest starts from `by_state[state]`.
+//!
+//! Each list is in the order rules fire in (salience, then specificity,
+//! descending, then declaration order), so that the search for the rule
+//! that fires first stops after the first group of equal salience and
+//! specificity that has an activated rule (recency decides within it, then
+//! declaration order: the interpreter's `best`).
+//!
+//! A rule is flattened from its chain of beta nodes: its state guards (the
+//! guard minus its target) become the states whose lists hold it; every
+//! other node is a [`Cond`]: an agent's event, run length, window and tests
+//! (alpha and join tests together, every field resolved to its place in the
+//! payload arena, as the interpreter reads it), or its staleness, either of
+//! them negated. Firings are recorded by the interpreter's own
+//! `record_firing`, so that steps, recorded firings and explanations are
+//! the same. A bundle is declined (the interpreter runs it) only if a state
+//! or staleness node carries join tests (the compiler writes none), if its
+//! lists would exceed [`MAX_LIST_ENTRIES`], or if an index of its network
+//! is out of range (`Program::check`; a validated bundle has none).
+//!
+//! Windows: the interpreter evaluates an event alpha node's window when its
+//! fact is inserted and when expiry refreshes it; in between, now may pass
+//! a deadline without expiry (`advance_clock`, `force_fact`, then
+//! `settle`), and the network's memory keeps the earlier value. The fast
+//! path therefore tests a window against `Engine::checked[a]`, the now of
+//! the agent's last evaluation, which equals now whenever expiry is due
+//! on no deadline.
+
+use super::eval::{compare, float, in_range};
+use super::net::{Net, NONE};
+use super::{copy_payload, AgentRec, Engine, Slot, Step, StepError, AGENT};
+use situ_bundle::{AlphaNode, BetaKind, Check, Cmp, Content, Operand, Value};
+
+/// The most entries the candidate lists of a bundle may take (u32 each):
+/// beyond, the bundle is declined and the interpreter runs it.
+pub const MAX_LIST_ENTRIES: usize = 1 << 22;
+
+/// `Cond::event` of a staleness test.
+const STALE: u32 = u32::MAX - 1;
+
+/// An operand: a constant, or a place in the payload arena.
+#[derive(Debug, Clone, Copy)]
+enum Arg {
+    Value(Value),
+    At(u32),
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Check2 {
+    Compare { op: Cmp, rhs: Arg },
+    Range { lo: Arg, hi: Arg, inclusive: bool },
+}
+
+/// A test of the payload value at a place `x` of the arena. A float field
+/// against float constants, the usual test, has its own shape (the field's
+/// type is known from its event; a value of another type, which the
+/// payload check keeps out, would go to `compare` all the same).
+#[derive(Debug, Clone, Copy)]
+enum Test {
+    F64 { x: u32, op: Cmp, c: f64 },
+    F64Range { x: u32, lo: f64, hi: f64, inclusive: bool },
+    Any { x: u32, check: Check2 },
+}
+
+/// One condition of a rule on one agent's fact.
+#[derive(Debug, Clone, Copy)]
+struct Cond {
+    agent: u32,
+    /// The event its fact must be, or `STALE`: the agent must be stale.
+    event: u32,
+    negative: bool,
+    min_run: u64,
+    /// The window, ns (`u64::MAX`: none).
+    within: u64,
+    /// Its tests, in `Program::tests`.
+    tests: (u32, u32),
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Rule {
+    /// Its conditions, in `Program::conds`, in the chain's order.
+    conds: (u32, u32),
+    /// The rank of its (salience, specificity) among the rules': a larger
+    /// one fires first.
+    group: u32,
+    /// The events (below 64) its positive patterns need as facts, as bits:
+    /// the rule cannot hold unless `Engine::have` has them all.
+    need: u64,
+    /// The agents its positive patterns match (recency), in `Program::agents`.
+    matches: (u32, u32),
+}
+
+/// The rules of a bundle flattened for the fast path.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Program {
+    ne: usize,
+    na: usize,
+    /// Per `state * events + event`, per `state * agents + agent`, per
+    /// state: a list in `lists`.
+    by_event: Vec<(u32, u32)>,
+    by_agent: Vec<(u32, u32)>,
+    by_state: Vec<(u32, u32)>,
+    lists: Vec<u32>,
+    rules: Vec<Rule>,
+    conds: Vec<Cond>,
+    tests: Vec<Test>,
+    agents: Vec<u32>,
+}
+
+/// The activated rule that fires first among those seen so far (`rule`:
+/// `NONE` before one), its group, and its recency once needed (`u64::MAX`:
+/// not yet computed).
+#[derive(Debug, Clone, Copy)]
+struct Best {
+    rule: u32,
+    group: u32,
+    recency: u64,
+}
+
+/// An event's bit in [`Engine::have`] (`0` from event 64 on: no bit).
+#[inline(always)]
+pub(super) fn bit(event: u32) -> u64 {
+    1u64.checked_shl(event).unwrap_or(0)
+}
+
+/// `v[i]` without the bounds check.
+///
+/// # Safety
+/// `i < v.len()`. Every index this module takes from the program (lists,
+/// rules, conditions, tests, agents, places in the arena) is checked once
+/// by [`Program::check`] when the program is built, against the engine's
+/// tables, whose lengths never change after construction
+/// `agents`: one per agent; `payload`: the arena's length); the
+/// state is always a state of the bundle and the event of a step one the
+/// payload check took.
+#[inline(always)]
+unsafe fn at<T>(v: &[T], i: usize) -> &T {
+    debug_assert!(i < v.len(), "{i} >= {}", v.len());
+    // SAFETY: the caller's.
+    unsafe { v.get_unchecked(i) }
+}
+
+/// `&mut v[i]` without the bounds check.
+///
+/// # Safety
+/// As [`at`].
+#[inline(always)]
+unsafe fn at_mut<T>(v: &mut [T], i: usize) -> &mut T {
+    debug_assert!(i < v.len(), "{i} >= {}", v.len());
+    // SAFETY: the caller's.
+    unsafe { v.get_unchecked_mut(i) }
+}
+
+impl Program {
+    /// The program of a validated bundle, or why the fast path declines it.
+    // The lists are built per state and agent, the tables indexed per rule.
+    #[allow(clippy::needless_range_loop)]
+    pub(super) fn new(c: &Content, net: &Net) -> Result<Program, &'static str> {
+        let ns = c.states.len();
+        let ne = c.events.len();
+        let na = c.agents.len();
+        let n = &c.network;
+        let mut p = Program { ne, na, ..Program::default() };
+        let arg = |o: &Operand, own: u32| -> Result<Arg, &'static str> {
+            Ok(match *o {
+                Operand::Value(v) => Arg::Value(v),
+                Operand::Own { field } => Arg::At(place(net, own, field)?),
+                Operand::Fact { agent, field } => {
+                    let a = agent as usize;
+                    if a >= na {
+                        return Err("a test reads an agent out of range");
+                    }
+                    if field < net.stride[a] {
+                        Arg::At(net.payload_at[a] + field)
+                    } else {
+                        // As the interpreter: a value that matches nothing.
+                        Arg::Value(Value::F64(f64::NAN))
+                    }
+                }
+            })
+        };
+        // Per rule: the states it can be activated in, the agents it reads.
+        let mut ok_states: Vec<Vec<bool>> = Vec::with_capacity(c.rules.len());
+        let mut reads: Vec<Vec<bool>> = Vec::with_capacity(c.rules.len());
+        let mut terminal = vec![NONE; c.rules.len()];
+        for t in &n.terminals {
+            terminal[t.rule as usize] = t.beta;
+        }
+        for (r, rule) in c.rules.iter().enumerate() {
+            let mut chain = Vec::new();
+            let mut b = terminal[r];
+            while b != NONE {
+                if chain.len() > n.beta.len() {
+                    return Err("a chain of beta nodes loops");
+                }
+                chain.push(b);
+                b = n.beta[b as usize].parent.unwrap_or(NONE);
+            }
+            if chain.is_empty() {
+                return Err("a rule without a terminal");
+            }
+            chain.reverse();
+            let mut ok = vec![true; ns];
+            let mut read = vec![false; na];
+            let c0 = p.conds.len();
+            for &b in &chain {
+                let beta = &n.beta[b as usize];
+                let negative = beta.kind == BetaKind::Negative;
+                match &n.alpha[beta.alpha as usize] {
+                    AlphaNode::State { states } => {
+                        if !beta.tests.is_empty() {
+                            return Err("join tests on a state node");
+                        }
+                        for (s, o) in ok.iter_mut().enumerate() {
+                            *o &= states.contains(&(s as u32)) != negative;
+                        }
+                    }
+                    AlphaNode::Stale { agent } => {
+                        if !beta.tests.is_empty() {
+                            return Err("join tests on a staleness node");
+                        }
+                        read[*agent as usize] = true;
+                        p.conds.push(Cond {
+                            agent: *agent,
+                            event: STALE,
+                            negative,
+                            min_run: 0,
+                            within: u64::MAX,
+                            tests: (0, 0),
+                        });
+                    }
+                    AlphaNode::Event { event, tests, min_run, within_ns } => {
+                        let agent = c.events[*event as usize].agent;
+                        read[agent as usize] = true;
+                        let own = net.payload_at[agent as usize];
+                        let t0 = p.tests.len() as u32;
+                        for t in tests.iter().chain(&beta.tests) {
+                            let x = place(net, own, t.field)?;
+                            let float = c.events[*event as usize]
+                                .fields
+                                .get(t.field as usize)
+                                .is_some_and(|f| f.ty == situ_bundle::FieldType::F64);
+                            let test = match &t.check {
+                                Check::Compare { op, rhs: Operand::Value(Value::F64(c)) } if float => {
+                                    Test::F64 { x, op: *op, c: *c }
+                                }
+                                Check::Range {
+                                    lo: Operand::Value(Value::F64(lo)),
+                                    hi: Operand::Value(Value::F64(hi)),
+                                    inclusive,
+                                } if float => Test::F64Range { x, lo: *lo, hi: *hi, inclusive: *inclusive },
+                                Check::Compare { op, rhs } => {
+                                    Test::Any { x, check: Check2::Compare { op: *op, rhs: arg(rhs, own)? } }
+                                }
+                                Check::Range { lo, hi, inclusive } => Test::Any {
+                                    x,
+                                    check: Check2::Range {
+                                        lo: arg(lo, own)?,
+                                        hi: arg(hi, own)?,
+                                        inclusive: *inclusive,
+                                    },
+                                },
+                            };
+                            for o in operands(&t.check) {
+                                if let Operand::Fact { agent, .. } = o {
+                                    read[*agent as usize] = true;
+                                }
+                            }
+                            p.tests.push(test);
+                        }
+                        p.conds.push(Cond {
+                            agent,
+                            event: *event,
+                            negative,
+                            min_run: *min_run,
+                            within: within_ns.unwrap_or(u64::MAX),
+                            tests: (t0, p.tests.len() as u32),
+                        });
+                    }
+                }
+            }
+            let m0 = p.agents.len() as u32;
+            p.agents.extend_from_slice(&rule.matches);
+            let need =
+                p.conds[c0..].iter().filter(|c| !c.negative && c.event != STALE).fold(0, |m, c| m | bit(c.event));
+            p.rules.push(Rule {
+                conds: (c0 as u32, p.conds.len() as u32),
+                group: 0,
+                need,
+                matches: (m0, p.agents.len() as u32),
+            });
+            ok_states.push(ok);
+            reads.push(read);
+        }
+
+        // The rules in the order they fire in, all else equal, and the rank
+        // of each one's (salience, specificity).
+        let prio = |r: u32| (c.rules[r as usize].salience, c.rules[r as usize].specificity);
+        let mut order: Vec<u32> = (0..c.rules.len() as u32).collect();
+        order.sort_by_key(|&r| (std::cmp::Reverse(prio(r)), r));
+        let mut groups: Vec<(i64, u32)> = order.iter().map(|&r| prio(r)).collect();
+        groups.dedup();
+        for r in 0..c.rules.len() {
+            let rank = groups.len() - 1 - groups.iter().position(|&g| g == prio(r as u32)).unwrap_or(0);
+            p.rules[r].group = rank as u32;
+        }
+        // Whether `e` (of agent `a`) makes a condition of `r` on `a` false.
+        let excluded = |p: &Program, r: u32, a: u32, e: u32| {
+            let (s, t) = p.rules[r as usize].conds;
+            p.conds[s as usize..t as usize].iter().any(|c| c.agent == a && !c.negative && c.event != e)
+        };
+        let push = |p: &mut Program, keep: &dyn Fn(&Program, u32) -> bool| -> Result<(u32, u32), &'static str> {
+            let s = p.lists.len();
+            for &r in &order {
+                if keep(p, r) {
+                    p.lists.push(r);
+                }
+            }
+            if p.lists.len() > MAX_LIST_ENTRIES {
+                return Err("its candidate lists are too large");
+            }
+            Ok((s as u32, p.lists.len() as u32))
+        };
+        for s in 0..ns {
+            let l = push(&mut p, &|_, r| ok_states[r as usize][s])?;
+            p.by_state.push(l);
+            for a in 0..na {
+                let l = push(&mut p, &|_, r| ok_states[r as usize][s] && reads[r as usize][a])?;
+                p.by_agent.push(l);
+            }
+            for e in 0..ne {
+                let a = c.events[e].agent;
+                let l = push(&mut p, &|p, r| {
+                    ok_states[r as usize][s] && reads[r as usize][a as usize] && !excluded(p, r, a, e as u32)
+                })?;
+                p.by_event.push(l);
+            }
+        }
+        p.check(ns, net)?;
+        Ok(p)
+    }
+
+    /// Checks every index of the program against the tables it indexes:
+    /// the invariant under which the engine reads them unchecked ([`at`]).
+    fn check(&self, ns: usize, net: &Net) -> Result<(), &'static str> {
+        let payload_len = net.payload_len;
+        // The events' agents, their places and windows (`fast_insert`).
+        let events = net.event.len() == self.ne
+            && net.timed_agents.iter().all(|&a| (a as usize) < self.na)
+            && net.event.iter().all(|e| {
+                (e.agent as usize) < self.na
+                    && e.payload_at as usize + (e.kinds.1 - e.kinds.0) as usize <= payload_len
+                    && e.windows.0 <= e.windows.1
+                    && e.windows.1 as usize <= net.windows.len()
+            });
+        let range = |(s, e): (u32, u32), len: usize| s <= e && e as usize <= len;
+        let lists = self.by_state.len() == ns
+            && self.by_agent.len() == ns * self.na
+            && self.by_event.len() == ns * self.ne
+            && self.by_state.iter().chain(&self.by_agent).chain(&self.by_event).all(|&l| range(l, self.lists.len()))
+            && self.lists.iter().all(|&r| (r as usize) < self.rules.len());
+        let rules = self.rules.iter().all(|r| range(r.conds, self.conds.len()) && range(r.matches, self.agents.len()))
+            && self.agents.iter().all(|&a| (a as usize) < self.na);
+        let conds = self.conds.iter().all(|c| (c.agent as usize) < self.na && range(c.tests, self.tests.len()));
+        let place = |i: u32| (i as usize) < payload_len;
+        let arg = |a: Arg| match a {
+            Arg::Value(_) => true,
+            Arg::At(i) => place(i),
+        };
+        let tests = self.tests.iter().all(|t| match *t {
+            Test::F64 { x, .. } | Test::F64Range { x, .. } => place(x),
+            Test::Any { x, check: Check2::Compare { rhs, .. } } => place(x) && arg(rhs),
+            Test::Any { x, check: Check2::Range { lo, hi, .. } } => place(x) && arg(lo) && arg(hi),
+        });
+        if events && lists && rules && conds && tests {
+            Ok(())
+        } else {
+            Err("an index of the program out of its table")
+        }
+    }
+}
+
+/// The place in the arena of field `field` of the agent whose payload starts
+/// at `own`, if the arena has it (the interpreter reads the same place).
+fn place(net: &Net, own: u32, field: u32) -> Result<u32, &'static str> {
+    let x = own as usize + field as usize;
+    if x < net.payload_len {
+        Ok(x as u32)
+    } else {
+        Err("a test reads a field out of the payload arena")
+    }
+}
+
+fn operands(c: &Check) -> Vec<&Operand> {
+    match c {
+        Check::Compare { rhs, .. } => vec![rhs],
+        Check::Range { lo, hi, .. } => vec![lo, hi],
+    }
+}
+
+impl Engine {
+    /// [`accepted`](Self::accepted) on the fast path.
+    #[inline(always)]
+    pub(super) fn fast_accepted(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Step, StepError> {
+        self.begin();
+        if time > self.now {
+            self.now = time;
+        }
+        if self.now > self.next_deadline {
+            self.fast_expire();
+        }
+        // Not at rest, or facts expired: one test for both.
+        if (self.active.len() | self.touched.len()) != 0 {
+            self.fast_rest(NONE)?;
+        }
+        self.fast_insert(event, time, payload);
+        if self.now > self.next_deadline {
+            // The fact came late: it may be expired already.
+            self.fast_expire();
+        }
+        self.fast_rest(event)?;
+        Ok(Step { from: self.record.from, to: self.state, firings: self.record.firings.len() })
+    }
+
+    /// [`insert`](Self::insert) without the network.
+    #[inline(always)]
+    pub(super) fn fast_insert(&mut self, event: u32, time: u64, payload: &[Value]) {
+        // SAFETY (`at`, `at_mut`): the event was taken by the payload check
+        // (it is the bundle's, and `payload` fits it); its agent, its
+        // place and its windows are checked (`Program::check`); the tables
+        // indexed by agent have one entry per agent.
+        let ev = unsafe { *at(&self.net.event, event as usize) };
+        let a = ev.agent as usize;
+        // `u64::MAX` (never) stays `u64::MAX`.
+        let stale_at = time.saturating_add(ev.stale_after);
+        let window_at = if ev.windows.0 == ev.windows.1 { u64::MAX } else { self.next_window(ev.windows, time) };
+        self.seq += 1;
+        let (seq, now) = (self.seq, self.now);
+        let r = unsafe { at_mut(&mut self.agents, a) };
+        let old = r.slot;
+        let run = if old.event == event { old.run + 1 } else { 1 };
+        r.slot = Slot { event, time, run, seq };
+        let old_bit = std::mem::replace(&mut r.bit, ev.bit);
+        r.last = r.last.max(time);
+        r.stale = false;
+        r.checked = now;
+        r.stale_at = stale_at;
+        r.window_at = window_at;
+        self.have = (self.have & !old_bit) | ev.bit;
+        // SAFETY: the event's place and its fields fit in the arena
+        // (`Program::check`), and `payload` has as many values as it has
+        // fields (the payload check).
+        copy_payload(unsafe { self.payload.get_unchecked_mut(ev.payload_at as usize..) }, payload);
+        self.next_deadline = self.next_deadline.min(stale_at).min(window_at);
+    }
+
+    /// [`expire`](Self::expire) without the network: the agents whose fact
+    /// expired or whose window closed are noted in `touched`.
+    pub(super) fn fast_expire(&mut self) {
+        let (now, mut next) = (self.now, u64::MAX);
+        for i in 0..self.net.timed_agents.len() {
+            // SAFETY (`at`, `at_mut`): the timed agents are agents
+            // (`Program::check`), `agents` has one record per agent.
+            let a = unsafe { *at(&self.net.timed_agents, i) } as usize;
+            let r = unsafe { at_mut(&mut self.agents, a) };
+            if r.stale_at < now {
+                self.have &= !r.bit;
+                *r = AgentRec { last: r.last, checked: r.checked, stale: true, ..AGENT };
+                self.touched.push(a as u32);
+            } else if r.window_at < now {
+                let slot = r.slot;
+                let window_at = self.next_window(self.net.event[slot.event as usize].windows, slot.time);
+                let r = unsafe { at_mut(&mut self.agents, a) };
+                r.checked = now;
+                r.window_at = window_at;
+                self.touched.push(a as u32);
+            }
+            let r = unsafe { at(&self.agents, a) };
+            next = next.min(r.stale_at).min(r.window_at);
+        }
+        self.next_deadline = next;
+    }
+
+    /// [`rest`](Self::rest) on the fast path. The first search covers what
+    /// changed since the last rest: every rule of the state if the engine
+    /// was not at rest (`active` not empty), else the rules of `event`'s new
+    /// fact (`NONE`: none) and of the agents in `touched`. With an event,
+    /// the engine was at rest before its fact was inserted (a rest came
+    /// first, or an error returned).
+    #[inline(always)]
+    pub(super) fn fast_rest(&mut self, event: u32) -> Result<(), StepError> {
+        let mut best = Best { rule: NONE, group: 0, recency: u64::MAX };
+        let st = self.state as usize;
+        if event == NONE && !self.active.is_empty() {
+            // SAFETY (`at`): the state is a state of the bundle.
+            self.fast_best_in(unsafe { *at(&self.fp.by_state, st) }, &mut best);
+            self.active.clear();
+        } else {
+            if event != NONE {
+                // SAFETY (`at`): the state and the event (taken by the
+                // payload check) are the bundle's: `st * ne + event < ns * ne`.
+                let list = unsafe { *at(&self.fp.by_event, st * self.fp.ne + event as usize) };
+                self.fast_best_in(list, &mut best);
+            }
+            if !self.touched.is_empty() {
+                for i in 0..self.touched.len() {
+                    let a = self.touched[i] as usize;
+                    self.fast_best_in(self.fp.by_agent[st * self.fp.na + a], &mut best);
+                }
+                self.touched.clear();
+            }
+        }
+        if best.rule == NONE {
+            return Ok(());
+        }
+        self.fast_fire(best)
+    }
+
+    /// Fires `best`, then the rule that fires first in each new state,
+    /// until none is activated; the bound counts the firings of the step.
+    #[inline(never)]
+    fn fast_fire(&mut self, mut best: Best) -> Result<(), StepError> {
+        while best.rule != NONE {
+            if self.record.firings.len() == self.cascade_limit {
+                self.fast_activate();
+                return Err(StepError::Cascade { limit: self.cascade_limit });
+            }
+            self.state = self.record_firing(best.rule);
+            best = Best { rule: NONE, group: 0, recency: u64::MAX };
+            self.fast_best_in(self.fp.by_state[self.state as usize], &mut best);
+        }
+        Ok(())
+    }
+
+    /// The activated rule of the list `(s, e)` that fires first, if it fires
+    /// before `best` (§10.4: salience, specificity, recency, declaration
+    /// order, as [`best`](Self::best)).
+    #[inline(always)]
+    fn fast_best_in(&self, (s, e): (u32, u32), best: &mut Best) {
+        let p = &*self.fp;
+        let (mut i, e) = (s as usize, e as usize);
+        while i < e {
+            // SAFETY (`at`): lists and their entries are checked.
+            let r = unsafe { *at(&p.lists, i) };
+            let rule = unsafe { at(&p.rules, r as usize) };
+            i += 1;
+            if best.rule != NONE && rule.group < best.group {
+                // The list is in firing order: no later rule comes first.
+                return;
+            }
+            if rule.need & self.have != rule.need || !self.fast_holds(rule) {
+                continue;
+            }
+            if best.rule == NONE || rule.group > best.group {
+                *best = Best { rule: r, group: rule.group, recency: u64::MAX };
+                continue;
+            }
+            // The same salience and specificity: recency, then the rule
+            // declared first.
+            if best.recency == u64::MAX {
+                best.recency = self.fast_recency(unsafe { at(&p.rules, best.rule as usize) });
+            }
+            let recency = self.fast_recency(rule);
+            if recency > best.recency || (recency == best.recency && r < best.rule) {
+                *best = Best { rule: r, group: rule.group, recency };
+            }
+        }
+    }
+
+    fn fast_recency(&self, rule: &Rule) -> u64 {
+        let (s, e) = rule.matches;
+        self.fp.agents[s as usize..e as usize].iter().map(|&a| self.agents[a as usize].slot.seq).max().unwrap_or(0)
+    }
+
+    /// Whether the rule's conditions hold (its state guard is its lists').
+    #[inline(always)]
+    fn fast_holds(&self, rule: &Rule) -> bool {
+        let (mut i, e) = (rule.conds.0 as usize, rule.conds.1 as usize);
+        while i < e {
+            // SAFETY (`at`): the rule's conditions are checked.
+            if !self.fast_cond(unsafe { at(&self.fp.conds, i) }) {
+                return false;
+            }
+            i += 1;
+        }
+        true
+    }
+
+    #[inline(always)]
+    fn fast_cond(&self, c: &Cond) -> bool {
+        let a = c.agent as usize;
+        // SAFETY (`at`): a condition's agent is checked, and `agents` has
+        // one record per agent.
+        let r = unsafe { at(&self.agents, a) };
+        let pos = if c.event == STALE {
+            r.stale
+        } else {
+            let slot = &r.slot;
+            slot.event == c.event
+                && slot.run >= c.min_run
+                && (c.within == u64::MAX || r.checked.saturating_sub(slot.time) <= c.within)
+                && (c.tests.0 == c.tests.1 || self.fast_tests(c.tests))
+        };
+        pos != c.negative
+    }
+
+    fn fast_tests(&self, (s, e): (u32, u32)) -> bool {
+        for i in s as usize..e as usize {
+            // SAFETY (`at`): tests and their places in the arena are checked.
+            let pass = match unsafe { *at(&self.fp.tests, i) } {
+                Test::F64 { x, op, c } => match unsafe { *at(&self.payload, x as usize) } {
+                    Value::F64(v) => float(op, v, c),
+                    other => compare(op, other, Value::F64(c)),
+                },
+                Test::F64Range { x, lo, hi, inclusive } => match unsafe { *at(&self.payload, x as usize) } {
+                    Value::F64(v) => v >= lo && if inclusive { v <= hi } else { v < hi },
+                    other => in_range(other, Value::F64(lo), Value::F64(hi), inclusive),
+                },
+                Test::Any { x, check } => {
+                    let x = unsafe { *at(&self.payload, x as usize) };
+                    match check {
+                        Check2::Compare { op, rhs } => compare(op, x, self.arg(rhs)),
+                        Check2::Range { lo, hi, inclusive } => in_range(x, self.arg(lo), self.arg(hi), inclusive),
+                    }
+                }
+            };
+            if !pass {
+                return false;
+            }
+        }
+        true
+    }
+
+    #[inline]
+    fn arg(&self, a: Arg) -> Value {
+        match a {
+            Arg::Value(v) => v,
+            // SAFETY (`at`): places in the arena are checked.
+            Arg::At(i) => unsafe { *at(&self.payload, i as usize) },
+        }
+    }
+
+    /// Out of rest: the activated rules, whole, into `active` (in
+    /// declaration order), which the next rest starts from.
+    pub(super) fn fast_activate(&mut self) {
+        debug_assert!(self.agents.len() == self.fp.na);
+        let mut active = std::mem::take(&mut self.active);
+        active.clear();
+        let (s, e) = self.fp.by_state[self.state as usize];
+        for i in s as usize..e as usize {
+            let r = self.fp.lists[i];
+            let rule = &self.fp.rules[r as usize];
+            if rule.need & self.have == rule.need && self.fast_holds(rule) {
+                active.push(r);
+            }
+        }
+        active.sort_unstable();
+        self.active = active;
+    }
+}
