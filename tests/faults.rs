@@ -93,6 +93,7 @@ fn a_router_killed_and_started_again_carries_the_mission_on() {
 fn delay_and_loss_between_hosts_keep_the_safe_mode_rule() {
     let l = lossy_for_12_s(false);
     eprintln!("50 ms delay, 5 % loss, 12 s: {}", l.figures());
+    l.monotonic.as_ref().unwrap_or_else(|e| panic!("{e}"));
     kept_the_safe_mode_rule_and_the_mission(&l);
 }
 
@@ -101,12 +102,18 @@ fn delay_and_loss_between_hosts_keep_the_safe_mode_rule() {
 /// the sensors' link (or a loaded machine) rightly make it an emergency
 /// and a stop, which is not what these tests are about (the soak runs the
 /// file's 500 ms and reports it).
+///
+/// With two boards the routes' least RTO is 20 ms, as docs/reliability.md
+/// advises for a lossy network: under Linux's 200 ms a segment lost twice
+/// stalls the boards' link for 600 ms, past the lease (450 ms), and the
+/// follower takes the late beats for a dead leader (a false takeover, seen
+/// once in CI; `soak_two_boards` counts them under both).
 fn lossy_for_12_s(two_boards: bool) -> scenarios::Lossy {
     delay_and_loss(&LossySettings {
         delay_ms: 50,
         loss_percent: 5,
         lasting: Duration::from_secs(12),
-        rto_min_ms: None,
+        rto_min_ms: two_boards.then_some(20),
         stale: Some("3s"),
         two_boards,
     })
@@ -184,6 +191,7 @@ fn two_boards_under_delay_and_loss_keep_one_leader() {
     // a late beat for a dead leader (the lease, 450 ms, is longer than a
     // single loss's 200 ms stall and the 100 ms round trip).
     let l = lossy_for_12_s(true);
+    // (With one epoch throughout, nothing can go back: `l.monotonic`.)
     eprintln!("two boards, 50 ms delay, 5 % loss, 12 s: {}", l.figures());
     // One leader throughout: every status the agents' host saw carried the
     // first leader's epoch, and the standby never said it leads.
@@ -208,8 +216,8 @@ fn a_router_down_longer_than_the_lease_under_two_boards_ends_with_one_leader() {
     // lease: no takeover.)
     let r = restart_router(Duration::from_millis(1000), Some("5s"), true);
     eprintln!("router down 1 s, two boards: {}; leaders seen (epoch, board): {:?}", router_figures(&r), r.epochs);
-    // restart_router checked that no epoch seen went back. The standby
-    // took over while the router was down …
+    // restart_router checked that `seq` never went back within an epoch.
+    // The standby took over while the router was down …
     let boards: Vec<Option<&str>> = r.epochs.iter().map(|e| e.1.as_deref()).collect();
     assert!(r.epochs.len() >= 2 && boards.contains(&Some("standby")), "no takeover: {r:#?}");
     // … and once the router was back one leader remained: the statuses of
@@ -374,15 +382,18 @@ fn soak_partition() {
 #[ignore = "a benchmark: cargo test -p situ --features zenoh --test faults -- --ignored --nocapture soak"]
 fn soak_two_boards() {
     let lasting = Duration::from_secs(env_or("SITU_SOAK_SECONDS", 60));
-    let s =
-        LossySettings { delay_ms: 50, loss_percent: 5, lasting, rto_min_ms: None, stale: Some("3s"), two_boards: true };
-    let l = delay_and_loss(&s);
-    eprintln!(
-        "soak: two boards, 50 ms delay, 5 % loss: false takeovers {}; {}; the boards said: {:?}",
-        l.epochs.len() - 1,
-        l.figures(),
-        l.leadership
-    );
+    for rto_min_ms in [None, Some(20)] {
+        let s =
+            LossySettings { delay_ms: 50, loss_percent: 5, lasting, rto_min_ms, stale: Some("3s"), two_boards: true };
+        let l = delay_and_loss(&s);
+        let rto = rto_min_ms.map_or("200 ms (Linux's)".to_string(), |ms| format!("{ms} ms"));
+        eprintln!(
+            "soak: two boards, 50 ms delay, 5 % loss, rto_min {rto}: false takeovers {}; {}; the boards said: {:?}",
+            l.epochs.iter().map(|e| e.0).collect::<std::collections::BTreeSet<_>>().len().saturating_sub(1),
+            l.figures(),
+            l.leadership
+        );
+    }
     let (mut gaps, mut backs, mut safe, mut takeovers, mut two_at_end, mut stopped) =
         (Vec::new(), Vec::new(), 0, 0, 0, 0);
     let rounds = env_or("SITU_SOAK_ROUNDS", 10);
