@@ -22,6 +22,9 @@
 //! # name = "board-b"                 # docs/reliability.md): the first listed
 //! # board = true                     # leads at start, the others follow its log
 //! # listen = ["tcp/127.0.0.1:7450"]  # and one of them leads when it falls silent
+//! # beats = { listen = "udp/127.0.0.1:7461", send = ["udp/127.0.0.1:7460"] }
+//! #                                  # optional, on each board: the leader's beats
+//! #                                  # over UDP too (a lossy network; `crate::beats`)
 //!
 //! # [standby]                        # optional, with two boards or more
 //! # lease_ms = 400                   # a follower leads after this long without the leader
@@ -165,6 +168,20 @@ pub struct Process {
     /// the file's directory ([`Deployment::journal`]).
     #[serde(default)]
     pub journal: Option<PathBuf>,
+    /// A board of a standby group: where it hears the other boards' beats
+    /// over UDP, and where it sends its own while it leads
+    /// ([`crate::beats`]).
+    #[serde(default)]
+    pub beats: Option<BeatsSettings>,
+}
+
+/// `beats = { listen = "udp/HOST:PORT", send = ["udp/HOST:PORT", …] }`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BeatsSettings {
+    pub listen: String,
+    #[serde(default)]
+    pub send: Vec<String>,
 }
 
 impl Process {
@@ -317,6 +334,23 @@ impl Deployment {
                     p.name
                 )));
             }
+            if let Some(b) = &p.beats {
+                if !p.board || boards.len() < 2 {
+                    return Err(DeployError(format!(
+                        "process `{}`: `beats` belongs to the boards of a standby group (two processes or more with \
+                         `board = true`)",
+                        p.name
+                    )));
+                }
+                for e in std::iter::once(&b.listen).chain(&b.send) {
+                    if !crate::beats::is_endpoint(e) {
+                        return Err(DeployError(format!(
+                            "process `{}`: `beats`: endpoint `{e}` is not `udp/HOST:PORT`",
+                            p.name
+                        )));
+                    }
+                }
+            }
             if p.mode == Mode::Client && p.connect.is_empty() {
                 return Err(DeployError(format!(
                     "process `{}`: a client talks through what it connects to: give it `connect` (the router)",
@@ -395,6 +429,19 @@ impl Deployment {
             config.give_up = ms(v);
         }
         Some(config)
+    }
+
+    /// Where `process` hears the boards' beats over UDP and where it sends
+    /// its own, the hosts resolved; `None` when it has no `beats`.
+    pub fn beats(&self, process: &Process) -> Result<Option<crate::beats::Beats>, DeployError> {
+        let Some(b) = &process.beats else { return Ok(None) };
+        let resolve = |e: &str| {
+            crate::beats::resolve(e).map_err(|why| DeployError(format!("process `{}`: `beats`: {why}", process.name)))
+        };
+        Ok(Some(crate::beats::Beats {
+            listen: resolve(&b.listen)?,
+            send: b.send.iter().map(|e| resolve(e)).collect::<Result<_, _>>()?,
+        }))
     }
 
     /// A board's place among the boards (0 leads at start), if it is one.
@@ -548,6 +595,23 @@ connect = ["tcp/127.0.0.1:7447"]
     }
 
     #[test]
+    fn a_board_s_beats_are_resolved_to_addresses() {
+        let text = format!(
+            "{GOOD}[[process]]\nname = \"b2\"\nboard = true\n\
+             beats = {{ listen = \"udp/127.0.0.1:7461\", send = [\"udp/127.0.0.1:7460\", \"udp/localhost:7462\"] }}\n"
+        );
+        let d = Deployment::parse(&text, &agents()).unwrap();
+        let beats = d.beats(d.process("b2").unwrap()).unwrap().unwrap();
+        assert_eq!(beats.listen, "127.0.0.1:7461".parse().unwrap());
+        assert_eq!(beats.send.iter().map(|a| a.port()).collect::<Vec<_>>(), [7460, 7462]);
+        assert_eq!(d.beats(d.process("board").unwrap()).unwrap(), None);
+        let unknown = text.replace("udp/localhost:7462", "udp/no-such-host.invalid:7462");
+        let d = Deployment::parse(&unknown, &agents()).unwrap();
+        let e = d.beats(d.process("b2").unwrap()).unwrap_err().to_string();
+        assert!(e.starts_with("process `b2`: `beats`: `udp/no-such-host.invalid:7462`: "), "{e}");
+    }
+
+    #[test]
     fn bad_files_say_what_is_wrong() {
         let cases = [
             (GOOD.replace("board = true", ""), "no process hosts the Bulletinboard"),
@@ -582,6 +646,27 @@ connect = ["tcp/127.0.0.1:7447"]
             (
                 GOOD.replace("agents = [", "journal = \"s.journal\"\nagents = ["),
                 "process `sensors`: `journal` belongs to the process that hosts the Bulletinboard",
+            ),
+            (
+                GOOD.replace("board = true", "board = true\nbeats = { listen = \"udp/127.0.0.1:7460\" }"),
+                "process `board`: `beats` belongs to the boards of a standby group",
+            ),
+            (
+                format!(
+                    "{GOOD}[[process]]\nname = \"b2\"\nboard = true\nbeats = {{ listen = \"tcp/127.0.0.1:7460\" }}\n"
+                ),
+                "process `b2`: `beats`: endpoint `tcp/127.0.0.1:7460` is not `udp/HOST:PORT`",
+            ),
+            (
+                format!(
+                    "{GOOD}[[process]]\nname = \"b2\"\nboard = true\nbeats = {{ listen = \"udp/127.0.0.1:1\", \
+                     send = [\"udp/127.0.0.1\"] }}\n"
+                ),
+                "endpoint `udp/127.0.0.1` is not `udp/HOST:PORT`",
+            ),
+            (
+                format!("{GOOD}[[process]]\nname = \"b2\"\nboard = true\nbeats = {{ listen = \"udp/127.0.0.1:1\", to = [] }}\n"),
+                "unknown field `to`",
             ),
         ];
         for (text, want) in cases {

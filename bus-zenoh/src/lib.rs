@@ -13,6 +13,7 @@
 //! and urgent data are sent `express` (no batching: latency first); data
 //! is batched (throughput first).
 
+pub mod beats;
 pub mod deploy;
 pub mod limit;
 pub mod standby;
@@ -191,7 +192,7 @@ impl ZenohBus {
         let old_epoch = Arc::new(AtomicU64::new(0));
         let peers = match (&group, placement.board) {
             (Some(g), true) => {
-                Some(Arc::new(standby::BoardPeers::new(g, &robot, session.clone(), content.clone(), local.clone())))
+                Some(Arc::new(standby::BoardPeers::new(g, &robot, session.clone(), content.clone(), local.clone())?))
             }
             _ => None,
         };

@@ -7,8 +7,11 @@
 //! | `situ/<robot>/board/sync/<from>` | a query, answered with [`BatchWire`]s | a board catching up | the leading board |
 //!
 //! A board also reads the status (`situ/<robot>/status`): a status of a
-//! higher epoch from another board means that board leads.
+//! higher epoch from another board means that board leads. With `beats`
+//! ([`crate::beats`]) the leader's beats also go as UDP datagrams, which
+//! keep alive the leader heard here when TCP stalls.
 
+use crate::beats::{BeatLink, Beats, Hears};
 use crate::wire::{self, EventWire, StatusWire, VERSION};
 use serde::{Deserialize, Serialize};
 use situ_compiler::bundle::Content;
@@ -138,6 +141,16 @@ pub struct BoardGroup {
     /// A follower not heard from for this long is not waited for.
     pub lease: Duration,
     pub log: SharedLog,
+    /// Where it hears and sends the leader's beats over UDP, if it does.
+    pub beats: Option<Beats>,
+}
+
+/// The leader last heard over Zenoh: its epoch, its name, when.
+#[derive(Debug, Clone)]
+struct Heard {
+    epoch: u64,
+    board: String,
+    at: Instant,
 }
 
 /// What arrives from the other boards (also from Zenoh's threads, for
@@ -147,8 +160,23 @@ struct Inbox {
     content: Arc<Content>,
     local: Arc<InProc>,
     incoming: Mutex<Vec<Batch>>,
-    heard: Mutex<Option<(u64, Instant)>>,
+    heard: Mutex<Option<Heard>>,
     refused: AtomicU64,
+}
+
+impl Hears for Inbox {
+    /// A beat over UDP renews the leader heard over Zenoh, and only it:
+    /// the same board at the same epoch ([`crate::beats`]).
+    fn alive(&self, board: &str, epoch: u64) {
+        let mut h = self.heard.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some(heard) = h.as_mut().filter(|h| h.epoch == epoch && h.board == board) {
+            heard.at = Instant::now();
+        }
+    }
+
+    fn refused(&self) {
+        self.refused.fetch_add(1, Ordering::Relaxed);
+    }
 }
 
 impl Inbox {
@@ -157,9 +185,9 @@ impl Inbox {
             return;
         }
         let mut h = self.heard.lock().unwrap_or_else(|p| p.into_inner());
-        match *h {
-            Some((e, _)) if e > epoch => {}
-            _ => *h = Some((epoch, Instant::now())),
+        match &*h {
+            Some(heard) if heard.epoch > epoch => {}
+            _ => *h = Some(Heard { epoch, board: board.to_string(), at: Instant::now() }),
         }
     }
 
@@ -191,6 +219,7 @@ pub struct BoardPeers {
     acked: Condvar,
     leading: AtomicBool,
     epoch: AtomicU64,
+    beats: Option<BeatLink>,
 }
 
 impl BoardPeers {
@@ -200,7 +229,7 @@ impl BoardPeers {
         session: zenoh::Session,
         content: Arc<Content>,
         local: Arc<InProc>,
-    ) -> BoardPeers {
+    ) -> Result<BoardPeers, crate::BusError> {
         let inbox = Inbox {
             name: group.name.clone(),
             content: content.clone(),
@@ -209,8 +238,16 @@ impl BoardPeers {
             heard: Mutex::new(None),
             refused: AtomicU64::new(0),
         };
-        BoardPeers {
-            inbox: Arc::new(inbox),
+        let inbox = Arc::new(inbox);
+        let beats =
+            match &group.beats {
+                Some(b) => Some(BeatLink::open(b, Arc::downgrade(&inbox)).map_err(|e| {
+                    crate::BusError(format!("cannot hear the boards' beats on `udp/{}`: {e}", b.listen))
+                })?),
+                None => None,
+            };
+        Ok(BoardPeers {
+            inbox,
             robot: robot.to_string(),
             session,
             content,
@@ -220,7 +257,13 @@ impl BoardPeers {
             acked: Condvar::new(),
             leading: AtomicBool::new(false),
             epoch: AtomicU64::new(0),
-        }
+            beats,
+        })
+    }
+
+    /// Where it hears the boards' beats over UDP, if it does.
+    pub fn beats_addr(&self) -> Option<std::net::SocketAddr> {
+        self.beats.as_ref().and_then(BeatLink::local_addr)
     }
 
     pub fn name(&self) -> &str {
@@ -313,6 +356,12 @@ impl Peers for BoardPeers {
     fn publish(&self, batch: &Batch) {
         let bytes = serde_json::to_vec(&batch_wire(&self.content, batch)).expect("JSON");
         self.put(log_key(&self.robot), bytes);
+        if batch.entries.is_empty() {
+            // A beat: over UDP too, where nothing waits for a lost one.
+            if let Some(link) = &self.beats {
+                link.beat(&self.inbox.name, batch.epoch);
+            }
+        }
     }
 
     fn wait_acks(&self, first: u64, last: u64, deadline: Instant) -> bool {
@@ -363,7 +412,7 @@ impl Peers for BoardPeers {
     }
 
     fn heard(&self) -> Option<(u64, Instant)> {
-        *self.inbox.heard.lock().unwrap_or_else(|p| p.into_inner())
+        self.inbox.heard.lock().unwrap_or_else(|p| p.into_inner()).as_ref().map(|h| (h.epoch, h.at))
     }
 
     fn linked(&self) -> bool {

@@ -21,7 +21,7 @@ fn port() -> u16 {
 fn open(d: &Deployment, name: &str, content: &Arc<situ_compiler::bundle::Content>, log: SharedLog) -> ZenohBus {
     let p = d.process(name).unwrap();
     let placement = Placement { robot: d.robot.clone(), local: vec![false; content.agents.len()], board: true };
-    let group = BoardGroup { name: name.into(), lease: Duration::from_secs(5), log };
+    let group = BoardGroup { name: name.into(), lease: Duration::from_secs(5), log, beats: d.beats(p).unwrap() };
     ZenohBus::open_in_group(content.clone(), placement, &d.zenoh_config(p), Capacity::default(), Some(group)).unwrap()
 }
 
@@ -170,7 +170,7 @@ fn dla_through_a_router_keeps_its_state_when_the_leading_board_goes_silent() {
         let p = d.process(name).unwrap();
         let config = StandbyConfig::new(name, d.rank(name).unwrap(), Duration::from_millis(200));
         let log = SharedLog::default();
-        let group = BoardGroup { name: name.into(), lease: config.lease, log: log.clone() };
+        let group = BoardGroup { name: name.into(), lease: config.lease, log: log.clone(), beats: None };
         let bus = ZenohBus::open_in_group(
             c.clone(),
             Placement::of(&d, p, &c),
@@ -276,7 +276,7 @@ fn follower_behind(decided: u64) -> Vec<String> {
     config.give_up = Duration::from_millis(1500);
     let log = SharedLog::default();
     let p = d.process("b").unwrap();
-    let group = BoardGroup { name: "b".into(), lease: config.lease, log: log.clone() };
+    let group = BoardGroup { name: "b".into(), lease: config.lease, log: log.clone(), beats: None };
     let placement = Placement { robot: d.robot.clone(), local: vec![false; content.agents.len()], board: true };
     let bus = ZenohBus::open_in_group(content.clone(), placement, &d.zenoh_config(p), Capacity::default(), Some(group))
         .unwrap();
@@ -404,5 +404,83 @@ fn long_log_memory_and_catch_up_time() {
         per_entry * n as f64 / 1048576.0,
         took.as_secs_f64(),
         n as f64 / took.as_secs_f64()
+    );
+}
+
+fn udp_port() -> u16 {
+    std::net::UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port()
+}
+
+/// A leader's beat also goes over UDP, and a follower whose Zenoh link is
+/// gone still hears it alive from its datagrams, and only from those of
+/// the board and epoch it heard over Zenoh: a datagram never raises the
+/// epoch, and another board's or epoch's renews nothing.
+#[test]
+fn a_leader_s_beats_over_udp_keep_it_alive_but_never_change_who_leads() {
+    let checked = situ_compiler::check_source("t.situ", RULES);
+    let content = Arc::new(situ_compiler::bundle::build(&checked));
+    let (a, b, ua, ub) = (port(), port(), udp_port(), udp_port());
+    // What the test hears of the leader's beats.
+    let tap = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    tap.set_read_timeout(Some(Duration::from_millis(100))).unwrap();
+    let t = tap.local_addr().unwrap().port();
+    let text = format!(
+        "robot = \"ub{a}\"\n[[process]]\nname = \"a\"\nboard = true\nlisten = [\"tcp/127.0.0.1:{a}\"]\n\
+         beats = {{ listen = \"udp/127.0.0.1:{ua}\", send = [\"udp/127.0.0.1:{ub}\", \"udp/127.0.0.1:{t}\"] }}\n\
+         [[process]]\nname = \"b\"\nboard = true\nlisten = [\"tcp/127.0.0.1:{b}\"]\nconnect = [\"tcp/127.0.0.1:{a}\"]\n\
+         beats = {{ listen = \"udp/127.0.0.1:{ub}\", send = [\"udp/127.0.0.1:{ua}\"] }}\n"
+    );
+    let d = Deployment::parse(&text, &["S".to_string()]).unwrap();
+    let leader = open(&d, "a", &content, SharedLog::default());
+    let follower = open(&d, "b", &content, SharedLog::default());
+    let (lp, fp) = (leader.peers().unwrap(), follower.peers().unwrap());
+    assert_eq!(fp.beats_addr().map(|a| a.port()), Some(ub));
+    let epoch = 9 << 8;
+    lp.set_leading(Some(epoch));
+    let beat = Batch { epoch, board: "a".into(), first: 1, prev_epoch: 0, decided: 0, entries: vec![] };
+    until("the follower hears the leader over Zenoh", || {
+        lp.publish(&beat);
+        fp.heard().is_some_and(|(e, _)| e == epoch)
+    });
+    // The beat went out as a datagram too.
+    let mut buf = [0u8; 512];
+    let mut datagram = None;
+    until("the leader's beat reaches the tap over UDP", || {
+        lp.publish(&beat);
+        datagram = tap.recv_from(&mut buf).ok().map(|(n, _)| buf[..n].to_vec());
+        datagram.is_some()
+    });
+    let w: serde_json::Value = serde_json::from_slice(&datagram.unwrap()).unwrap();
+    assert_eq!((w["board"].as_str(), w["epoch"].as_u64()), (Some("a"), Some(epoch)), "{w}");
+    // The leader's Zenoh session closed: only datagrams reach the follower.
+    drop((leader, lp));
+    let raw = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    let send = |text: &str| raw.send_to(text.as_bytes(), ("127.0.0.1", ub)).unwrap();
+    let datagram = |board: &str, e: u64| format!("{{\"v\": 1, \"board\": \"{board}\", \"epoch\": {e}}}");
+    // The datagrams are taken in order: once a garbage datagram sent after
+    // them is counted, the ones before it were heard.
+    let settle = || {
+        let before = fp.refused();
+        until("the garbage datagram counted", || {
+            send("not a beat");
+            std::thread::sleep(Duration::from_millis(20));
+            fp.refused() > before
+        });
+    };
+    let (_, at) = fp.heard().unwrap();
+    until("a datagram of the leader renews it", || {
+        send(&datagram("a", epoch));
+        fp.heard().is_some_and(|(e, when)| e == epoch && when > at)
+    });
+    settle();
+    let renewed = fp.heard().unwrap();
+    for (board, e) in [("a", epoch + 1), ("a", epoch - 1), ("c", epoch), ("b", epoch)] {
+        send(&datagram(board, e));
+    }
+    settle();
+    assert_eq!(
+        fp.heard(),
+        Some(renewed),
+        "another board's or epoch's datagram renewed the leader or changed the epoch"
     );
 }

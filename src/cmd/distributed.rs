@@ -275,10 +275,18 @@ fn zenoh(args: &Args, content: Arc<Content>, file: Option<&[u8]>, checked: Optio
     let standby = d
         .standby_config(&process.name, STATUS_EVERY)
         .map(|config| (config, situ_runtime::standby::SharedLog::default()));
+    let beats = match d.beats(&process) {
+        Ok(b) => b,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return USAGE;
+        }
+    };
     let group = standby.as_ref().map(|(config, log)| situ_bus_zenoh::standby::BoardGroup {
         name: config.name.clone(),
         lease: config.lease,
         log: log.clone(),
+        beats,
     });
     let bus =
         match ZenohBus::open_in_group(content.clone(), placement, &d.zenoh_config(&process), Default::default(), group)

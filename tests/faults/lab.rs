@@ -60,6 +60,8 @@ pub struct Relay {
     pub pid: Pid,
     /// The relay's port for each target `(host, port)`.
     ports: BTreeMap<(String, u16), u16>,
+    /// The relay's UDP port for each datagram target `(host, port)`.
+    udp_ports: BTreeMap<(String, u16), u16>,
     addr: String,
 }
 
@@ -71,6 +73,15 @@ impl Relay {
             .get(&(host.to_string(), port))
             .unwrap_or_else(|| panic!("the relay has no route to {host}:{port}"));
         format!("tcp/{}:{p}", self.addr)
+    }
+
+    /// The UDP endpoint through the relay to `host`'s `port`.
+    pub fn udp_endpoint(&self, host: &str, port: u16) -> String {
+        let p = self
+            .udp_ports
+            .get(&(host.to_string(), port))
+            .unwrap_or_else(|| panic!("the relay has no datagram route to {host}:{port}"));
+        format!("udp/{}:{p}", self.addr)
     }
 }
 
@@ -424,7 +435,7 @@ impl Lab {
     /// A relay in the switch namespace: one port of the switch's address for
     /// each `(host, port)`, whose streams it passes on after `delay_ms`
     /// (each chunk held that long, the order kept). Waits until it listens.
-    pub fn relay(&mut self, delay_ms: u32, targets: &[(&str, u16)]) -> Relay {
+    pub fn relay(&mut self, delay_ms: u32, targets: &[(&str, u16)], udp_targets: &[(&str, u16)]) -> Relay {
         let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/faults/relay.py");
         let addr = self.switch_addr();
         let mut ports = BTreeMap::new();
@@ -435,13 +446,19 @@ impl Lab {
             ports.insert((host.to_string(), *port), via);
             cmd.arg(format!("{via}={}:{port}", self.addr(host)));
         }
+        let mut udp_ports = BTreeMap::new();
+        for (i, (host, port)) in udp_targets.iter().enumerate() {
+            let via = 21000 + i as u16;
+            udp_ports.insert((host.to_string(), *port), via);
+            cmd.arg(format!("udp:{via}={}:{port}", self.addr(host)));
+        }
         let sw = self.switch_ns();
         let n = self.procs.len();
         let pid = self.spawn_in(&sw, &format!("relay-{n}"), cmd);
         if !self.wait_for_output(pid, "listening", Duration::from_secs(20)) {
             panic!("the relay did not start\n{}", self.output(pid));
         }
-        Relay { pid, ports, addr }
+        Relay { pid, ports, udp_ports, addr }
     }
 }
 

@@ -2,15 +2,17 @@
 """A TCP relay that delays: the fault tests' stand-in for netem, which this
 machine's kernel lacks.
 
-    python3 relay.py --listen 10.20.0.254 --delay-ms 50 20000=10.20.0.1:7447 …
+    python3 relay.py --listen 10.20.0.254 --delay-ms 50 20000=10.20.0.1:7447 udp:21000=10.20.0.1:7460 …
 
 Each `PORT=HOST:TPORT` listens on `--listen`:PORT; every connection made
 there is joined to a new connection to HOST:TPORT, and every chunk read from
 either side is written to the other `--delay-ms` later (plus up to
 `--jitter-ms` at random, the order of the stream kept: a chunk never
 overtakes the one before it). A side that closes closes the other once what
-it sent has been passed on. It prints `listening` when every port listens,
-and one line per connection.
+it sent has been passed on. Each `udp:PORT=HOST:TPORT` receives datagrams
+on `--listen`:PORT and sends each to HOST:TPORT `--delay-ms` later (plus
+the jitter; one way only, as the boards' beats go). It prints `listening`
+when every port listens, and one line per connection.
 """
 
 import argparse
@@ -79,6 +81,30 @@ async def serve(listen: str, port: int, host: str, tport: int, delay: float, jit
     return await asyncio.start_server(handle, listen, port)
 
 
+class Datagrams(asyncio.DatagramProtocol):
+    """Passes each datagram on to `target`, `delay` (+ jitter) later."""
+
+    def __init__(self, target: tuple, delay: float, jitter: float) -> None:
+        self.target, self.delay, self.jitter = target, delay, jitter
+        self.transport = None
+
+    def connection_made(self, transport) -> None:
+        self.transport = transport
+
+    def datagram_received(self, data: bytes, addr) -> None:
+        loop = asyncio.get_running_loop()
+        loop.call_later(self.delay + random.uniform(0.0, self.jitter), self.send, data)
+
+    def send(self, data: bytes) -> None:
+        try:
+            self.transport.sendto(data, self.target)
+        except OSError:
+            pass
+
+    def error_received(self, exc) -> None:
+        pass
+
+
 async def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--listen", required=True)
@@ -87,9 +113,16 @@ async def main() -> int:
     ap.add_argument("routes", nargs="+", help="PORT=HOST:TPORT")
     args = ap.parse_args()
     servers = []
+    loop = asyncio.get_running_loop()
     for route in args.routes:
         port, target = route.split("=", 1)
         host, tport = target.rsplit(":", 1)
+        if port.startswith("udp:"):
+            await loop.create_datagram_endpoint(
+                lambda: Datagrams((host, int(tport)), args.delay_ms / 1000, args.jitter_ms / 1000),
+                local_addr=(args.listen, int(port[4:])),
+            )
+            continue
         servers.append(
             await serve(args.listen, int(port), host, int(tport), args.delay_ms / 1000, args.jitter_ms / 1000)
         )

@@ -261,6 +261,9 @@ pub struct LossySettings {
     /// A second board, `standby`, on a host of its own: a standby group
     /// whose boards talk through the relay too.
     pub two_boards: bool,
+    /// The boards also beat over UDP (`beats` in the deployment), through
+    /// the relay's datagram routes and the same loss.
+    pub beats: bool,
 }
 
 /// The TCP counters of the hosts and the switch (the relay), summed.
@@ -287,7 +290,8 @@ pub fn delay_and_loss(s: &LossySettings) -> Lossy {
         if s.two_boards { &["board", "standby", "sensors", "pipeline"] } else { &["board", "sensors", "pipeline"] };
     let mut lab = Lab::new(hosts);
     let procs = if s.two_boards { super::standby::fig5_two_boards() } else { fig5_peers() };
-    let relay = lab.relay(s.delay_ms, &relay_targets(&procs));
+    let udp = if s.beats { beat_targets(&procs) } else { Vec::new() };
+    let relay = lab.relay(s.delay_ms, &relay_targets(&procs), &udp);
     for &h in hosts {
         lab.only_through_switch(h);
     }
@@ -298,7 +302,11 @@ pub fn delay_and_loss(s: &LossySettings) -> Lossy {
         Some(stale) => fig5_rules_with_stale(&lab, stale),
         None => fig5_rules(),
     };
-    let deploy = write_deployment(&lab, "fig5", &procs, Some(&relay));
+    let deploy = if s.beats {
+        write_deployment_with_beats(&lab, "fig5", &procs, Some(&relay))
+    } else {
+        write_deployment(&lab, "fig5", &procs, Some(&relay))
+    };
     let mut running = start(&mut lab, &rules, &deploy, &procs);
     let at = format!("tcp/{}:7449", lab.addr("pipeline"));
     running.observer = Some(observe(&mut lab, "pipeline", &at, "client", "fig5"));

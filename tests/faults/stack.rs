@@ -8,9 +8,14 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
-/// How long a process of a scenario may run: scenarios stop them with
-/// SIGTERM when they have seen what they came for.
-pub const RUN_FOR: &str = "120";
+/// How long a process of a scenario may run (s): scenarios stop them with
+/// SIGTERM when they have seen what they came for. 120, or a minute more
+/// than a soak's `SITU_SOAK_SECONDS` (a longer soak's faults must not
+/// outlast the processes).
+pub fn run_for() -> String {
+    let soak = std::env::var("SITU_SOAK_SECONDS").ok().and_then(|v| v.parse::<u64>().ok()).unwrap_or(0);
+    (soak + 60).max(120).to_string()
+}
 
 /// One process of a deployment, placed on a host.
 #[derive(Debug, Clone)]
@@ -106,6 +111,20 @@ pub fn fig5_rules() -> PathBuf {
 /// through `relay` when there is one (it must route to every listening
 /// process), directly to the hosts' addresses otherwise.
 pub fn write_deployment(lab: &Lab, robot: &str, procs: &[Proc], relay: Option<&Relay>) -> PathBuf {
+    deployment_file(lab, robot, procs, relay, false)
+}
+
+/// The port a board hears the others' beats on (UDP, its host's address).
+pub const BEATS_PORT: u16 = 7460;
+
+/// As [`write_deployment`], each board of the standby group also with
+/// `beats`: it hears on its host's [`BEATS_PORT`] and sends to the other
+/// boards' (through the relay's datagram routes when there is one).
+pub fn write_deployment_with_beats(lab: &Lab, robot: &str, procs: &[Proc], relay: Option<&Relay>) -> PathBuf {
+    deployment_file(lab, robot, procs, relay, true)
+}
+
+fn deployment_file(lab: &Lab, robot: &str, procs: &[Proc], relay: Option<&Relay>, beats: bool) -> PathBuf {
     let endpoint = |name: &str| {
         let p = procs.iter().find(|p| p.name == name).unwrap_or_else(|| panic!("no process `{name}`"));
         let port = p.listen.unwrap_or_else(|| panic!("`{name}` listens nowhere"));
@@ -130,6 +149,15 @@ pub fn write_deployment(lab: &Lab, robot: &str, procs: &[Proc], relay: Option<&R
         if !p.connect.is_empty() {
             text += &format!("connect = [{}]\n", list(p.connect.iter().map(|c| endpoint(c)).collect()));
         }
+        if beats && p.board {
+            let to = |q: &Proc| match relay {
+                Some(r) => r.udp_endpoint(q.host, BEATS_PORT),
+                None => format!("udp/{}:{BEATS_PORT}", lab.addr(q.host)),
+            };
+            let send = procs.iter().filter(|q| q.board && q.name != p.name).map(to).collect();
+            text +=
+                &format!("beats = {{ listen = \"udp/{}:{BEATS_PORT}\", send = [{}] }}\n", lab.addr(p.host), list(send));
+        }
     }
     let path = lab.dir().join("deploy.toml");
     std::fs::write(&path, text).unwrap();
@@ -141,13 +169,19 @@ pub fn relay_targets(procs: &[Proc]) -> Vec<(&'static str, u16)> {
     procs.iter().filter_map(|p| p.listen.map(|port| (p.host, port))).collect()
 }
 
+/// The relay's datagram targets for the boards' beats: every board's
+/// [`BEATS_PORT`].
+pub fn beat_targets(procs: &[Proc]) -> Vec<(&'static str, u16)> {
+    procs.iter().filter(|p| p.board).map(|p| (p.host, BEATS_PORT)).collect()
+}
+
 /// `situ run RULES --stack demo --transport zenoh --deploy D --process NAME`,
 /// recorded to `NAME.mcap` in the lab.
 pub fn situ_run(lab: &Lab, rules: &Path, deploy: &Path, process: &str) -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_situ"));
     c.env("NO_COLOR", "1").current_dir(repo()).arg("run").arg(rules);
     c.args(["--stack", "demo", "--transport", "zenoh", "--deploy"]).arg(deploy);
-    c.args(["--process", process, "--duration", RUN_FOR]);
+    c.args(["--process", process, "--duration", &run_for()]);
     if !is_router(process) {
         c.arg("--record").arg(recording(lab, process));
     }

@@ -83,7 +83,9 @@ fn two_boards_in_ro(stale: Option<&str>) -> (Lab, Running, Pid, Seen, u64) {
         Some(stale) => fig5_rules_with_stale(&lab, stale),
         None => fig5_rules(),
     };
-    let deploy = write_deployment(&lab, "fig5", &procs, None);
+    // The boards beat over UDP too, as advised between hosts: a kill or a
+    // cut host silences the datagrams as well.
+    let deploy = write_deployment_with_beats(&lab, "fig5", &procs, None);
     let mut running = start(&mut lab, &rules, &deploy, &procs);
     let at = format!("tcp/{}:7449", lab.addr("pipeline"));
     let observer = observe(&mut lab, "pipeline", &at, "client", "fig5");

@@ -50,17 +50,16 @@ impl LogOut for ToFollowers {
             return;
         }
         let logged: Vec<Logged> = entries.drain(..).map(|entry| Logged { epoch: self.epoch, entry }).collect();
-        let (first, prev_epoch, last) = {
+        let (first, prev_epoch, last, decided) = {
             let mut log = self.log.lock().unwrap_or_else(|p| p.into_inner());
             let first = log.len() + 1;
             let prev_epoch = log.epoch_at(first - 1).unwrap_or(0);
             for l in &logged {
                 log.push(l.clone());
             }
-            (first, prev_epoch, log.len())
+            (first, prev_epoch, log.len(), log.decided())
         };
         if !logged.is_empty() {
-            let decided = self.log.lock().unwrap_or_else(|p| p.into_inner()).decided();
             let batch =
                 Batch { epoch: self.epoch, board: self.name.clone(), first, prev_epoch, decided, entries: logged };
             self.peers.publish(&batch);
