@@ -23,6 +23,7 @@
 
 use crate::wire::{self, VERSION};
 use serde::{Deserialize, Serialize};
+use std::io::ErrorKind;
 use std::net::{SocketAddr, UdpSocket};
 use std::sync::Weak;
 use std::time::Duration;
@@ -56,11 +57,14 @@ pub(crate) trait Hears: Send + Sync + 'static {
     fn refused(&self);
 }
 
-/// The board's UDP socket: it sends beats from it and a thread hears on it.
+/// The board's UDP sockets: a thread hears on the `listen` one; beats go
+/// from sockets of their own (one per address family), which never block.
+/// (One socket could not be both: its duplicate for the thread would
+/// share the non-blocking flag, and the thread would spin.)
 #[derive(Debug)]
 pub(crate) struct BeatLink {
-    socket: UdpSocket,
-    send: Vec<SocketAddr>,
+    listen: SocketAddr,
+    senders: Vec<(UdpSocket, Vec<SocketAddr>)>,
 }
 
 impl BeatLink {
@@ -69,40 +73,56 @@ impl BeatLink {
     pub(crate) fn open<H: Hears>(beats: &Beats, hears: Weak<H>) -> std::io::Result<BeatLink> {
         let socket = UdpSocket::bind(beats.listen)?;
         socket.set_read_timeout(Some(POLL))?;
-        let reader = socket.try_clone()?;
-        std::thread::Builder::new().name("situ-beats".into()).spawn(move || listen(&reader, &hears))?;
-        // Sending never blocks the board's thread.
-        socket.set_nonblocking(true)?;
-        Ok(BeatLink { socket, send: beats.send.clone() })
+        let listen = socket.local_addr()?;
+        let mut senders = Vec::new();
+        for v6 in [false, true] {
+            let to: Vec<SocketAddr> = beats.send.iter().filter(|a| a.is_ipv6() == v6).copied().collect();
+            if to.is_empty() {
+                continue;
+            }
+            let any: SocketAddr = if v6 { "[::]:0" } else { "0.0.0.0:0" }.parse().expect("an address");
+            let sender = UdpSocket::bind(any)?;
+            // A datagram the kernel cannot take now is dropped, never
+            // waited for: the board's thread sends them.
+            sender.set_nonblocking(true)?;
+            senders.push((sender, to));
+        }
+        std::thread::Builder::new().name("situ-beats".into()).spawn(move || listen_on(&socket, &hears))?;
+        Ok(BeatLink { listen, senders })
     }
 
     /// Sends one beat to every address (a datagram the kernel cannot take
     /// now is dropped: the next beat follows).
     pub(crate) fn beat(&self, board: &str, epoch: u64) {
         let bytes = serde_json::to_vec(&BeatWire { v: VERSION, board: board.to_string(), epoch }).expect("JSON");
-        for to in &self.send {
-            let _ = self.socket.send_to(&bytes, to);
+        for (socket, to) in &self.senders {
+            for addr in to {
+                let _ = socket.send_to(&bytes, addr);
+            }
         }
     }
 
     /// The address it hears on (with the port the system chose for `:0`).
-    pub(crate) fn local_addr(&self) -> Option<SocketAddr> {
-        self.socket.local_addr().ok()
+    pub(crate) fn listen_addr(&self) -> SocketAddr {
+        self.listen
     }
 }
 
-fn listen<H: Hears>(socket: &UdpSocket, hears: &Weak<H>) {
+fn listen_on<H: Hears>(socket: &UdpSocket, hears: &Weak<H>) {
     let mut buf = [0u8; MAX_DATAGRAM];
     loop {
         let got = socket.recv_from(&mut buf);
         let Some(h) = hears.upgrade() else { return };
-        // An error is the poll's timeout, or an ICMP "port unreachable"
-        // reported on this socket for a beat it sent: nothing to hear.
-        if let Ok((n, _)) = got {
-            match wire::parse::<BeatWire>(&buf[..n]) {
+        match got {
+            Ok((n, _)) => match wire::parse::<BeatWire>(&buf[..n]) {
                 Ok(b) => h.alive(&b.board, b.epoch),
                 Err(_) => h.refused(),
-            }
+            },
+            // The poll's timeout: nothing to hear.
+            Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut | ErrorKind::Interrupted) => {}
+            // Anything else is not waited on in a loop: the next look is a
+            // poll later.
+            Err(_) => std::thread::sleep(POLL),
         }
     }
 }
@@ -160,7 +180,7 @@ mod tests {
         let any: SocketAddr = "127.0.0.1:0".parse().unwrap();
         let heard = Arc::new(Heard::default());
         let hearing = BeatLink::open(&Beats { listen: any, send: vec![] }, Arc::downgrade(&heard)).unwrap();
-        let to = hearing.local_addr().unwrap();
+        let to = hearing.listen_addr();
         let nobody = Arc::new(Heard::default());
         let sending = BeatLink::open(&Beats { listen: any, send: vec![to] }, Arc::downgrade(&nobody)).unwrap();
         // Datagrams on loopback may still be dropped: beat until one is heard.
@@ -174,6 +194,38 @@ mod tests {
             raw.send_to(b"{\"v\": 1, \"board\": 3}", to).unwrap();
             *heard.refused.lock().unwrap() > 0
         });
+    }
+
+    /// CPU time (clock ticks) of this process's threads named `name`.
+    fn cpu_ticks(name: &str) -> u64 {
+        let mut ticks = 0;
+        for task in std::fs::read_dir("/proc/self/task").unwrap().flatten() {
+            let comm = std::fs::read_to_string(task.path().join("comm")).unwrap_or_default();
+            if comm.trim() != name {
+                continue;
+            }
+            let stat = std::fs::read_to_string(task.path().join("stat")).unwrap_or_default();
+            // After the command's closing parenthesis: fields 3 on; utime
+            // and stime are fields 14 and 15.
+            let rest = &stat[stat.rfind(')').map_or(0, |i| i + 2)..];
+            let f: Vec<u64> = rest.split_whitespace().map(|x| x.parse().unwrap_or(0)).collect();
+            ticks += f.get(11).unwrap_or(&0) + f.get(12).unwrap_or(&0);
+        }
+        ticks
+    }
+
+    #[test]
+    fn the_thread_that_hears_sleeps_while_nothing_comes() {
+        let heard = Arc::new(Heard::default());
+        let any: SocketAddr = "127.0.0.1:0".parse().unwrap();
+        let link = BeatLink::open(&Beats { listen: any, send: vec![any] }, Arc::downgrade(&heard)).unwrap();
+        link.beat("a", 1);
+        let before = cpu_ticks("situ-beats");
+        std::thread::sleep(Duration::from_secs(1));
+        // A thread that waits takes no CPU; one that spun (a non-blocking
+        // socket) would take most of a core's 100 ticks a second.
+        let used = cpu_ticks("situ-beats") - before;
+        assert!(used < 25, "the threads that hear beats took {used} ticks in 1 s");
     }
 
     #[test]

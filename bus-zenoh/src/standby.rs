@@ -263,7 +263,7 @@ impl BoardPeers {
 
     /// Where it hears the boards' beats over UDP, if it does.
     pub fn beats_addr(&self) -> Option<std::net::SocketAddr> {
-        self.beats.as_ref().and_then(BeatLink::local_addr)
+        self.beats.as_ref().map(BeatLink::listen_addr)
     }
 
     pub fn name(&self) -> &str {
