@@ -354,14 +354,15 @@ impl BoardPeers {
 
 impl Peers for BoardPeers {
     fn publish(&self, batch: &Batch) {
-        let bytes = serde_json::to_vec(&batch_wire(&self.content, batch)).expect("JSON");
-        self.put(log_key(&self.robot), bytes);
         if batch.entries.is_empty() {
-            // A beat: over UDP too, where nothing waits for a lost one.
+            // A beat: over UDP too, where nothing waits for a lost one;
+            // first, as Zenoh's `put` may wait on a stalled link.
             if let Some(link) = &self.beats {
                 link.beat(&self.inbox.name, batch.epoch);
             }
         }
+        let bytes = serde_json::to_vec(&batch_wire(&self.content, batch)).expect("JSON");
+        self.put(log_key(&self.robot), bytes);
     }
 
     fn wait_acks(&self, first: u64, last: u64, deadline: Instant) -> bool {
