@@ -104,9 +104,14 @@ struct Rule {
     /// The rank of its (salience, specificity) among the rules': a larger
     /// one fires first.
     group: u32,
-    /// The events (below 64) its positive patterns need as facts, as bits:
-    /// the rule cannot hold unless `Engine::have` has them all.
+    /// The bits of [`Engine::have`] its conditions read (`mask`) and the
+    /// values they need (`need`): an event's bit (below 64) set for a
+    /// positive pattern of it, a stale agent's bit set for a positive
+    /// `stale`, either clear for a negated one. The rule cannot hold unless
+    /// `have & mask == need`; a condition that the bits decide whole (no
+    /// run length above 1, no window, no tests) is not in `conds`.
     need: u64,
+    mask: u64,
     /// The agents its positive patterns match (recency), in `Program::agents`.
     matches: (u32, u32),
 }
@@ -123,6 +128,9 @@ pub(super) struct Program {
     by_state: Vec<(u32, u32)>,
     lists: Vec<u32>,
     rules: Vec<Rule>,
+    /// Per agent: its bit in [`Engine::have`] while it is stale (after the
+    /// events': `ne + agent`, below 64; `0`: none).
+    pub(super) stale_bit: Vec<u64>,
     conds: Vec<Cond>,
     tests: Vec<Test>,
     agents: Vec<u32>,
@@ -181,7 +189,8 @@ impl Program {
         let ne = c.events.len();
         let na = c.agents.len();
         let n = &c.network;
-        let mut p = Program { ne, na, ..Program::default() };
+        let stale_bit: Vec<u64> = (0..na).map(|a| if ne + a < 64 { 1 << (ne + a) } else { 0 }).collect();
+        let mut p = Program { ne, na, stale_bit: stale_bit.clone(), ..Program::default() };
         let arg = |o: &Operand, own: u32| -> Result<Arg, &'static str> {
             Ok(match *o {
                 Operand::Value(v) => Arg::Value(v),
@@ -302,12 +311,30 @@ impl Program {
             }
             let m0 = p.agents.len() as u32;
             p.agents.extend_from_slice(&rule.matches);
-            let need =
-                p.conds[c0..].iter().filter(|c| !c.negative && c.event != STALE).fold(0, |m, c| m | bit(c.event));
+            // The bits: a positive condition's in `need` (kept as a
+            // condition unless the bit decides it whole), a negated one
+            // decided whole by its bit in `mask` alone, unless a positive
+            // condition needs the same bit (the rule never holds: its
+            // conditions say so).
+            let cond_bit = |c: &Cond| if c.event == STALE { stale_bit[c.agent as usize] } else { bit(c.event) };
+            let whole = |c: &Cond, b: u64| b != 0 && c.min_run <= 1 && c.within == u64::MAX && c.tests.0 == c.tests.1;
+            let need = p.conds[c0..].iter().filter(|c| !c.negative).fold(0, |m, c| m | cond_bit(c));
+            let (mut mask, mut kept) = (need, Vec::new());
+            for c in &p.conds[c0..] {
+                let b = cond_bit(c);
+                if whole(c, b) && (!c.negative || need & b == 0) {
+                    mask |= b;
+                } else {
+                    kept.push(*c);
+                }
+            }
+            p.conds.truncate(c0);
+            p.conds.extend(kept);
             p.rules.push(Rule {
                 conds: (c0 as u32, p.conds.len() as u32),
                 group: 0,
                 need,
+                mask,
                 matches: (m0, p.agents.len() as u32),
             });
             ok_states.push(ok);
@@ -382,7 +409,8 @@ impl Program {
             && self.lists.iter().all(|&r| (r as usize) < self.rules.len());
         let rules = self.rules.iter().all(|r| range(r.conds, self.conds.len()) && range(r.matches, self.agents.len()))
             && self.agents.iter().all(|&a| (a as usize) < self.na);
-        let conds = self.conds.iter().all(|c| (c.agent as usize) < self.na && range(c.tests, self.tests.len()));
+        let conds = self.stale_bit.len() == self.na
+            && self.conds.iter().all(|c| (c.agent as usize) < self.na && range(c.tests, self.tests.len()));
         let place = |i: u32| (i as usize) < payload_len;
         let arg = |a: Arg| match a {
             Arg::Value(_) => true,
@@ -485,8 +513,10 @@ impl Engine {
             let a = unsafe { *at(&self.net.timed_agents, i) } as usize;
             let r = unsafe { at_mut(&mut self.agents, a) };
             if r.stale_at < now {
-                self.have &= !r.bit;
-                *r = AgentRec { last: r.last, checked: r.checked, stale: true, ..AGENT };
+                // SAFETY (`at`): `stale_bit` has one entry per agent (`Program::check`).
+                let sb = unsafe { *at(&self.fp.stale_bit, a) };
+                self.have = (self.have & !r.bit) | sb;
+                *r = AgentRec { last: r.last, checked: r.checked, stale: true, bit: sb, ..AGENT };
                 self.touched.push(a as u32);
             } else if r.window_at < now {
                 let slot = r.slot;
@@ -569,7 +599,7 @@ impl Engine {
                 // The list is in firing order: no later rule comes first.
                 return;
             }
-            if rule.need & self.have != rule.need || !self.fast_holds(rule) {
+            if self.have & rule.mask != rule.need || !self.fast_holds(rule) {
                 continue;
             }
             if best.rule == NONE || rule.group > best.group {
@@ -671,7 +701,7 @@ impl Engine {
         for i in s as usize..e as usize {
             let r = self.fp.lists[i];
             let rule = &self.fp.rules[r as usize];
-            if rule.need & self.have == rule.need && self.fast_holds(rule) {
+            if self.have & rule.mask == rule.need && self.fast_holds(rule) {
                 active.push(r);
             }
         }
