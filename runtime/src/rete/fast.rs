@@ -112,8 +112,16 @@ struct Rule {
     /// run length above 1, no window, no tests) is not in `conds`.
     need: u64,
     mask: u64,
-    /// The agents its positive patterns match (recency), in `Program::agents`.
-    matches: (u32, u32),
+}
+
+/// What a firing of a rule reads (`Engine::fast_record`) and its recency.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Fire {
+    pub(super) target: u32,
+    /// The agents its positive patterns match (recency, the matched facts)
+    /// and those it tests for staleness, in `Program::agents`.
+    pub(super) matches: (u32, u32),
+    pub(super) stale: (u32, u32),
 }
 
 /// The rules of a bundle flattened for the fast path.
@@ -128,12 +136,14 @@ pub(super) struct Program {
     by_state: Vec<(u32, u32)>,
     lists: Vec<u32>,
     rules: Vec<Rule>,
+    /// Per rule, what its firing records.
+    pub(super) fires: Vec<Fire>,
     /// Per agent: its bit in [`Engine::have`] while it is stale (after the
     /// events': `ne + agent`, below 64; `0`: none).
     pub(super) stale_bit: Vec<u64>,
     conds: Vec<Cond>,
     tests: Vec<Test>,
-    agents: Vec<u32>,
+    pub(super) agents: Vec<u32>,
 }
 
 /// The activated rule that fires first among those seen so far (`rule`:
@@ -163,7 +173,7 @@ pub(super) fn bit(event: u32) -> u64 {
 /// state is always a state of the bundle and the event of a step one the
 /// payload check took.
 #[inline(always)]
-unsafe fn at<T>(v: &[T], i: usize) -> &T {
+pub(super) unsafe fn at<T>(v: &[T], i: usize) -> &T {
     debug_assert!(i < v.len(), "{i} >= {}", v.len());
     // SAFETY: the caller's.
     unsafe { v.get_unchecked(i) }
@@ -311,6 +321,9 @@ impl Program {
             }
             let m0 = p.agents.len() as u32;
             p.agents.extend_from_slice(&rule.matches);
+            let s0 = p.agents.len() as u32;
+            p.agents.extend_from_slice(&rule.stale);
+            p.fires.push(Fire { target: rule.target, matches: (m0, s0), stale: (s0, p.agents.len() as u32) });
             // The bits: a positive condition's in `need` (kept as a
             // condition unless the bit decides it whole), a negated one
             // decided whole by its bit in `mask` alone, unless a positive
@@ -330,13 +343,7 @@ impl Program {
             }
             p.conds.truncate(c0);
             p.conds.extend(kept);
-            p.rules.push(Rule {
-                conds: (c0 as u32, p.conds.len() as u32),
-                group: 0,
-                need,
-                mask,
-                matches: (m0, p.agents.len() as u32),
-            });
+            p.rules.push(Rule { conds: (c0 as u32, p.conds.len() as u32), group: 0, need, mask });
             ok_states.push(ok);
             reads.push(read);
         }
@@ -407,7 +414,9 @@ impl Program {
             && self.by_event.len() == ns * self.ne
             && self.by_state.iter().chain(&self.by_agent).chain(&self.by_event).all(|&l| range(l, self.lists.len()))
             && self.lists.iter().all(|&r| (r as usize) < self.rules.len());
-        let rules = self.rules.iter().all(|r| range(r.conds, self.conds.len()) && range(r.matches, self.agents.len()))
+        let rules = self.rules.iter().all(|r| range(r.conds, self.conds.len()))
+            && self.fires.len() == self.rules.len()
+            && self.fires.iter().all(|f| range(f.matches, self.agents.len()) && range(f.stale, self.agents.len()))
             && self.agents.iter().all(|&a| (a as usize) < self.na);
         let conds = self.stale_bit.len() == self.na
             && self.conds.iter().all(|c| (c.agent as usize) < self.na && range(c.tests, self.tests.len()));
@@ -576,7 +585,7 @@ impl Engine {
                 self.fast_activate();
                 return Err(StepError::Cascade { limit: self.cascade_limit });
             }
-            self.state = self.record_firing(best.rule);
+            self.state = self.fast_record(best.rule);
             best = Best { rule: NONE, group: 0, recency: u64::MAX };
             self.fast_best_in(self.fp.by_state[self.state as usize], &mut best);
         }
@@ -609,17 +618,17 @@ impl Engine {
             // The same salience and specificity: recency, then the rule
             // declared first.
             if best.recency == u64::MAX {
-                best.recency = self.fast_recency(unsafe { at(&p.rules, best.rule as usize) });
+                best.recency = self.fast_recency(best.rule);
             }
-            let recency = self.fast_recency(rule);
+            let recency = self.fast_recency(r);
             if recency > best.recency || (recency == best.recency && r < best.rule) {
                 *best = Best { rule: r, group: rule.group, recency };
             }
         }
     }
 
-    fn fast_recency(&self, rule: &Rule) -> u64 {
-        let (s, e) = rule.matches;
+    fn fast_recency(&self, r: u32) -> u64 {
+        let (s, e) = self.fp.fires[r as usize].matches;
         self.fp.agents[s as usize..e as usize].iter().map(|&a| self.agents[a as usize].slot.seq).max().unwrap_or(0)
     }
 
