@@ -222,6 +222,8 @@ impl Program {
         // Per rule: the states it can be activated in, the agents it reads.
         let mut ok_states: Vec<Vec<bool>> = Vec::with_capacity(c.rules.len());
         let mut reads: Vec<Vec<bool>> = Vec::with_capacity(c.rules.len());
+        // Per rule, all its conditions (those the bits decide too).
+        let mut full: Vec<Vec<Cond>> = Vec::with_capacity(c.rules.len());
         let mut terminal = vec![NONE; c.rules.len()];
         for t in &n.terminals {
             terminal[t.rule as usize] = t.beta;
@@ -341,7 +343,7 @@ impl Program {
                     kept.push(*c);
                 }
             }
-            p.conds.truncate(c0);
+            full.push(p.conds.split_off(c0));
             p.conds.extend(kept);
             p.rules.push(Rule { conds: (c0 as u32, p.conds.len() as u32), group: 0, need, mask });
             ok_states.push(ok);
@@ -359,15 +361,14 @@ impl Program {
             let rank = groups.len() - 1 - groups.iter().position(|&g| g == prio(r as u32)).unwrap_or(0);
             p.rules[r].group = rank as u32;
         }
-        // Whether `e` (of agent `a`) makes a condition of `r` on `a` false.
-        let excluded = |p: &Program, r: u32, a: u32, e: u32| {
-            let (s, t) = p.rules[r as usize].conds;
-            p.conds[s as usize..t as usize].iter().any(|c| c.agent == a && !c.negative && c.event != e)
-        };
-        let push = |p: &mut Program, keep: &dyn Fn(&Program, u32) -> bool| -> Result<(u32, u32), &'static str> {
+        // Whether `e` (of agent `a`) makes a condition of `r` on `a` false
+        // (any of its conditions, those the bits decide too).
+        let excluded =
+            |r: u32, a: u32, e: u32| full[r as usize].iter().any(|c| c.agent == a && !c.negative && c.event != e);
+        let push = |p: &mut Program, keep: &dyn Fn(u32) -> bool| -> Result<(u32, u32), &'static str> {
             let s = p.lists.len();
             for &r in &order {
-                if keep(p, r) {
+                if keep(r) {
                     p.lists.push(r);
                 }
             }
@@ -377,16 +378,16 @@ impl Program {
             Ok((s as u32, p.lists.len() as u32))
         };
         for s in 0..ns {
-            let l = push(&mut p, &|_, r| ok_states[r as usize][s])?;
+            let l = push(&mut p, &|r| ok_states[r as usize][s])?;
             p.by_state.push(l);
             for a in 0..na {
-                let l = push(&mut p, &|_, r| ok_states[r as usize][s] && reads[r as usize][a])?;
+                let l = push(&mut p, &|r| ok_states[r as usize][s] && reads[r as usize][a])?;
                 p.by_agent.push(l);
             }
             for e in 0..ne {
                 let a = c.events[e].agent;
-                let l = push(&mut p, &|p, r| {
-                    ok_states[r as usize][s] && reads[r as usize][a as usize] && !excluded(p, r, a, e as u32)
+                let l = push(&mut p, &|r| {
+                    ok_states[r as usize][s] && reads[r as usize][a as usize] && !excluded(r, a, e as u32)
                 })?;
                 p.by_event.push(l);
             }
