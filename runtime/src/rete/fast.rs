@@ -470,14 +470,15 @@ impl Engine {
         }
         // Not at rest, or facts expired: one test for both.
         if (self.active.len() | self.touched.len()) != 0 {
-            self.fast_rest(NONE)?;
+            self.fast_rest()?;
         }
         self.fast_insert(event, time, payload);
-        if self.now > self.next_deadline {
-            // The fact came late: it may be expired already.
+        // The fact came late: it may be expired already.
+        let late = self.now > self.next_deadline;
+        if late {
             self.fast_expire();
         }
-        self.fast_rest(event)?;
+        self.fast_rest_after(event, late)?;
         Ok(Step { from: self.record.from, to: self.state, firings: self.record.firings.len() })
     }
 
@@ -500,7 +501,9 @@ impl Engine {
         let run = if old.event == event { old.run + 1 } else { 1 };
         r.slot = Slot { event, time, run, seq };
         let old_bit = std::mem::replace(&mut r.bit, ev.bit);
-        r.last = r.last.max(time);
+        // The agent's clock: a step's event is stamped at or after it
+        // (`admit`); `force_fact` keeps the later of the two itself.
+        r.last = time;
         r.stale = false;
         r.checked = now;
         r.stale_at = stale_at;
@@ -542,39 +545,54 @@ impl Engine {
         self.next_deadline = next;
     }
 
-    /// [`rest`](Self::rest) on the fast path. The first search covers what
-    /// changed since the last rest: every rule of the state if the engine
-    /// was not at rest (`active` not empty), else the rules of `event`'s new
-    /// fact (`NONE`: none) and of the agents in `touched`. With an event,
-    /// the engine was at rest before its fact was inserted (a rest came
-    /// first, or an error returned).
+    /// [`rest`](Self::rest) on the fast path, without a new fact: every
+    /// rule of the state if the engine was not at rest (`active` not
+    /// empty), else the rules of the agents in `touched`.
     #[inline(always)]
-    pub(super) fn fast_rest(&mut self, event: u32) -> Result<(), StepError> {
+    pub(super) fn fast_rest(&mut self) -> Result<(), StepError> {
         let mut best = Best { rule: NONE, group: 0, recency: u64::MAX };
         let st = self.state as usize;
-        if event == NONE && !self.active.is_empty() {
+        if !self.active.is_empty() {
             // SAFETY (`at`): the state is a state of the bundle.
             self.fast_best_in(unsafe { *at(&self.fp.by_state, st) }, &mut best);
             self.active.clear();
         } else {
-            if event != NONE {
-                // SAFETY (`at`): the state and the event (taken by the
-                // payload check) are the bundle's: `st * ne + event < ns * ne`.
-                let list = unsafe { *at(&self.fp.by_event, st * self.fp.ne + event as usize) };
-                self.fast_best_in(list, &mut best);
-            }
-            if !self.touched.is_empty() {
-                for i in 0..self.touched.len() {
-                    let a = self.touched[i] as usize;
-                    self.fast_best_in(self.fp.by_agent[st * self.fp.na + a], &mut best);
-                }
-                self.touched.clear();
-            }
+            self.fast_best_touched(st, &mut best);
         }
         if best.rule == NONE {
             return Ok(());
         }
         self.fast_fire(best)
+    }
+
+    /// The rest after a step's fact of `event`: the engine was at rest
+    /// before it was inserted (a rest came first, or an error returned), so
+    /// the rules of `event`'s new fact, and if expiry ran after the insert
+    /// (`late`), those of the agents in `touched` (else it is empty).
+    #[inline(always)]
+    fn fast_rest_after(&mut self, event: u32, late: bool) -> Result<(), StepError> {
+        let mut best = Best { rule: NONE, group: 0, recency: u64::MAX };
+        let st = self.state as usize;
+        // SAFETY (`at`): the state and the event (taken by the payload
+        // check) are the bundle's: `st * ne + event < ns * ne`.
+        let list = unsafe { *at(&self.fp.by_event, st * self.fp.ne + event as usize) };
+        self.fast_best_in(list, &mut best);
+        if late {
+            self.fast_best_touched(st, &mut best);
+        }
+        if best.rule == NONE {
+            return Ok(());
+        }
+        self.fast_fire(best)
+    }
+
+    /// The rules of the agents in `touched` (emptied) in state `st`.
+    fn fast_best_touched(&mut self, st: usize, best: &mut Best) {
+        for i in 0..self.touched.len() {
+            let a = self.touched[i] as usize;
+            self.fast_best_in(self.fp.by_agent[st * self.fp.na + a], best);
+        }
+        self.touched.clear();
     }
 
     /// Fires `best`, then the rule that fires first in each new state,

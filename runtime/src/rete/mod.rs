@@ -407,7 +407,7 @@ impl Engine {
                 self.fast_expire();
             }
             if !self.active.is_empty() || !self.touched.is_empty() {
-                self.fast_rest(NONE).map_err(|e| self.post_error(e))?;
+                self.fast_rest().map_err(|e| self.post_error(e))?;
             }
         } else {
             if self.now > self.next_deadline {
@@ -425,7 +425,7 @@ impl Engine {
     pub fn settle(&mut self) -> Result<Option<StateChange>, PostError> {
         self.begin();
         if self.fast {
-            self.fast_rest(NONE).map_err(|e| self.post_error(e))?;
+            self.fast_rest().map_err(|e| self.post_error(e))?;
         } else {
             self.rest().map_err(|e| self.post_error(e))?;
         }
@@ -510,8 +510,10 @@ impl Engine {
         self.validate(event, payload)?;
         self.now = self.now.max(time);
         if self.fast {
-            self.fast_insert(event, time, payload);
             let agent = self.content.events[event as usize].agent as usize;
+            let last = self.agents[agent].last;
+            self.fast_insert(event, time, payload);
+            self.agents[agent].last = last.max(time);
             self.agents[agent].slot.run = run.max(1);
             self.fast_activate();
             return Ok(());
