@@ -493,7 +493,7 @@ impl Engine {
         let a = ev.agent as usize;
         // `u64::MAX` (never) stays `u64::MAX`.
         let stale_at = time.saturating_add(ev.stale_after);
-        let window_at = if ev.windows.0 == ev.windows.1 { u64::MAX } else { self.next_window(ev.windows, time) };
+        let window_at = self.fast_next_window(ev.windows, time);
         self.seq += 1;
         let (seq, now) = (self.seq, self.now);
         let r = unsafe { at_mut(&mut self.agents, a) };
@@ -516,6 +516,22 @@ impl Engine {
         self.next_deadline = self.next_deadline.min(stale_at).min(window_at);
     }
 
+    /// [`next_window`](Self::next_window) with the windows read unchecked.
+    #[inline(always)]
+    fn fast_next_window(&self, (s, e): (u32, u32), time: u64) -> u64 {
+        let mut i = s as usize;
+        while i < e as usize {
+            // SAFETY (`at`): an event's windows are in `windows`
+            // (`Program::check`).
+            let deadline = time.saturating_add(unsafe { *at(&self.net.windows, i) });
+            if deadline >= self.now {
+                return deadline;
+            }
+            i += 1;
+        }
+        u64::MAX
+    }
+
     /// [`expire`](Self::expire) without the network: the agents whose fact
     /// expired or whose window closed are noted in `touched`.
     pub(super) fn fast_expire(&mut self) {
@@ -533,7 +549,7 @@ impl Engine {
                 self.touched.push(a as u32);
             } else if r.window_at < now {
                 let slot = r.slot;
-                let window_at = self.next_window(self.net.event[slot.event as usize].windows, slot.time);
+                let window_at = self.fast_next_window(self.net.event[slot.event as usize].windows, slot.time);
                 let r = unsafe { at_mut(&mut self.agents, a) };
                 r.checked = now;
                 r.window_at = window_at;
