@@ -465,11 +465,12 @@ impl Engine {
         if time > self.now {
             self.now = time;
         }
-        if self.now > self.next_deadline {
+        // Expiry ran (facts may have expired), or not at rest.
+        let expiry = self.now > self.next_deadline;
+        if expiry {
             self.fast_expire();
         }
-        // Not at rest, or facts expired: one test for both.
-        if (self.active.len() | self.touched.len()) != 0 {
+        if expiry || !self.active.is_empty() {
             self.fast_rest()?;
         }
         self.fast_insert(event, time, payload);
@@ -563,7 +564,9 @@ impl Engine {
 
     /// [`rest`](Self::rest) on the fast path, without a new fact: every
     /// rule of the state if the engine was not at rest (`active` not
-    /// empty), else the rules of the agents in `touched`.
+    /// empty), else the rules of the agents in `touched`. Both are empty
+    /// after it, so that in a step `touched` is not empty only if expiry
+    /// ran in the step.
     #[inline(always)]
     pub(super) fn fast_rest(&mut self) -> Result<(), StepError> {
         let mut best = Best { rule: NONE, group: 0, recency: u64::MAX };
@@ -572,6 +575,8 @@ impl Engine {
             // SAFETY (`at`): the state is a state of the bundle.
             self.fast_best_in(unsafe { *at(&self.fp.by_state, st) }, &mut best);
             self.active.clear();
+            // Their rules are the state's.
+            self.touched.clear();
         } else {
             self.fast_best_touched(st, &mut best);
         }
