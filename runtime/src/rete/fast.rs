@@ -56,6 +56,9 @@ use situ_bundle::{AlphaNode, BetaKind, Check, Cmp, Content, Operand, Value};
 /// beyond, the bundle is declined and the interpreter runs it.
 pub const MAX_LIST_ENTRIES: usize = 1 << 22;
 
+/// The largest run-length threshold that gets a bit of its own.
+const MAX_RUN_BIT: u64 = 64;
+
 /// `Cond::event` of a staleness test.
 const STALE: u32 = u32::MAX - 1;
 
@@ -141,6 +144,15 @@ pub(super) struct Program {
     /// Per agent: its bit in [`Engine::have`] while it is stale (after the
     /// events': `ne + agent`, below 64; `0`: none).
     pub(super) stale_bit: Vec<u64>,
+    /// Per event, its bits in [`Engine::have`] by run length: its own, and
+    /// one per run-length threshold `k` of its patterns (above 1, at most
+    /// [`MAX_RUN_BIT`]; after the agents' bits, below 64), set while the
+    /// event is its agent's fact with a run length of at least `k`.
+    /// `run_at[e]` is (its first entry in `runs`, its largest threshold
+    /// `cap`): the bits of `e`'s fact with run length `run` are
+    /// `runs[first + min(run, cap)]`.
+    run_at: Vec<(u32, u32)>,
+    runs: Vec<u64>,
     conds: Vec<Cond>,
     tests: Vec<Test>,
     pub(super) agents: Vec<u32>,
@@ -201,6 +213,41 @@ impl Program {
         let n = &c.network;
         let stale_bit: Vec<u64> = (0..na).map(|a| if ne + a < 64 { 1 << (ne + a) } else { 0 }).collect();
         let mut p = Program { ne, na, stale_bit: stale_bit.clone(), ..Program::default() };
+        // The run-length thresholds that get a bit.
+        let mut pairs: Vec<(u32, u64)> = n
+            .alpha
+            .iter()
+            .filter_map(|a| match a {
+                AlphaNode::Event { event, min_run, .. } if *min_run > 1 && (*event as usize) < ne => {
+                    Some((*event, *min_run))
+                }
+                _ => None,
+            })
+            .collect();
+        pairs.sort_unstable();
+        pairs.dedup();
+        let mut run_bit = std::collections::HashMap::new();
+        let mut next = ne + na;
+        for e in 0..ne as u32 {
+            let mine: Vec<(u64, u64)> = pairs
+                .iter()
+                .filter(|&&(pe, k)| pe == e && k <= MAX_RUN_BIT && bit(e) != 0)
+                .filter_map(|&(_, k)| {
+                    let b = if next < 64 { 1u64 << next } else { 0 };
+                    next += 1;
+                    (b != 0).then(|| {
+                        run_bit.insert((e, k), b);
+                        (k, b)
+                    })
+                })
+                .collect();
+            let cap = mine.iter().map(|&(k, _)| k).max().unwrap_or(0);
+            let first = p.runs.len() as u32;
+            for run in 0..=cap {
+                p.runs.push(mine.iter().filter(|&&(k, _)| run >= k).fold(bit(e), |m, &(_, b)| m | b));
+            }
+            p.run_at.push((first, cap as u32));
+        }
         let arg = |o: &Operand, own: u32| -> Result<Arg, &'static str> {
             Ok(match *o {
                 Operand::Value(v) => Arg::Value(v),
@@ -327,12 +374,29 @@ impl Program {
             p.agents.extend_from_slice(&rule.stale);
             p.fires.push(Fire { target: rule.target, matches: (m0, s0), stale: (s0, p.agents.len() as u32) });
             // The bits: a positive condition's in `need` (kept as a
-            // condition unless the bit decides it whole), a negated one
-            // decided whole by its bit in `mask` alone, unless a positive
-            // condition needs the same bit (the rule never holds: its
-            // conditions say so).
-            let cond_bit = |c: &Cond| if c.event == STALE { stale_bit[c.agent as usize] } else { bit(c.event) };
-            let whole = |c: &Cond, b: u64| b != 0 && c.min_run <= 1 && c.within == u64::MAX && c.tests.0 == c.tests.1;
+            // condition unless the bit decides it whole: no window, no
+            // tests, and no run length above 1 without a threshold's bit),
+            // a negated one decided whole by its bit in `mask` alone,
+            // unless a positive condition needs the same bit (the rule
+            // never holds: its conditions say so).
+            // A run length above 1 is decided by its threshold's bit, if it
+            // has one (else the event's bit is only needed).
+            let threshold_bit = |c: &Cond| run_bit.get(&(c.event, c.min_run)).copied();
+            let cond_bit = |c: &Cond| {
+                if c.event == STALE {
+                    stale_bit[c.agent as usize]
+                } else if c.min_run > 1 {
+                    threshold_bit(c).unwrap_or(bit(c.event))
+                } else {
+                    bit(c.event)
+                }
+            };
+            let whole = |c: &Cond, b: u64| {
+                b != 0
+                    && (c.min_run <= 1 || c.event == STALE || threshold_bit(c).is_some())
+                    && c.within == u64::MAX
+                    && c.tests.0 == c.tests.1
+            };
             let need = p.conds[c0..].iter().filter(|c| !c.negative).fold(0, |m, c| m | cond_bit(c));
             let (mut mask, mut kept) = (need, Vec::new());
             for c in &p.conds[c0..] {
@@ -420,6 +484,8 @@ impl Program {
             && self.fires.iter().all(|f| range(f.matches, self.agents.len()) && range(f.stale, self.agents.len()))
             && self.agents.iter().all(|&a| (a as usize) < self.na);
         let conds = self.stale_bit.len() == self.na
+            && self.run_at.len() == self.ne
+            && self.run_at.iter().all(|&(s, cap)| (s as usize + cap as usize) < self.runs.len())
             && self.conds.iter().all(|c| (c.agent as usize) < self.na && range(c.tests, self.tests.len()));
         let place = |i: u32| (i as usize) < payload_len;
         let arg = |a: Arg| match a {
@@ -501,7 +567,11 @@ impl Engine {
         let old = r.slot;
         let run = if old.event == event { old.run + 1 } else { 1 };
         r.slot = Slot { event, time, run, seq };
-        let old_bit = std::mem::replace(&mut r.bit, ev.bit);
+        // SAFETY (`at`): `run_at` has one entry per event, its range in
+        // `runs` (`Program::check`).
+        let (first, cap) = unsafe { *at(&self.fp.run_at, event as usize) };
+        let new_bit = unsafe { *at(&self.fp.runs, first as usize + run.min(cap as u64) as usize) };
+        let old_bit = std::mem::replace(&mut r.bit, new_bit);
         // The agent's clock: a step's event is stamped at or after it
         // (`admit`); `force_fact` keeps the later of the two itself.
         r.last = time;
@@ -509,12 +579,18 @@ impl Engine {
         r.checked = now;
         r.stale_at = stale_at;
         r.window_at = window_at;
-        self.have = (self.have & !old_bit) | ev.bit;
+        self.have = (self.have & !old_bit) | new_bit;
         // SAFETY: the event's place and its fields fit in the arena
         // (`Program::check`), and `payload` has as many values as it has
         // fields (the payload check).
         copy_payload(unsafe { self.payload.get_unchecked_mut(ev.payload_at as usize..) }, payload);
         self.next_deadline = self.next_deadline.min(stale_at).min(window_at);
+    }
+
+    /// The bits of `event`'s fact with run length `run` (`Program::runs`).
+    pub(super) fn fast_run_bits(&self, event: u32, run: u64) -> u64 {
+        let (first, cap) = self.fp.run_at[event as usize];
+        self.fp.runs[first as usize + run.min(cap as u64) as usize]
     }
 
     /// [`next_window`](Self::next_window) with the windows read unchecked.

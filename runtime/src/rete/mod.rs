@@ -515,6 +515,10 @@ impl Engine {
             self.fast_insert(event, time, payload);
             self.agents[agent].last = last.max(time);
             self.agents[agent].slot.run = run.max(1);
+            // The fact's bits with its run length.
+            let bit = self.fast_run_bits(event, run.max(1));
+            self.have = (self.have & !self.agents[agent].bit) | bit;
+            self.agents[agent].bit = bit;
             self.fast_activate();
             return Ok(());
         }
