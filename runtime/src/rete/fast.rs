@@ -32,9 +32,14 @@
 //! other node is a [`Cond`]: an agent's event, run length, window and tests
 //! (alpha and join tests together, every field resolved to its place in the
 //! payload arena, as the interpreter reads it), or its staleness, either of
-//! them negated. Firings are recorded by the interpreter's own
-//! `record_firing`, so that steps, recorded firings and explanations are
-//! the same. A bundle is declined (the interpreter runs it) only if a state
+//! them negated. The working memory is also held as bits
+//! ([`Engine::have`]: each agent's fact's event, the run-length thresholds
+//! it reaches, a stale agent): a rule is first tested by
+//! `have & mask == need`, and a condition its bit decides whole (no window,
+//! no tests) is not among its conditions. Firings are recorded as the
+//! interpreter's `record_firing` records them (`fast_record`, from the
+//! program's per-rule tables), so that steps, recorded firings and
+//! explanations are the same. A bundle is declined (the interpreter runs it) only if a state
 //! or staleness node carries join tests (the compiler writes none), if its
 //! lists would exceed [`MAX_LIST_ENTRIES`], or if an index of its network
 //! is out of range (`Program::check`; a validated bundle has none).
