@@ -32,9 +32,14 @@
 //! other node is a [`Cond`]: an agent's event, run length, window and tests
 //! (alpha and join tests together, every field resolved to its place in the
 //! payload arena, as the interpreter reads it), or its staleness, either of
-//! them negated. Firings are recorded by the interpreter's own
-//! `record_firing`, so that steps, recorded firings and explanations are
-//! the same. A bundle is declined (the interpreter runs it) only if a state
+//! them negated. The working memory is also held as bits
+//! ([`Engine::have`]: each agent's fact's event, the run-length thresholds
+//! it reaches, a stale agent): a rule is first tested by
+//! `have & mask == need`, and a condition its bit decides whole (no window,
+//! no tests) is not among its conditions. Firings are recorded as the
+//! interpreter's `record_firing` records them (`fast_record`, from the
+//! program's per-rule tables), so that steps, recorded firings and
+//! explanations are the same. A bundle is declined (the interpreter runs it) only if a state
 //! or staleness node carries join tests (the compiler writes none), if its
 //! lists would exceed [`MAX_LIST_ENTRIES`], or if an index of its network
 //! is out of range (`Program::check`; a validated bundle has none).
@@ -47,14 +52,19 @@
 //! the agent's last evaluation, which equals now whenever expiry is due
 //! on no deadline.
 
+mod build;
+
 use super::eval::{compare, float, in_range};
-use super::net::{Net, NONE};
+use super::net::NONE;
 use super::{copy_payload, AgentRec, Engine, Slot, Step, StepError, AGENT};
-use situ_bundle::{AlphaNode, BetaKind, Check, Cmp, Content, Operand, Value};
+use situ_bundle::{Cmp, Value};
 
 /// The most entries the candidate lists of a bundle may take (u32 each):
 /// beyond, the bundle is declined and the interpreter runs it.
 pub const MAX_LIST_ENTRIES: usize = 1 << 22;
+
+/// The largest run-length threshold that gets a bit of its own.
+const MAX_RUN_BIT: u64 = 64;
 
 /// `Cond::event` of a staleness test.
 const STALE: u32 = u32::MAX - 1;
@@ -104,11 +114,24 @@ struct Rule {
     /// The rank of its (salience, specificity) among the rules': a larger
     /// one fires first.
     group: u32,
-    /// The events (below 64) its positive patterns need as facts, as bits:
-    /// the rule cannot hold unless `Engine::have` has them all.
+    /// The bits of [`Engine::have`] its conditions read (`mask`) and the
+    /// values they need (`need`): an event's bit (below 64) set for a
+    /// positive pattern of it, a stale agent's bit set for a positive
+    /// `stale`, either clear for a negated one. The rule cannot hold unless
+    /// `have & mask == need`; a condition that the bits decide whole (no
+    /// run length above 1, no window, no tests) is not in `conds`.
     need: u64,
-    /// The agents its positive patterns match (recency), in `Program::agents`.
-    matches: (u32, u32),
+    mask: u64,
+}
+
+/// What a firing of a rule reads (`Engine::fast_record`) and its recency.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Fire {
+    pub(super) target: u32,
+    /// The agents its positive patterns match (recency, the matched facts)
+    /// and those it tests for staleness, in `Program::agents`.
+    pub(super) matches: (u32, u32),
+    pub(super) stale: (u32, u32),
 }
 
 /// The rules of a bundle flattened for the fast path.
@@ -123,9 +146,23 @@ pub(super) struct Program {
     by_state: Vec<(u32, u32)>,
     lists: Vec<u32>,
     rules: Vec<Rule>,
+    /// Per rule, what its firing records.
+    pub(super) fires: Vec<Fire>,
+    /// Per agent: its bit in [`Engine::have`] while it is stale (after the
+    /// events': `ne + agent`, below 64; `0`: none).
+    pub(super) stale_bit: Vec<u64>,
+    /// Per event, its bits in [`Engine::have`] by run length: its own, and
+    /// one per run-length threshold `k` of its patterns (above 1, at most
+    /// [`MAX_RUN_BIT`]; after the agents' bits, below 64), set while the
+    /// event is its agent's fact with a run length of at least `k`.
+    /// `run_at[e]` is (its first entry in `runs`, its largest threshold
+    /// `cap`): the bits of `e`'s fact with run length `run` are
+    /// `runs[first + min(run, cap)]`.
+    run_at: Vec<(u32, u32)>,
+    runs: Vec<u64>,
     conds: Vec<Cond>,
     tests: Vec<Test>,
-    agents: Vec<u32>,
+    pub(super) agents: Vec<u32>,
 }
 
 /// The activated rule that fires first among those seen so far (`rule`:
@@ -155,7 +192,7 @@ pub(super) fn bit(event: u32) -> u64 {
 /// state is always a state of the bundle and the event of a step one the
 /// payload check took.
 #[inline(always)]
-unsafe fn at<T>(v: &[T], i: usize) -> &T {
+pub(super) unsafe fn at<T>(v: &[T], i: usize) -> &T {
     debug_assert!(i < v.len(), "{i} >= {}", v.len());
     // SAFETY: the caller's.
     unsafe { v.get_unchecked(i) }
@@ -172,253 +209,6 @@ unsafe fn at_mut<T>(v: &mut [T], i: usize) -> &mut T {
     unsafe { v.get_unchecked_mut(i) }
 }
 
-impl Program {
-    /// The program of a validated bundle, or why the fast path declines it.
-    // The lists are built per state and agent, the tables indexed per rule.
-    #[allow(clippy::needless_range_loop)]
-    pub(super) fn new(c: &Content, net: &Net) -> Result<Program, &'static str> {
-        let ns = c.states.len();
-        let ne = c.events.len();
-        let na = c.agents.len();
-        let n = &c.network;
-        let mut p = Program { ne, na, ..Program::default() };
-        let arg = |o: &Operand, own: u32| -> Result<Arg, &'static str> {
-            Ok(match *o {
-                Operand::Value(v) => Arg::Value(v),
-                Operand::Own { field } => Arg::At(place(net, own, field)?),
-                Operand::Fact { agent, field } => {
-                    let a = agent as usize;
-                    if a >= na {
-                        return Err("a test reads an agent out of range");
-                    }
-                    if field < net.stride[a] {
-                        Arg::At(net.payload_at[a] + field)
-                    } else {
-                        // As the interpreter: a value that matches nothing.
-                        Arg::Value(Value::F64(f64::NAN))
-                    }
-                }
-            })
-        };
-        // Per rule: the states it can be activated in, the agents it reads.
-        let mut ok_states: Vec<Vec<bool>> = Vec::with_capacity(c.rules.len());
-        let mut reads: Vec<Vec<bool>> = Vec::with_capacity(c.rules.len());
-        let mut terminal = vec![NONE; c.rules.len()];
-        for t in &n.terminals {
-            terminal[t.rule as usize] = t.beta;
-        }
-        for (r, rule) in c.rules.iter().enumerate() {
-            let mut chain = Vec::new();
-            let mut b = terminal[r];
-            while b != NONE {
-                if chain.len() > n.beta.len() {
-                    return Err("a chain of beta nodes loops");
-                }
-                chain.push(b);
-                b = n.beta[b as usize].parent.unwrap_or(NONE);
-            }
-            if chain.is_empty() {
-                return Err("a rule without a terminal");
-            }
-            chain.reverse();
-            let mut ok = vec![true; ns];
-            let mut read = vec![false; na];
-            let c0 = p.conds.len();
-            for &b in &chain {
-                let beta = &n.beta[b as usize];
-                let negative = beta.kind == BetaKind::Negative;
-                match &n.alpha[beta.alpha as usize] {
-                    AlphaNode::State { states } => {
-                        if !beta.tests.is_empty() {
-                            return Err("join tests on a state node");
-                        }
-                        for (s, o) in ok.iter_mut().enumerate() {
-                            *o &= states.contains(&(s as u32)) != negative;
-                        }
-                    }
-                    AlphaNode::Stale { agent } => {
-                        if !beta.tests.is_empty() {
-                            return Err("join tests on a staleness node");
-                        }
-                        read[*agent as usize] = true;
-                        p.conds.push(Cond {
-                            agent: *agent,
-                            event: STALE,
-                            negative,
-                            min_run: 0,
-                            within: u64::MAX,
-                            tests: (0, 0),
-                        });
-                    }
-                    AlphaNode::Event { event, tests, min_run, within_ns } => {
-                        let agent = c.events[*event as usize].agent;
-                        read[agent as usize] = true;
-                        let own = net.payload_at[agent as usize];
-                        let t0 = p.tests.len() as u32;
-                        for t in tests.iter().chain(&beta.tests) {
-                            let x = place(net, own, t.field)?;
-                            let float = c.events[*event as usize]
-                                .fields
-                                .get(t.field as usize)
-                                .is_some_and(|f| f.ty == situ_bundle::FieldType::F64);
-                            let test = match &t.check {
-                                Check::Compare { op, rhs: Operand::Value(Value::F64(c)) } if float => {
-                                    Test::F64 { x, op: *op, c: *c }
-                                }
-                                Check::Range {
-                                    lo: Operand::Value(Value::F64(lo)),
-                                    hi: Operand::Value(Value::F64(hi)),
-                                    inclusive,
-                                } if float => Test::F64Range { x, lo: *lo, hi: *hi, inclusive: *inclusive },
-                                Check::Compare { op, rhs } => {
-                                    Test::Any { x, check: Check2::Compare { op: *op, rhs: arg(rhs, own)? } }
-                                }
-                                Check::Range { lo, hi, inclusive } => Test::Any {
-                                    x,
-                                    check: Check2::Range {
-                                        lo: arg(lo, own)?,
-                                        hi: arg(hi, own)?,
-                                        inclusive: *inclusive,
-                                    },
-                                },
-                            };
-                            for o in operands(&t.check) {
-                                if let Operand::Fact { agent, .. } = o {
-                                    read[*agent as usize] = true;
-                                }
-                            }
-                            p.tests.push(test);
-                        }
-                        p.conds.push(Cond {
-                            agent,
-                            event: *event,
-                            negative,
-                            min_run: *min_run,
-                            within: within_ns.unwrap_or(u64::MAX),
-                            tests: (t0, p.tests.len() as u32),
-                        });
-                    }
-                }
-            }
-            let m0 = p.agents.len() as u32;
-            p.agents.extend_from_slice(&rule.matches);
-            let need =
-                p.conds[c0..].iter().filter(|c| !c.negative && c.event != STALE).fold(0, |m, c| m | bit(c.event));
-            p.rules.push(Rule {
-                conds: (c0 as u32, p.conds.len() as u32),
-                group: 0,
-                need,
-                matches: (m0, p.agents.len() as u32),
-            });
-            ok_states.push(ok);
-            reads.push(read);
-        }
-
-        // The rules in the order they fire in, all else equal, and the rank
-        // of each one's (salience, specificity).
-        let prio = |r: u32| (c.rules[r as usize].salience, c.rules[r as usize].specificity);
-        let mut order: Vec<u32> = (0..c.rules.len() as u32).collect();
-        order.sort_by_key(|&r| (std::cmp::Reverse(prio(r)), r));
-        let mut groups: Vec<(i64, u32)> = order.iter().map(|&r| prio(r)).collect();
-        groups.dedup();
-        for r in 0..c.rules.len() {
-            let rank = groups.len() - 1 - groups.iter().position(|&g| g == prio(r as u32)).unwrap_or(0);
-            p.rules[r].group = rank as u32;
-        }
-        // Whether `e` (of agent `a`) makes a condition of `r` on `a` false.
-        let excluded = |p: &Program, r: u32, a: u32, e: u32| {
-            let (s, t) = p.rules[r as usize].conds;
-            p.conds[s as usize..t as usize].iter().any(|c| c.agent == a && !c.negative && c.event != e)
-        };
-        let push = |p: &mut Program, keep: &dyn Fn(&Program, u32) -> bool| -> Result<(u32, u32), &'static str> {
-            let s = p.lists.len();
-            for &r in &order {
-                if keep(p, r) {
-                    p.lists.push(r);
-                }
-            }
-            if p.lists.len() > MAX_LIST_ENTRIES {
-                return Err("its candidate lists are too large");
-            }
-            Ok((s as u32, p.lists.len() as u32))
-        };
-        for s in 0..ns {
-            let l = push(&mut p, &|_, r| ok_states[r as usize][s])?;
-            p.by_state.push(l);
-            for a in 0..na {
-                let l = push(&mut p, &|_, r| ok_states[r as usize][s] && reads[r as usize][a])?;
-                p.by_agent.push(l);
-            }
-            for e in 0..ne {
-                let a = c.events[e].agent;
-                let l = push(&mut p, &|p, r| {
-                    ok_states[r as usize][s] && reads[r as usize][a as usize] && !excluded(p, r, a, e as u32)
-                })?;
-                p.by_event.push(l);
-            }
-        }
-        p.check(ns, net)?;
-        Ok(p)
-    }
-
-    /// Checks every index of the program against the tables it indexes:
-    /// the invariant under which the engine reads them unchecked ([`at`]).
-    fn check(&self, ns: usize, net: &Net) -> Result<(), &'static str> {
-        let payload_len = net.payload_len;
-        // The events' agents, their places and windows (`fast_insert`).
-        let events = net.event.len() == self.ne
-            && net.timed_agents.iter().all(|&a| (a as usize) < self.na)
-            && net.event.iter().all(|e| {
-                (e.agent as usize) < self.na
-                    && e.payload_at as usize + (e.kinds.1 - e.kinds.0) as usize <= payload_len
-                    && e.windows.0 <= e.windows.1
-                    && e.windows.1 as usize <= net.windows.len()
-            });
-        let range = |(s, e): (u32, u32), len: usize| s <= e && e as usize <= len;
-        let lists = self.by_state.len() == ns
-            && self.by_agent.len() == ns * self.na
-            && self.by_event.len() == ns * self.ne
-            && self.by_state.iter().chain(&self.by_agent).chain(&self.by_event).all(|&l| range(l, self.lists.len()))
-            && self.lists.iter().all(|&r| (r as usize) < self.rules.len());
-        let rules = self.rules.iter().all(|r| range(r.conds, self.conds.len()) && range(r.matches, self.agents.len()))
-            && self.agents.iter().all(|&a| (a as usize) < self.na);
-        let conds = self.conds.iter().all(|c| (c.agent as usize) < self.na && range(c.tests, self.tests.len()));
-        let place = |i: u32| (i as usize) < payload_len;
-        let arg = |a: Arg| match a {
-            Arg::Value(_) => true,
-            Arg::At(i) => place(i),
-        };
-        let tests = self.tests.iter().all(|t| match *t {
-            Test::F64 { x, .. } | Test::F64Range { x, .. } => place(x),
-            Test::Any { x, check: Check2::Compare { rhs, .. } } => place(x) && arg(rhs),
-            Test::Any { x, check: Check2::Range { lo, hi, .. } } => place(x) && arg(lo) && arg(hi),
-        });
-        if events && lists && rules && conds && tests {
-            Ok(())
-        } else {
-            Err("an index of the program out of its table")
-        }
-    }
-}
-
-/// The place in the arena of field `field` of the agent whose payload starts
-/// at `own`, if the arena has it (the interpreter reads the same place).
-fn place(net: &Net, own: u32, field: u32) -> Result<u32, &'static str> {
-    let x = own as usize + field as usize;
-    if x < net.payload_len {
-        Ok(x as u32)
-    } else {
-        Err("a test reads a field out of the payload arena")
-    }
-}
-
-fn operands(c: &Check) -> Vec<&Operand> {
-    match c {
-        Check::Compare { rhs, .. } => vec![rhs],
-        Check::Range { lo, hi, .. } => vec![lo, hi],
-    }
-}
-
 impl Engine {
     /// [`accepted`](Self::accepted) on the fast path.
     #[inline(always)]
@@ -427,19 +217,21 @@ impl Engine {
         if time > self.now {
             self.now = time;
         }
-        if self.now > self.next_deadline {
+        // Expiry ran (facts may have expired), or not at rest.
+        let expiry = self.now > self.next_deadline;
+        if expiry {
             self.fast_expire();
         }
-        // Not at rest, or facts expired: one test for both.
-        if (self.active.len() | self.touched.len()) != 0 {
-            self.fast_rest(NONE)?;
+        if expiry || !self.active.is_empty() {
+            self.fast_rest()?;
         }
         self.fast_insert(event, time, payload);
-        if self.now > self.next_deadline {
-            // The fact came late: it may be expired already.
+        // The fact came late: it may be expired already.
+        let late = self.now > self.next_deadline;
+        if late {
             self.fast_expire();
         }
-        self.fast_rest(event)?;
+        self.fast_rest_after(event, late)?;
         Ok(Step { from: self.record.from, to: self.state, firings: self.record.firings.len() })
     }
 
@@ -454,25 +246,53 @@ impl Engine {
         let a = ev.agent as usize;
         // `u64::MAX` (never) stays `u64::MAX`.
         let stale_at = time.saturating_add(ev.stale_after);
-        let window_at = if ev.windows.0 == ev.windows.1 { u64::MAX } else { self.next_window(ev.windows, time) };
+        let window_at = self.fast_next_window(ev.windows, time);
         self.seq += 1;
         let (seq, now) = (self.seq, self.now);
         let r = unsafe { at_mut(&mut self.agents, a) };
         let old = r.slot;
         let run = if old.event == event { old.run + 1 } else { 1 };
         r.slot = Slot { event, time, run, seq };
-        let old_bit = std::mem::replace(&mut r.bit, ev.bit);
-        r.last = r.last.max(time);
+        // SAFETY (`at`): `run_at` has one entry per event, its range in
+        // `runs` (`Program::check`).
+        let (first, cap) = unsafe { *at(&self.fp.run_at, event as usize) };
+        let new_bit = unsafe { *at(&self.fp.runs, first as usize + run.min(cap as u64) as usize) };
+        let old_bit = std::mem::replace(&mut r.bit, new_bit);
+        // The agent's clock: a step's event is stamped at or after it
+        // (`admit`); `force_fact` keeps the later of the two itself.
+        r.last = time;
         r.stale = false;
         r.checked = now;
         r.stale_at = stale_at;
         r.window_at = window_at;
-        self.have = (self.have & !old_bit) | ev.bit;
+        self.have = (self.have & !old_bit) | new_bit;
         // SAFETY: the event's place and its fields fit in the arena
         // (`Program::check`), and `payload` has as many values as it has
         // fields (the payload check).
         copy_payload(unsafe { self.payload.get_unchecked_mut(ev.payload_at as usize..) }, payload);
         self.next_deadline = self.next_deadline.min(stale_at).min(window_at);
+    }
+
+    /// The bits of `event`'s fact with run length `run` (`Program::runs`).
+    pub(super) fn fast_run_bits(&self, event: u32, run: u64) -> u64 {
+        let (first, cap) = self.fp.run_at[event as usize];
+        self.fp.runs[first as usize + run.min(cap as u64) as usize]
+    }
+
+    /// [`next_window`](Self::next_window) with the windows read unchecked.
+    #[inline(always)]
+    fn fast_next_window(&self, (s, e): (u32, u32), time: u64) -> u64 {
+        let mut i = s as usize;
+        while i < e as usize {
+            // SAFETY (`at`): an event's windows are in `windows`
+            // (`Program::check`).
+            let deadline = time.saturating_add(unsafe { *at(&self.net.windows, i) });
+            if deadline >= self.now {
+                return deadline;
+            }
+            i += 1;
+        }
+        u64::MAX
     }
 
     /// [`expire`](Self::expire) without the network: the agents whose fact
@@ -485,12 +305,14 @@ impl Engine {
             let a = unsafe { *at(&self.net.timed_agents, i) } as usize;
             let r = unsafe { at_mut(&mut self.agents, a) };
             if r.stale_at < now {
-                self.have &= !r.bit;
-                *r = AgentRec { last: r.last, checked: r.checked, stale: true, ..AGENT };
+                // SAFETY (`at`): `stale_bit` has one entry per agent (`Program::check`).
+                let sb = unsafe { *at(&self.fp.stale_bit, a) };
+                self.have = (self.have & !r.bit) | sb;
+                *r = AgentRec { last: r.last, checked: r.checked, stale: true, bit: sb, ..AGENT };
                 self.touched.push(a as u32);
             } else if r.window_at < now {
                 let slot = r.slot;
-                let window_at = self.next_window(self.net.event[slot.event as usize].windows, slot.time);
+                let window_at = self.fast_next_window(self.net.event[slot.event as usize].windows, slot.time);
                 let r = unsafe { at_mut(&mut self.agents, a) };
                 r.checked = now;
                 r.window_at = window_at;
@@ -502,39 +324,58 @@ impl Engine {
         self.next_deadline = next;
     }
 
-    /// [`rest`](Self::rest) on the fast path. The first search covers what
-    /// changed since the last rest: every rule of the state if the engine
-    /// was not at rest (`active` not empty), else the rules of `event`'s new
-    /// fact (`NONE`: none) and of the agents in `touched`. With an event,
-    /// the engine was at rest before its fact was inserted (a rest came
-    /// first, or an error returned).
+    /// [`rest`](Self::rest) on the fast path, without a new fact: every
+    /// rule of the state if the engine was not at rest (`active` not
+    /// empty), else the rules of the agents in `touched`. Both are empty
+    /// after it, so that in a step `touched` is not empty only if expiry
+    /// ran in the step.
     #[inline(always)]
-    pub(super) fn fast_rest(&mut self, event: u32) -> Result<(), StepError> {
+    pub(super) fn fast_rest(&mut self) -> Result<(), StepError> {
         let mut best = Best { rule: NONE, group: 0, recency: u64::MAX };
         let st = self.state as usize;
-        if event == NONE && !self.active.is_empty() {
+        if !self.active.is_empty() {
             // SAFETY (`at`): the state is a state of the bundle.
             self.fast_best_in(unsafe { *at(&self.fp.by_state, st) }, &mut best);
             self.active.clear();
+            // Their rules are the state's.
+            self.touched.clear();
         } else {
-            if event != NONE {
-                // SAFETY (`at`): the state and the event (taken by the
-                // payload check) are the bundle's: `st * ne + event < ns * ne`.
-                let list = unsafe { *at(&self.fp.by_event, st * self.fp.ne + event as usize) };
-                self.fast_best_in(list, &mut best);
-            }
-            if !self.touched.is_empty() {
-                for i in 0..self.touched.len() {
-                    let a = self.touched[i] as usize;
-                    self.fast_best_in(self.fp.by_agent[st * self.fp.na + a], &mut best);
-                }
-                self.touched.clear();
-            }
+            self.fast_best_touched(st, &mut best);
         }
         if best.rule == NONE {
             return Ok(());
         }
         self.fast_fire(best)
+    }
+
+    /// The rest after a step's fact of `event`: the engine was at rest
+    /// before it was inserted (a rest came first, or an error returned), so
+    /// the rules of `event`'s new fact, and if expiry ran after the insert
+    /// (`late`), those of the agents in `touched` (else it is empty).
+    #[inline(always)]
+    fn fast_rest_after(&mut self, event: u32, late: bool) -> Result<(), StepError> {
+        let mut best = Best { rule: NONE, group: 0, recency: u64::MAX };
+        let st = self.state as usize;
+        // SAFETY (`at`): the state and the event (taken by the payload
+        // check) are the bundle's: `st * ne + event < ns * ne`.
+        let list = unsafe { *at(&self.fp.by_event, st * self.fp.ne + event as usize) };
+        self.fast_best_in(list, &mut best);
+        if late {
+            self.fast_best_touched(st, &mut best);
+        }
+        if best.rule == NONE {
+            return Ok(());
+        }
+        self.fast_fire(best)
+    }
+
+    /// The rules of the agents in `touched` (emptied) in state `st`.
+    fn fast_best_touched(&mut self, st: usize, best: &mut Best) {
+        for i in 0..self.touched.len() {
+            let a = self.touched[i] as usize;
+            self.fast_best_in(self.fp.by_agent[st * self.fp.na + a], best);
+        }
+        self.touched.clear();
     }
 
     /// Fires `best`, then the rule that fires first in each new state,
@@ -546,7 +387,7 @@ impl Engine {
                 self.fast_activate();
                 return Err(StepError::Cascade { limit: self.cascade_limit });
             }
-            self.state = self.record_firing(best.rule);
+            self.state = self.fast_record(best.rule);
             best = Best { rule: NONE, group: 0, recency: u64::MAX };
             self.fast_best_in(self.fp.by_state[self.state as usize], &mut best);
         }
@@ -569,7 +410,7 @@ impl Engine {
                 // The list is in firing order: no later rule comes first.
                 return;
             }
-            if rule.need & self.have != rule.need || !self.fast_holds(rule) {
+            if self.have & rule.mask != rule.need || !self.fast_holds(rule) {
                 continue;
             }
             if best.rule == NONE || rule.group > best.group {
@@ -579,17 +420,17 @@ impl Engine {
             // The same salience and specificity: recency, then the rule
             // declared first.
             if best.recency == u64::MAX {
-                best.recency = self.fast_recency(unsafe { at(&p.rules, best.rule as usize) });
+                best.recency = self.fast_recency(best.rule);
             }
-            let recency = self.fast_recency(rule);
+            let recency = self.fast_recency(r);
             if recency > best.recency || (recency == best.recency && r < best.rule) {
                 *best = Best { rule: r, group: rule.group, recency };
             }
         }
     }
 
-    fn fast_recency(&self, rule: &Rule) -> u64 {
-        let (s, e) = rule.matches;
+    fn fast_recency(&self, r: u32) -> u64 {
+        let (s, e) = self.fp.fires[r as usize].matches;
         self.fp.agents[s as usize..e as usize].iter().map(|&a| self.agents[a as usize].slot.seq).max().unwrap_or(0)
     }
 
@@ -671,7 +512,7 @@ impl Engine {
         for i in s as usize..e as usize {
             let r = self.fp.lists[i];
             let rule = &self.fp.rules[r as usize];
-            if rule.need & self.have == rule.need && self.fast_holds(rule) {
+            if self.have & rule.mask == rule.need && self.fast_holds(rule) {
                 active.push(r);
             }
         }

@@ -3,6 +3,7 @@
 //! firing until no rule is activated, each firing recorded with the facts
 //! it matched (for explanations) in the buffers of the step.
 
+use super::fast::at;
 use super::{Engine, FactRec, FiringRec, StepError};
 
 impl Engine {
@@ -108,5 +109,50 @@ impl Engine {
         };
         self.record.firings.push(rec);
         to
+    }
+}
+
+impl Engine {
+    /// [`record_firing`](Self::record_firing) on the fast path, from the
+    /// program's per-rule tables (`fast::Fire`): the same records.
+    #[inline(always)]
+    pub(super) fn fast_record(&mut self, r: u32) -> u32 {
+        let p = &*self.fp;
+        // SAFETY (`fast::at`): `r` is a rule of the program's lists, and
+        // `fires` has one entry per rule; a firing's agents are in
+        // `agents`, which are agents (`Program::check`), and `self.agents`
+        // has one record per agent.
+        let f = unsafe { *at(&p.fires, r as usize) };
+        let rec = &mut self.record;
+        let facts0 = rec.facts.len() as u32;
+        for i in f.matches.0 as usize..f.matches.1 as usize {
+            let a = unsafe { *at(&p.agents, i) };
+            let slot = unsafe { at(&self.agents, a as usize) }.slot;
+            // An agent's fact is one of its events, whose place and fields
+            // fit in the arena (`Program::check`): the interpreter's
+            // `payload_at[a]` and field count.
+            let (s, n) = self
+                .net
+                .event
+                .get(slot.event as usize)
+                .map_or((0, 0), |e| (e.payload_at as usize, e.kinds.1.wrapping_sub(e.kinds.0) as usize));
+            let v0 = rec.values.len() as u32;
+            for j in s..s + n {
+                rec.values.push(unsafe { *at(&self.payload, j) });
+            }
+            let values = (v0, rec.values.len() as u32);
+            rec.facts.push(FactRec { agent: a, event: slot.event, time: slot.time, run: slot.run, values });
+        }
+        let stale0 = rec.stale.len() as u32;
+        for i in f.stale.0 as usize..f.stale.1 as usize {
+            let a = unsafe { *at(&p.agents, i) };
+            if unsafe { at(&self.agents, a as usize) }.stale {
+                rec.stale.push(a);
+            }
+        }
+        let facts = (facts0, rec.facts.len() as u32);
+        let stale = (stale0, rec.stale.len() as u32);
+        rec.firings.push(FiringRec { rule: r, from: self.state, to: f.target, time: self.now, facts, stale });
+        f.target
     }
 }

@@ -83,7 +83,9 @@ const EMPTY: Slot = Slot { event: NONE, time: 0, run: 0, seq: 0 };
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 struct AgentRec {
     slot: Slot,
-    /// `fast::bit(slot.event)`: its fact's bit of `Engine::have`.
+    /// Its bit of `Engine::have`: its fact's (`fast::bit(slot.event)`), or
+    /// on the fast path its stale bit while it is stale
+    /// (`fast::Program::stale_bit`), or 0.
     bit: u64,
     /// Timers: the time its fact expires and the next window that closes
     /// (`u64::MAX`: none).
@@ -139,8 +141,9 @@ pub struct Engine {
     fp: Arc<fast::Program>,
     touched: Vec<u32>,
     declined: Option<&'static str>,
-    /// The events (below 64) that are an agent's fact now, as bits
-    /// (`fast::bit`); kept on the fast path only.
+    /// The events (below 64) that are an agent's fact now, and the stale
+    /// agents (`fast::Program::stale_bit`), as bits: the `bit`s of the
+    /// agents' records, or'd; kept on the fast path only.
     have: u64,
 }
 
@@ -404,7 +407,7 @@ impl Engine {
                 self.fast_expire();
             }
             if !self.active.is_empty() || !self.touched.is_empty() {
-                self.fast_rest(NONE).map_err(|e| self.post_error(e))?;
+                self.fast_rest().map_err(|e| self.post_error(e))?;
             }
         } else {
             if self.now > self.next_deadline {
@@ -422,7 +425,7 @@ impl Engine {
     pub fn settle(&mut self) -> Result<Option<StateChange>, PostError> {
         self.begin();
         if self.fast {
-            self.fast_rest(NONE).map_err(|e| self.post_error(e))?;
+            self.fast_rest().map_err(|e| self.post_error(e))?;
         } else {
             self.rest().map_err(|e| self.post_error(e))?;
         }
@@ -507,9 +510,15 @@ impl Engine {
         self.validate(event, payload)?;
         self.now = self.now.max(time);
         if self.fast {
-            self.fast_insert(event, time, payload);
             let agent = self.content.events[event as usize].agent as usize;
+            let last = self.agents[agent].last;
+            self.fast_insert(event, time, payload);
+            self.agents[agent].last = last.max(time);
             self.agents[agent].slot.run = run.max(1);
+            // The fact's bits with its run length.
+            let bit = self.fast_run_bits(event, run.max(1));
+            self.have = (self.have & !self.agents[agent].bit) | bit;
+            self.agents[agent].bit = bit;
             self.fast_activate();
             return Ok(());
         }
@@ -533,9 +542,10 @@ impl Engine {
             return;
         }
         if self.fast {
-            self.have &= !fast::bit(self.agents[a].slot.event);
+            let sb = self.fp.stale_bit[a];
+            self.have = (self.have & !self.agents[a].bit) | sb;
             self.agents[a].slot = EMPTY;
-            self.agents[a].bit = 0;
+            self.agents[a].bit = sb;
             self.agents[a].stale = true;
             self.agents[a].stale_at = u64::MAX;
             self.agents[a].window_at = u64::MAX;
