@@ -23,8 +23,8 @@
 //! # board = true                     # leads at start, the others follow its log
 //! # listen = ["tcp/127.0.0.1:7450"]  # and one of them leads when it falls silent
 //! # beats = { listen = "udp/127.0.0.1:7461", send = ["udp/127.0.0.1:7460"] }
-//! #                                  # optional, on each board: the leader's beats
-//! #                                  # over UDP too (a lossy network; `crate::beats`)
+//! #                                  # optional, on every board or none: the leader's
+//! #                                  # beats over UDP too (a lossy network; `crate::beats`)
 //!
 //! # [standby]                        # optional, with two boards or more
 //! # lease_ms = 400                   # a follower leads after this long without the leader
@@ -342,6 +342,19 @@ impl Deployment {
                         p.name
                     )));
                 }
+                if b.send.is_empty() {
+                    return Err(DeployError(format!(
+                        "process `{}`: `beats` with no `send`: when it leads, its beats would reach no other board",
+                        p.name
+                    )));
+                }
+                if let Some(q) = d.processes.iter().find(|q| q.board && q.beats.is_none()) {
+                    return Err(DeployError(format!(
+                        "process `{}` has `beats` and board `{}` has not: give `beats` to every board of the standby \
+                         group or to none (a leader without it sends none)",
+                        p.name, q.name
+                    )));
+                }
                 for e in std::iter::once(&b.listen).chain(&b.send) {
                     if !crate::beats::is_endpoint(e) {
                         return Err(DeployError(format!(
@@ -594,17 +607,28 @@ connect = ["tcp/127.0.0.1:7447"]
         assert!(!Deployment::parse(GOOD, &agents()).unwrap().has_standby());
     }
 
+    /// [`GOOD`] with a second board, `b2`: `beats = { a }` on `board` and
+    /// `beats = { b }` on `b2` (none for an empty text).
+    fn group(a: &str, b: &str) -> String {
+        let beats = |x: &str| if x.is_empty() { String::new() } else { format!("\nbeats = {{ {x} }}") };
+        format!(
+            "{}[[process]]\nname = \"b2\"\nboard = true{}\n",
+            GOOD.replace("board = true", &format!("board = true{}", beats(a))),
+            beats(b)
+        )
+    }
+
     #[test]
     fn a_board_s_beats_are_resolved_to_addresses() {
-        let text = format!(
-            "{GOOD}[[process]]\nname = \"b2\"\nboard = true\n\
-             beats = {{ listen = \"udp/127.0.0.1:7461\", send = [\"udp/127.0.0.1:7460\", \"udp/localhost:7462\"] }}\n"
+        let text = group(
+            "listen = \"udp/127.0.0.1:7460\", send = [\"udp/127.0.0.1:7461\"]",
+            "listen = \"udp/127.0.0.1:7461\", send = [\"udp/127.0.0.1:7460\", \"udp/localhost:7462\"]",
         );
         let d = Deployment::parse(&text, &agents()).unwrap();
         let beats = d.beats(d.process("b2").unwrap()).unwrap().unwrap();
         assert_eq!(beats.listen, "127.0.0.1:7461".parse().unwrap());
         assert_eq!(beats.send.iter().map(|a| a.port()).collect::<Vec<_>>(), [7460, 7462]);
-        assert_eq!(d.beats(d.process("board").unwrap()).unwrap(), None);
+        assert_eq!(d.beats(d.process("sensors").unwrap()).unwrap(), None);
         let unknown = text.replace("udp/localhost:7462", "udp/no-such-host.invalid:7462");
         let d = Deployment::parse(&unknown, &agents()).unwrap();
         let e = d.beats(d.process("b2").unwrap()).unwrap_err().to_string();
@@ -652,21 +676,30 @@ connect = ["tcp/127.0.0.1:7447"]
                 "process `board`: `beats` belongs to the boards of a standby group",
             ),
             (
-                format!(
-                    "{GOOD}[[process]]\nname = \"b2\"\nboard = true\nbeats = {{ listen = \"tcp/127.0.0.1:7460\" }}\n"
+                group(
+                    "listen = \"udp/127.0.0.1:1\", send = [\"udp/127.0.0.1:2\"]",
+                    "listen = \"tcp/127.0.0.1:7460\", send = [\"udp/127.0.0.1:1\"]",
                 ),
                 "process `b2`: `beats`: endpoint `tcp/127.0.0.1:7460` is not `udp/HOST:PORT`",
             ),
             (
-                format!(
-                    "{GOOD}[[process]]\nname = \"b2\"\nboard = true\nbeats = {{ listen = \"udp/127.0.0.1:1\", \
-                     send = [\"udp/127.0.0.1\"] }}\n"
+                group(
+                    "listen = \"udp/127.0.0.1:1\", send = [\"udp/127.0.0.1\"]",
+                    "listen = \"udp/127.0.0.1:2\", send = [\"udp/127.0.0.1:1\"]",
                 ),
-                "endpoint `udp/127.0.0.1` is not `udp/HOST:PORT`",
+                "process `board`: `beats`: endpoint `udp/127.0.0.1` is not `udp/HOST:PORT`",
+            ),
+            (group("listen = \"udp/127.0.0.1:1\", to = []", ""), "unknown field `to`"),
+            (
+                group("listen = \"udp/127.0.0.1:1\"", "listen = \"udp/127.0.0.1:2\""),
+                "process `board`: `beats` with no `send`",
             ),
             (
-                format!("{GOOD}[[process]]\nname = \"b2\"\nboard = true\nbeats = {{ listen = \"udp/127.0.0.1:1\", to = [] }}\n"),
-                "unknown field `to`",
+                format!(
+                    "{GOOD}[[process]]\nname = \"b2\"\nboard = true\nbeats = {{ listen = \"udp/127.0.0.1:1\", \
+                     send = [\"udp/127.0.0.1:2\"] }}\n"
+                ),
+                "process `b2` has `beats` and board `board` has not",
             ),
         ];
         for (text, want) in cases {
