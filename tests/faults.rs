@@ -206,6 +206,11 @@ fn two_boards_under_delay_and_loss_keep_one_leader() {
         l.leadership
     );
     kept_the_safe_mode_rule_and_the_mission(&l);
+    // The datagrams crossed the relay and the loss: the standby heard the
+    // leader's beats over UDP (20 a second; 5 % lost), and they renewed
+    // the leader it heard over Zenoh.
+    let renewed = l.beats_renewed("standby");
+    assert!(renewed.is_some_and(|n| n >= 100), "beats over UDP: {:?}", l.beats);
 }
 
 #[test]

@@ -162,15 +162,20 @@ struct Inbox {
     incoming: Mutex<Vec<Batch>>,
     heard: Mutex<Option<Heard>>,
     refused: AtomicU64,
+    /// Beats heard over UDP, and those of them that renewed the leader.
+    beats_heard: AtomicU64,
+    beats_renewed: AtomicU64,
 }
 
 impl Hears for Inbox {
     /// A beat over UDP renews the leader heard over Zenoh, and only it:
     /// the same board at the same epoch ([`crate::beats`]).
     fn alive(&self, board: &str, epoch: u64) {
+        self.beats_heard.fetch_add(1, Ordering::Relaxed);
         let mut h = self.heard.lock().unwrap_or_else(|p| p.into_inner());
         if let Some(heard) = h.as_mut().filter(|h| h.epoch == epoch && h.board == board) {
             heard.at = Instant::now();
+            self.beats_renewed.fetch_add(1, Ordering::Relaxed);
         }
     }
 
@@ -237,6 +242,8 @@ impl BoardPeers {
             incoming: Mutex::new(Vec::new()),
             heard: Mutex::new(None),
             refused: AtomicU64::new(0),
+            beats_heard: AtomicU64::new(0),
+            beats_renewed: AtomicU64::new(0),
         };
         let inbox = Arc::new(inbox);
         let beats =
@@ -264,6 +271,15 @@ impl BoardPeers {
     /// Where it hears the boards' beats over UDP, if it does.
     pub fn beats_addr(&self) -> Option<std::net::SocketAddr> {
         self.beats.as_ref().map(BeatLink::listen_addr)
+    }
+
+    /// The beats heard over UDP so far, and how many of them renewed the
+    /// leader heard over Zenoh (the others were of another board or
+    /// epoch); `None` without `beats`.
+    pub fn beats_heard(&self) -> Option<(u64, u64)> {
+        self.beats
+            .as_ref()
+            .map(|_| (self.inbox.beats_heard.load(Ordering::Relaxed), self.inbox.beats_renewed.load(Ordering::Relaxed)))
     }
 
     pub fn name(&self) -> &str {

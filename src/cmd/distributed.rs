@@ -297,6 +297,10 @@ fn zenoh(args: &Args, content: Arc<Content>, file: Option<&[u8]>, checked: Optio
                 return USAGE;
             }
         };
+    let board_peers = bus.peers();
+    if let Some(addr) = board_peers.as_ref().and_then(|p| p.beats_addr()) {
+        eprintln!("{}: hears the boards' beats on udp/{addr}", process.name);
+    }
     let standby = match (standby, bus.peers()) {
         (Some((config, log)), Some(peers)) => {
             let name = process.name.clone();
@@ -357,6 +361,9 @@ fn zenoh(args: &Args, content: Arc<Content>, file: Option<&[u8]>, checked: Optio
             eprintln!("{name}: state {}", states[c.to as usize])
         });
     watchers.end();
+    if let Some((heard, renewed)) = board_peers.as_ref().and_then(|p| p.beats_heard()) {
+        eprintln!("{name}: {heard} beat(s) heard over UDP, {renewed} of them from the leader heard over Zenoh");
+    }
     finish(summary)
 }
 

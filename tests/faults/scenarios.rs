@@ -241,6 +241,9 @@ pub struct Lossy {
     pub epochs: Vec<(Option<u64>, Option<String>)>,
     /// The boards' lines on leading and stepping down (standard error).
     pub leadership: Vec<String>,
+    /// The boards' closing lines on the beats they heard over UDP
+    /// (standard error), each prefixed with its process.
+    pub beats: Vec<String>,
     /// Whether the statuses seen never went back ([`check_monotonic`]):
     /// after a false takeover the old leader's last statuses may reach the
     /// observer after the new one's (agents ignore them, a lower epoch).
@@ -344,12 +347,33 @@ pub fn delay_and_loss(s: &LossySettings) -> Lossy {
         pipeline_path: path(&lab.stdout(running.procs["pipeline"])),
         epochs: epoch_changes(&seen),
         leadership: leadership(&lab, &running),
+        beats: board_lines(&lab, &running, " heard over UDP"),
         monotonic,
     }
 }
 
 /// The boards' lines on leading and stepping down, from their standard
 /// error, each prefixed with its process.
+/// The boards' lines of standard error that contain `what`, each
+/// prefixed with its process.
+pub fn board_lines(lab: &Lab, running: &Running, what: &str) -> Vec<String> {
+    let mut lines = Vec::new();
+    for b in &running.boards {
+        if let Some(pid) = running.procs.get(b) {
+            lines.extend(lab.stderr(*pid).lines().filter(|l| l.contains(what)).map(|l| format!("{b}: {l}")));
+        }
+    }
+    lines
+}
+
+impl Lossy {
+    /// How many beats over UDP `board` said renewed the leader, if it said.
+    pub fn beats_renewed(&self, board: &str) -> Option<u64> {
+        let line = self.beats.iter().find(|l| l.starts_with(&format!("{board}: ")))?;
+        line.split(", ").nth(1)?.split_whitespace().next()?.parse().ok()
+    }
+}
+
 pub fn leadership(lab: &Lab, running: &Running) -> Vec<String> {
     let mut lines = Vec::new();
     for b in &running.boards {
