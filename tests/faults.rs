@@ -214,6 +214,35 @@ fn two_boards_under_delay_and_loss_keep_one_leader() {
 }
 
 #[test]
+fn a_stalled_tcp_link_between_the_boards_is_no_takeover_with_beats() {
+    // Every TCP segment from the leader's host to the standby's dropped for
+    // 1.5 s (three leases): Zenoh says nothing to the standby, but the
+    // leader's datagrams pass and keep it alive there.
+    let t = standby::stall_tcp_between_boards(Duration::from_millis(1500), true);
+    assert_eq!(t.epochs.len(), 1, "a takeover: {t:#?}");
+    assert_eq!(t.epochs[0].1.as_deref(), Some("board"), "{t:#?}");
+    assert!(!t.leadership.iter().any(|l| l.starts_with("standby:") && l.contains(" leads at epoch ")), "{t:#?}");
+    assert!(t.standby_err.contains("hears the boards' beats on udp/"), "{t:#?}");
+    let renewed = t.beats.iter().find(|l| l.starts_with("standby: ")).and_then(|l| {
+        l.split(", ").nth(1).and_then(|x| x.split_whitespace().next()).and_then(|n| n.parse::<u64>().ok())
+    });
+    assert!(renewed.is_some_and(|n| n >= 20), "{t:#?}");
+}
+
+#[test]
+fn without_beats_a_stalled_tcp_link_between_the_boards_is_a_takeover() {
+    // The same stall without `beats`: the standby hears nothing for longer
+    // than its lease and leads (a false takeover, which `beats` prevents;
+    // this is what makes the test above mean something). The old leader
+    // hears the standby's statuses (that way TCP flows) and steps down.
+    let t = standby::stall_tcp_between_boards(Duration::from_millis(1500), false);
+    assert!(t.leadership.iter().any(|l| l.starts_with("standby:") && l.contains(" leads at epoch ")), "{t:#?}");
+    assert!(t.leadership.iter().any(|l| l.contains("board `board` steps down")), "{t:#?}");
+    assert_eq!(t.epochs.last().and_then(|e| e.1.as_deref()), Some("standby"), "{t:#?}");
+    assert!(t.beats.is_empty(), "{t:#?}");
+}
+
+#[test]
 fn a_router_down_longer_than_the_lease_under_two_boards_ends_with_one_leader() {
     // Down for 1 s: the boards, clients of the router, are cut from each
     // other for longer than the lease (450 ms, 500 ms for the standby), so

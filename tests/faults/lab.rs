@@ -52,6 +52,8 @@ struct Filter {
     /// Packets to other hosts are dropped unless they go to the switch's
     /// address (the relay): every link between hosts crosses the relay.
     only_switch: bool,
+    /// TCP segments from this host (by its index) are dropped; UDP passes.
+    tcp_from: Option<usize>,
 }
 
 /// A relay of TCP streams in the switch namespace (`relay.py`).
@@ -365,6 +367,14 @@ impl Lab {
         self.write_filter(host);
     }
 
+    /// Drops every TCP segment that reaches `host` from `from` (`None`
+    /// ends it): their TCP links stall, datagrams still pass.
+    pub fn drop_tcp_from(&mut self, host: &str, from: Option<&str>) {
+        let from = from.map(|f| self.index(f));
+        self.filters.entry(host.to_string()).or_default().tcp_from = from;
+        self.write_filter(host);
+    }
+
     /// From now on `host` reaches other hosts only through the switch's
     /// address (a relay there): direct packets to other hosts are dropped,
     /// so that no link (Zenoh's gossip finds the others' addresses) goes
@@ -387,6 +397,9 @@ impl Lab {
         let mut input = String::new();
         if f.loss > 0 {
             input += &format!("    iifname \"eth0\" numgen random mod 100 < {} drop\n", f.loss);
+        }
+        if let Some(i) = f.tcp_from {
+            input += &format!("    iifname \"eth0\" ip saddr {} meta l4proto tcp drop\n", self.addr(&self.hosts[i]));
         }
         // Made (if missing) then deleted, so that the script works on a
         // host with or without the table; then written anew.

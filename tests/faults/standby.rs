@@ -77,6 +77,11 @@ pub struct Takeover {
 /// (`fig5_rules_with_stale`), or the file's 500 ms. Returns the
 /// observer's latest status, with its epoch.
 fn two_boards_in_ro(stale: Option<&str>) -> (Lab, Running, Pid, Seen, u64) {
+    two_boards_in_ro_with(stale, true)
+}
+
+/// As [`two_boards_in_ro`], the boards with `beats` or not.
+fn two_boards_in_ro_with(stale: Option<&str>, beats: bool) -> (Lab, Running, Pid, Seen, u64) {
     let mut lab = Lab::new(&["board", "standby", "sensors", "pipeline"]);
     let procs = fig5_two_boards();
     let rules = match stale {
@@ -85,7 +90,11 @@ fn two_boards_in_ro(stale: Option<&str>) -> (Lab, Running, Pid, Seen, u64) {
     };
     // The boards beat over UDP too, as advised between hosts: a kill or a
     // cut host silences the datagrams as well.
-    let deploy = write_deployment_with_beats(&lab, "fig5", &procs, None);
+    let deploy = if beats {
+        write_deployment_with_beats(&lab, "fig5", &procs, None)
+    } else {
+        write_deployment(&lab, "fig5", &procs, None)
+    };
     let mut running = start(&mut lab, &rules, &deploy, &procs);
     let at = format!("tcp/{}:7449", lab.addr("pipeline"));
     let observer = observe(&mut lab, "pipeline", &at, "client", "fig5");
@@ -211,5 +220,38 @@ pub fn partition_leader(cut: Duration, stale: Option<&str>) -> LeaderCut {
         standby_states: recorded_states(&recording(&lab, "standby"), stopped),
         pipeline_path: path(&lab.stdout(running.procs["pipeline"])),
         board_err: lab.stderr(running.procs["board"]),
+    }
+}
+
+/// What a stall of the boards' TCP link did.
+#[derive(Debug)]
+pub struct TcpStall {
+    /// The (epoch, board) of the statuses the pipeline's host saw, as they
+    /// changed over the run.
+    pub epochs: Vec<(Option<u64>, Option<String>)>,
+    /// The boards' lines on leading and stepping down.
+    pub leadership: Vec<String>,
+    /// The boards' closing lines on the beats they heard over UDP.
+    pub beats: Vec<String>,
+    pub standby_err: String,
+}
+
+/// Fig. 5 with two boards on four hosts, with `beats` or not; once the
+/// observer has seen RO from the leader, every TCP segment from the
+/// leader's host to the standby's is dropped for `stall` (datagrams pass),
+/// then let through again, and the run goes on for 3 s more.
+pub fn stall_tcp_between_boards(stall: Duration, beats: bool) -> TcpStall {
+    let (mut lab, running, observer, _, _) = two_boards_in_ro_with(Some("3s"), beats);
+    lab.drop_tcp_from("standby", Some("board"));
+    std::thread::sleep(stall);
+    lab.drop_tcp_from("standby", None);
+    std::thread::sleep(Duration::from_secs(3));
+    let _ = stop_all(&mut lab, &running);
+    let all = seen(&lab, observer);
+    TcpStall {
+        epochs: super::scenarios::epoch_changes(&all),
+        leadership: super::scenarios::leadership(&lab, &running),
+        beats: super::scenarios::board_lines(&lab, &running, " heard over UDP"),
+        standby_err: lab.stderr(running.procs["standby"]),
     }
 }
