@@ -209,7 +209,7 @@ fn two_boards_under_delay_and_loss_keep_one_leader() {
     // The datagrams crossed the relay and the loss: the standby heard the
     // leader's beats over UDP (20 a second; 5 % lost), and they renewed
     // the leader it heard over Zenoh.
-    let renewed = l.beats_renewed("standby");
+    let renewed = scenarios::beats_renewed(&l.beats, "standby");
     assert!(renewed.is_some_and(|n| n >= 100), "beats over UDP: {:?}", l.beats);
 }
 
@@ -223,9 +223,7 @@ fn a_stalled_tcp_link_between_the_boards_is_no_takeover_with_beats() {
     assert_eq!(t.epochs[0].1.as_deref(), Some("board"), "{t:#?}");
     assert!(!t.leadership.iter().any(|l| l.starts_with("standby:") && l.contains(" leads at epoch ")), "{t:#?}");
     assert!(t.standby_err.contains("hears the boards' beats on udp/"), "{t:#?}");
-    let renewed = t.beats.iter().find(|l| l.starts_with("standby: ")).and_then(|l| {
-        l.split(", ").nth(1).and_then(|x| x.split_whitespace().next()).and_then(|n| n.parse::<u64>().ok())
-    });
+    let renewed = scenarios::beats_renewed(&t.beats, "standby");
     assert!(renewed.is_some_and(|n| n >= 20), "{t:#?}");
 }
 

@@ -301,7 +301,7 @@ fn zenoh(args: &Args, content: Arc<Content>, file: Option<&[u8]>, checked: Optio
     if let Some(addr) = board_peers.as_ref().and_then(|p| p.beats_addr()) {
         eprintln!("{}: hears the boards' beats on udp/{addr}", process.name);
     }
-    let standby = match (standby, bus.peers()) {
+    let standby = match (standby, board_peers.clone()) {
         (Some((config, log)), Some(peers)) => {
             let name = process.name.clone();
             let tell: situ_runtime::standby::Tell = std::sync::Arc::new(move |what: &str| eprintln!("{name}: {what}"));

@@ -70,20 +70,19 @@ pub struct Relay {
 impl Relay {
     /// The Zenoh endpoint through the relay to `host`'s `port`.
     pub fn endpoint(&self, host: &str, port: u16) -> String {
-        let p = self
-            .ports
-            .get(&(host.to_string(), port))
-            .unwrap_or_else(|| panic!("the relay has no route to {host}:{port}"));
-        format!("tcp/{}:{p}", self.addr)
+        self.via(&self.ports, "tcp", host, port)
     }
 
     /// The UDP endpoint through the relay to `host`'s `port`.
     pub fn udp_endpoint(&self, host: &str, port: u16) -> String {
-        let p = self
-            .udp_ports
+        self.via(&self.udp_ports, "udp", host, port)
+    }
+
+    fn via(&self, routes: &BTreeMap<(String, u16), u16>, proto: &str, host: &str, port: u16) -> String {
+        let p = routes
             .get(&(host.to_string(), port))
-            .unwrap_or_else(|| panic!("the relay has no datagram route to {host}:{port}"));
-        format!("udp/{}:{p}", self.addr)
+            .unwrap_or_else(|| panic!("the relay has no {proto} route to {host}:{port}"));
+        format!("{proto}/{}:{p}", self.addr)
     }
 }
 

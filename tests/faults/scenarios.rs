@@ -347,43 +347,40 @@ pub fn delay_and_loss(s: &LossySettings) -> Lossy {
         pipeline_path: path(&lab.stdout(running.procs["pipeline"])),
         epochs: epoch_changes(&seen),
         leadership: leadership(&lab, &running),
-        beats: board_lines(&lab, &running, " heard over UDP"),
+        beats: beat_lines(&lab, &running),
         monotonic,
     }
 }
 
+/// The boards' lines of standard error that contain any of `what`, each
+/// prefixed with its process.
+pub fn board_lines(lab: &Lab, running: &Running, what: &[&str]) -> Vec<String> {
+    let mut lines = Vec::new();
+    for b in &running.boards {
+        if let Some(pid) = running.procs.get(b) {
+            let said = lab.stderr(*pid);
+            lines.extend(said.lines().filter(|l| what.iter().any(|w| l.contains(w))).map(|l| format!("{b}: {l}")));
+        }
+    }
+    lines
+}
+
 /// The boards' lines on leading and stepping down, from their standard
 /// error, each prefixed with its process.
-/// The boards' lines of standard error that contain `what`, each
-/// prefixed with its process.
-pub fn board_lines(lab: &Lab, running: &Running, what: &str) -> Vec<String> {
-    let mut lines = Vec::new();
-    for b in &running.boards {
-        if let Some(pid) = running.procs.get(b) {
-            lines.extend(lab.stderr(*pid).lines().filter(|l| l.contains(what)).map(|l| format!("{b}: {l}")));
-        }
-    }
-    lines
-}
-
-impl Lossy {
-    /// How many beats over UDP `board` said renewed the leader, if it said.
-    pub fn beats_renewed(&self, board: &str) -> Option<u64> {
-        let line = self.beats.iter().find(|l| l.starts_with(&format!("{board}: ")))?;
-        line.split(", ").nth(1)?.split_whitespace().next()?.parse().ok()
-    }
-}
-
 pub fn leadership(lab: &Lab, running: &Running) -> Vec<String> {
-    let mut lines = Vec::new();
-    for b in &running.boards {
-        if let Some(pid) = running.procs.get(b) {
-            for l in lab.stderr(*pid).lines().filter(|l| l.contains(" leads at epoch ") || l.contains(" steps down")) {
-                lines.push(format!("{b}: {l}"));
-            }
-        }
-    }
-    lines
+    board_lines(lab, running, &[" leads at epoch ", " steps down"])
+}
+
+/// The boards' closing lines on the beats they heard over UDP.
+pub fn beat_lines(lab: &Lab, running: &Running) -> Vec<String> {
+    board_lines(lab, running, &[" heard over UDP"])
+}
+
+/// How many beats over UDP `board` said renewed the leader, from
+/// [`beat_lines`], if it said.
+pub fn beats_renewed(lines: &[String], board: &str) -> Option<u64> {
+    let line = lines.iter().find(|l| l.starts_with(&format!("{board}: ")))?;
+    line.split(", ").nth(1)?.split_whitespace().next()?.parse().ok()
 }
 
 impl Lossy {

@@ -251,7 +251,7 @@ pub fn stall_tcp_between_boards(stall: Duration, beats: bool) -> TcpStall {
     TcpStall {
         epochs: super::scenarios::epoch_changes(&all),
         leadership: super::scenarios::leadership(&lab, &running),
-        beats: super::scenarios::board_lines(&lab, &running, " heard over UDP"),
+        beats: super::scenarios::beat_lines(&lab, &running),
         standby_err: lab.stderr(running.procs["standby"]),
     }
 }
