@@ -23,12 +23,12 @@ mod twin;
 
 use naive::Naive;
 use proptest::prelude::*;
-use situ_compiler::bundle::{Content, FieldType, Value};
+use situ_compiler::bundle::{Content, Value};
 use situ_compiler::Checked;
 use situ_runtime::rete::{Engine, PostError};
 use situ_runtime::stream::Generator;
 use std::sync::Arc;
-use twin::{ops, posts, twins};
+use twin::{ops, pool, posts, twins};
 
 fn compile(checked: &Checked) -> Arc<Content> {
     let front: Vec<_> = checked.diagnostics.iter().filter(|d| d.code < "E0300").collect();
@@ -117,52 +117,6 @@ fn the_papers_stacks_on_seeded_streams() {
 // ─── Random events over a given bundle ─────────────────────────────────────
 
 /// Values for a field: NaN, the rules' thresholds and their neighbours.
-fn pool(content: &Content, event: usize, field: usize) -> Vec<Value> {
-    match &content.events[event].fields[field].ty {
-        FieldType::F64 => {
-            let mut v = vec![Value::F64(f64::NAN), Value::F64(-1.0), Value::F64(0.0), Value::F64(1000.0)];
-            for c in thresholds(content, event, field) {
-                v.extend([c - 0.5, c, c.next_up(), c + 0.5].map(Value::F64));
-            }
-            v
-        }
-        FieldType::I64 => {
-            let mut v = vec![Value::I64(-1), Value::I64(0), Value::I64(1000)];
-            for c in thresholds(content, event, field) {
-                v.extend([c as i64 - 1, c as i64, c as i64 + 1].map(Value::I64));
-            }
-            v
-        }
-        FieldType::Bool => vec![Value::Bool(false), Value::Bool(true)],
-        FieldType::Symbols(s) => (0..s.len() as u32).map(Value::Symbol).collect(),
-    }
-}
-
-fn thresholds(content: &Content, event: usize, field: usize) -> Vec<f64> {
-    use situ_compiler::bundle::{AlphaNode, Check, Operand};
-    let mut out = Vec::new();
-    for node in &content.network.alpha {
-        let AlphaNode::Event { event: e, tests, .. } = node else { continue };
-        if *e as usize != event {
-            continue;
-        }
-        for t in tests.iter().filter(|t| t.field as usize == field) {
-            let ops = match &t.check {
-                Check::Compare { rhs, .. } => vec![*rhs],
-                Check::Range { lo, hi, .. } => vec![*lo, *hi],
-            };
-            for o in ops {
-                match o {
-                    Operand::Value(Value::F64(f)) if f.is_finite() => out.push(f),
-                    Operand::Value(Value::I64(i)) => out.push(i as f64),
-                    _ => {}
-                }
-            }
-        }
-    }
-    out
-}
-
 /// Millisecond gaps that cross the stale times (200 to 1000 ms) and the
 /// windows (500 ms) of the files, and land on them exactly.
 const GAPS_MS: [u64; 8] = [0, 1, 10, 10, 50, 100, 250, 600];

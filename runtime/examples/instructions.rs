@@ -11,10 +11,17 @@
 //! (`--toggle-collect=*::process_stream`), steps every event as `situ bench`
 //! does (the event's clock set, `Engine::step`, the state at rest compared,
 //! a mission reset in a final state) on the engine's fast path, or on the
-//! Rete interpreter with `INTERPRETED=1` in the environment (which
+//! Rete interpreter with `INTERPRETED=1` in the environment, or on the
+//! native code of `rules/outdoor.situ` with `NATIVE=1` (both of which
 //! `bench/instructions.sh` passes on). Writes the `INDEX STATE` lines of
 //! `situ bench --states-out` to STATES_OUT, so that the script checks the
 //! state sequence against the hand-written matcher's.
+
+// The native code of `rules/outdoor.situ` (`situ build --native`), held
+// to the interpreter by `runtime-tests/tests/native.rs`.
+#[rustfmt::skip]
+#[path = "../../runtime-tests/native/outdoor.rs"]
+mod outdoor_native;
 
 use situ_runtime::rete::Engine;
 use situ_runtime::stream::{self, Event};
@@ -91,8 +98,19 @@ fn main() -> ExitCode {
     drop(events);
 
     // `INTERPRETED=1`: the Rete interpreter, the fast path's reference.
-    let mut engine = if std::env::var_os("INTERPRETED").is_some_and(|v| v == "1") {
+    // `NATIVE=1`: the native code of `rules/outdoor.situ`, which refuses
+    // any other bundle.
+    let flag = |name: &str| std::env::var_os(name).is_some_and(|v| v == "1");
+    let mut engine = if flag("INTERPRETED") {
         Engine::interpreted(content.clone())
+    } else if flag("NATIVE") {
+        match Engine::with_native(content.clone(), &outdoor_native::NATIVE) {
+            Ok(engine) => engine,
+            Err(e) => {
+                eprintln!("instructions: {e}");
+                return ExitCode::from(2);
+            }
+        }
     } else {
         Engine::new(content.clone())
     };

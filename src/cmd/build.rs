@@ -1,6 +1,8 @@
-//! `situ build FILE -o BUNDLE [--binary] [--stats] [--sign KEY]`: compiles
-//! a checked source to a bundle, written atomically; with `--sign`, signed
-//! with the secret key of `situ key new` (`docs/signing.md`).
+//! `situ build FILE -o BUNDLE [--binary] [--stats] [--sign KEY] [--native FILE.rs]`:
+//! compiles a checked source to a bundle, written atomically; with
+//! `--sign`, signed with the secret key of `situ key new`
+//! (`docs/signing.md`); with `--native`, also the bundle's native code, a
+//! Rust module (`situ_runtime::rete::native`, docs/performance.md).
 
 use super::{CliError, Outcome, OK};
 use situ_compiler::bundle::{self, codec, Encoding};
@@ -25,6 +27,10 @@ pub struct Args {
     /// Sign the bundle with this secret key (`situ key new NAME` writes NAME.key).
     #[arg(long, value_name = "KEY")]
     pub sign: Option<PathBuf>,
+    /// Also write the bundle's rules as a Rust module, for
+    /// `Engine::with_native` in a program that links situ-runtime.
+    #[arg(long, value_name = "FILE.rs")]
+    pub native: Option<PathBuf>,
 }
 
 pub fn run(args: &Args) -> Outcome {
@@ -38,6 +44,18 @@ pub fn run(args: &Args) -> Outcome {
         .map_err(|e| CliError::Usage(format!("--sign: {e}")))?;
     let checked = super::program::check(file, args.deny_warnings).map_err(CliError::Reported)?;
     let content = bundle::build(&checked);
+    // Native code before anything is written: a bundle it cannot take
+    // writes nothing.
+    let native = match &args.native {
+        Some(path) => {
+            let name =
+                file.file_name().map_or_else(|| file.display().to_string(), |n| n.to_string_lossy().into_owned());
+            let code = situ_runtime::rete::native::generate(&content, &name)
+                .map_err(|e| CliError::Failed(format!("--native: {e}")))?;
+            Some((path, code))
+        }
+        None => None,
+    };
     let encoding = if binary { Encoding::Binary } else { Encoding::Json };
     let bytes = match &key {
         Some(key) => bundle::sign::encode_signed(&content, encoding, key),
@@ -59,6 +77,11 @@ pub fn run(args: &Args) -> Outcome {
     );
     if let Some(key) = &key {
         println!("signed by key {}", key.key_id());
+    }
+    if let Some((path, code)) = &native {
+        super::write_atomically(path, code.as_bytes())
+            .map_err(|e| CliError::Usage(format!("cannot write `{}`: {e}", path.display())))?;
+        println!("{} -> {} (native code, {} lines)", file.display(), path.display(), code.lines().count());
     }
     if args.stats {
         let s = content.network.stats;

@@ -10,7 +10,7 @@
 #![allow(dead_code)]
 
 use proptest::prelude::*;
-use situ_compiler::bundle::{Content, Value};
+use situ_compiler::bundle::{Content, FieldType, Value};
 use situ_runtime::rete::{Engine, StepError};
 use std::sync::Arc;
 
@@ -92,7 +92,13 @@ fn memory(e: &Engine, agents: usize) -> String {
 /// Runs `ops` on both engines; the number of firings of the fast one, or
 /// the first difference. The fast path must not decline the bundle.
 pub fn twins(content: &Arc<Content>, ops: &[Op]) -> Result<usize, String> {
-    let mut fast = Engine::new(content.clone());
+    twins_with(content, ops, &|c| Engine::new(c))
+}
+
+/// [`twins`] with the engine held to the interpreter built by `make`
+/// (the fast path, or native code).
+pub fn twins_with(content: &Arc<Content>, ops: &[Op], make: &dyn Fn(Arc<Content>) -> Engine) -> Result<usize, String> {
+    let mut fast = make(content.clone());
     let mut slow = Engine::interpreted(content.clone());
     if !fast.is_fast() {
         return Err(format!("the fast path declined the bundle: {:?}", fast.fast_declined()));
@@ -100,7 +106,7 @@ pub fn twins(content: &Arc<Content>, ops: &[Op]) -> Result<usize, String> {
     assert!(!slow.is_fast());
     let agents = content.agents.len();
     let mut fired = 0;
-    let mut copy = Engine::new(content.clone());
+    let mut copy = make(content.clone());
     for (i, op) in ops.iter().enumerate() {
         let (a, b) = (apply(&mut fast, op), apply(&mut slow, op));
         if a != b {
@@ -178,4 +184,53 @@ pub fn ops(
             out
         },
     )
+}
+
+/// Payload values for field `field` of `event`: the edges, and each
+/// constant its rules compare the field with, a little below, at and
+/// above it.
+pub fn pool(content: &Content, event: usize, field: usize) -> Vec<Value> {
+    match &content.events[event].fields[field].ty {
+        FieldType::F64 => {
+            let mut v = vec![Value::F64(f64::NAN), Value::F64(-1.0), Value::F64(0.0), Value::F64(1000.0)];
+            for c in thresholds(content, event, field) {
+                v.extend([c - 0.5, c, c.next_up(), c + 0.5].map(Value::F64));
+            }
+            v
+        }
+        FieldType::I64 => {
+            let mut v = vec![Value::I64(-1), Value::I64(0), Value::I64(1000)];
+            for c in thresholds(content, event, field) {
+                v.extend([c as i64 - 1, c as i64, c as i64 + 1].map(Value::I64));
+            }
+            v
+        }
+        FieldType::Bool => vec![Value::Bool(false), Value::Bool(true)],
+        FieldType::Symbols(s) => (0..s.len() as u32).map(Value::Symbol).collect(),
+    }
+}
+
+fn thresholds(content: &Content, event: usize, field: usize) -> Vec<f64> {
+    use situ_compiler::bundle::{AlphaNode, Check, Operand};
+    let mut out = Vec::new();
+    for node in &content.network.alpha {
+        let AlphaNode::Event { event: e, tests, .. } = node else { continue };
+        if *e as usize != event {
+            continue;
+        }
+        for t in tests.iter().filter(|t| t.field as usize == field) {
+            let ops = match &t.check {
+                Check::Compare { rhs, .. } => vec![*rhs],
+                Check::Range { lo, hi, .. } => vec![*lo, *hi],
+            };
+            for o in ops {
+                match o {
+                    Operand::Value(Value::F64(f)) if f.is_finite() => out.push(f),
+                    Operand::Value(Value::I64(i)) => out.push(i as f64),
+                    _ => {}
+                }
+            }
+        }
+    }
+    out
 }

@@ -68,11 +68,20 @@ impl Engine {
     /// [`admit`](Self::admit), its refusal in short.
     #[inline(always)]
     pub(super) fn admitted(&self, event: u32, time: u64, payload: &[Value]) -> Result<(), StepError> {
-        let agent = self.validated(event, payload)? as usize;
+        let agent = self.validated(event, payload)?;
+        self.admitted_time(event, agent, time)
+    }
+
+    /// The part of [`admitted`](Self::admitted) after the payload check:
+    /// the time of `event` of agent `agent` against the agent's clock and
+    /// the clock it arrived at.
+    #[inline(always)]
+    pub(super) fn admitted_time(&self, event: u32, agent: u32, time: u64) -> Result<(), StepError> {
         // SAFETY: an event's agent is an agent: `Net::new` reads each
         // event's agent's `stale after` from a table of one entry per
-        // agent, and `agents` has one record per agent.
-        let last = unsafe { self.agents.get_unchecked(agent) }.last;
+        // agent, and `agents` has one record per agent (native code: its
+        // digest, checked by `Engine::with_native`).
+        let last = unsafe { self.agents.get_unchecked(agent as usize) }.last;
         if time < last {
             return Err(StepError::OutOfOrder { event, time, last });
         }

@@ -67,17 +67,17 @@ pub const MAX_LIST_ENTRIES: usize = 1 << 22;
 const MAX_RUN_BIT: u64 = 64;
 
 /// `Cond::event` of a staleness test.
-const STALE: u32 = u32::MAX - 1;
+pub(in crate::rete) const STALE: u32 = u32::MAX - 1;
 
 /// An operand: a constant, or a place in the payload arena.
 #[derive(Debug, Clone, Copy)]
-enum Arg {
+pub enum Arg {
     Value(Value),
     At(u32),
 }
 
 #[derive(Debug, Clone, Copy)]
-enum Check2 {
+pub(in crate::rete) enum Check2 {
     Compare { op: Cmp, rhs: Arg },
     Range { lo: Arg, hi: Arg, inclusive: bool },
 }
@@ -87,7 +87,7 @@ enum Check2 {
 /// type is known from its event; a value of another type, which the
 /// payload check keeps out, would go to `compare` all the same).
 #[derive(Debug, Clone, Copy)]
-enum Test {
+pub(in crate::rete) enum Test {
     F64 { x: u32, op: Cmp, c: f64 },
     F64Range { x: u32, lo: f64, hi: f64, inclusive: bool },
     Any { x: u32, check: Check2 },
@@ -95,62 +95,62 @@ enum Test {
 
 /// One condition of a rule on one agent's fact.
 #[derive(Debug, Clone, Copy)]
-struct Cond {
-    agent: u32,
+pub(in crate::rete) struct Cond {
+    pub(in crate::rete) agent: u32,
     /// The event its fact must be, or `STALE`: the agent must be stale.
-    event: u32,
-    negative: bool,
-    min_run: u64,
+    pub(in crate::rete) event: u32,
+    pub(in crate::rete) negative: bool,
+    pub(in crate::rete) min_run: u64,
     /// The window, ns (`u64::MAX`: none).
-    within: u64,
+    pub(in crate::rete) within: u64,
     /// Its tests, in `Program::tests`.
-    tests: (u32, u32),
+    pub(in crate::rete) tests: (u32, u32),
 }
 
 #[derive(Debug, Clone, Copy)]
-struct Rule {
+pub(in crate::rete) struct Rule {
     /// Its conditions, in `Program::conds`, in the chain's order.
-    conds: (u32, u32),
+    pub(in crate::rete) conds: (u32, u32),
     /// The rank of its (salience, specificity) among the rules': a larger
     /// one fires first.
-    group: u32,
+    pub(in crate::rete) group: u32,
     /// The bits of [`Engine::have`] its conditions read (`mask`) and the
     /// values they need (`need`): an event's bit (below 64) set for a
     /// positive pattern of it, a stale agent's bit set for a positive
     /// `stale`, either clear for a negated one. The rule cannot hold unless
     /// `have & mask == need`; a condition that the bits decide whole (no
     /// run length above 1, no window, no tests) is not in `conds`.
-    need: u64,
-    mask: u64,
+    pub(in crate::rete) need: u64,
+    pub(in crate::rete) mask: u64,
 }
 
 /// What a firing of a rule reads (`Engine::fast_record`) and its recency.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Fire {
-    pub(super) target: u32,
+    pub(in crate::rete) target: u32,
     /// The agents its positive patterns match (recency, the matched facts)
     /// and those it tests for staleness, in `Program::agents`.
-    pub(super) matches: (u32, u32),
-    pub(super) stale: (u32, u32),
+    pub(in crate::rete) matches: (u32, u32),
+    pub(in crate::rete) stale: (u32, u32),
 }
 
 /// The rules of a bundle flattened for the fast path.
 #[derive(Debug, Clone, Default)]
 pub(super) struct Program {
-    ne: usize,
-    na: usize,
+    pub(in crate::rete) ne: usize,
+    pub(in crate::rete) na: usize,
     /// Per `state * events + event`, per `state * agents + agent`, per
     /// state: a list in `lists`.
-    by_event: Vec<(u32, u32)>,
-    by_agent: Vec<(u32, u32)>,
-    by_state: Vec<(u32, u32)>,
-    lists: Vec<u32>,
-    rules: Vec<Rule>,
+    pub(in crate::rete) by_event: Vec<(u32, u32)>,
+    pub(in crate::rete) by_agent: Vec<(u32, u32)>,
+    pub(in crate::rete) by_state: Vec<(u32, u32)>,
+    pub(in crate::rete) lists: Vec<u32>,
+    pub(in crate::rete) rules: Vec<Rule>,
     /// Per rule, what its firing records.
-    pub(super) fires: Vec<Fire>,
+    pub(in crate::rete) fires: Vec<Fire>,
     /// Per agent: its bit in [`Engine::have`] while it is stale (after the
     /// events': `ne + agent`, below 64; `0`: none).
-    pub(super) stale_bit: Vec<u64>,
+    pub(in crate::rete) stale_bit: Vec<u64>,
     /// Per event, its bits in [`Engine::have`] by run length: its own, and
     /// one per run-length threshold `k` of its patterns (above 1, at most
     /// [`MAX_RUN_BIT`]; after the agents' bits, below 64), set while the
@@ -158,21 +158,33 @@ pub(super) struct Program {
     /// `run_at[e]` is (its first entry in `runs`, its largest threshold
     /// `cap`): the bits of `e`'s fact with run length `run` are
     /// `runs[first + min(run, cap)]`.
-    run_at: Vec<(u32, u32)>,
-    runs: Vec<u64>,
-    conds: Vec<Cond>,
-    tests: Vec<Test>,
-    pub(super) agents: Vec<u32>,
+    pub(in crate::rete) run_at: Vec<(u32, u32)>,
+    pub(in crate::rete) runs: Vec<u64>,
+    pub(in crate::rete) conds: Vec<Cond>,
+    pub(in crate::rete) tests: Vec<Test>,
+    pub(in crate::rete) agents: Vec<u32>,
 }
 
 /// The activated rule that fires first among those seen so far (`rule`:
 /// `NONE` before one), its group, and its recency once needed (`u64::MAX`:
 /// not yet computed).
 #[derive(Debug, Clone, Copy)]
-struct Best {
+pub struct Best {
     rule: u32,
     group: u32,
     recency: u64,
+}
+
+impl Best {
+    /// No rule yet.
+    pub const NONE: Best = Best { rule: NONE, group: 0, recency: u64::MAX };
+
+    /// Whether no rule of rank `group`, and none after it in a list in
+    /// firing order, can fire before `self`: the search of the list ends.
+    #[inline(always)]
+    pub fn cuts(&self, group: u32) -> bool {
+        self.rule != NONE && group < self.group
+    }
 }
 
 /// An event's bit in [`Engine::have`] (`0` from event 64 on: no bit).
@@ -213,6 +225,29 @@ impl Engine {
     /// [`accepted`](Self::accepted) on the fast path.
     #[inline(always)]
     pub(super) fn fast_accepted(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Step, StepError> {
+        self.before_insert(time)?;
+        self.fast_insert(event, time, payload);
+        let late = self.after_insert();
+        let mut best = Best::NONE;
+        let st = self.state as usize;
+        // SAFETY (`at`): the state and the event (taken by the payload
+        // check) are the bundle's: `st * ne + event < ns * ne`.
+        self.fast_best_in(unsafe { *at(&self.fp.by_event, st * self.fp.ne + event as usize) }, &mut best);
+        self.rest_after(best, late, |e, best| e.fast_best_in(e.fp.by_state[e.state as usize], best))?;
+        Ok(self.step_done())
+    }
+
+    /// What the step did.
+    #[inline(always)]
+    pub(super) fn step_done(&self) -> Step {
+        Step { from: self.record.from, to: self.state, firings: self.record.firings.len() }
+    }
+
+    /// A step's work before its fact is inserted: the record begun, now
+    /// moved to `time`, expiry, and the rest if expiry ran or the engine
+    /// was not at rest.
+    #[inline(always)]
+    pub(super) fn before_insert(&mut self, time: u64) -> Result<(), StepError> {
         self.begin();
         if time > self.now {
             self.now = time;
@@ -225,38 +260,87 @@ impl Engine {
         if expiry || !self.active.is_empty() {
             self.fast_rest()?;
         }
-        self.fast_insert(event, time, payload);
-        // The fact came late: it may be expired already.
+        Ok(())
+    }
+
+    /// After the insert: the fact came late, it may be expired already
+    /// (expiry runs); whether it ran.
+    #[inline(always)]
+    pub(super) fn after_insert(&mut self) -> bool {
         let late = self.now > self.next_deadline;
         if late {
             self.fast_expire();
         }
-        self.fast_rest_after(event, late)?;
-        Ok(Step { from: self.record.from, to: self.state, firings: self.record.firings.len() })
+        late
+    }
+
+    /// The rest after a step's fact: `best` holds the rules of the new
+    /// fact's search (the engine was at rest before the insert: a rest came
+    /// first, or an error returned); if expiry ran after the insert
+    /// (`late`), those of the agents in `touched` (else it is empty) are
+    /// searched too; then the firings, each new state's rules searched by
+    /// `by_state`.
+    #[inline(always)]
+    pub(super) fn rest_after(
+        &mut self,
+        mut best: Best,
+        late: bool,
+        by_state: impl Fn(&Engine, &mut Best),
+    ) -> Result<(), StepError> {
+        if late {
+            let st = self.state as usize;
+            self.fast_best_touched(st, &mut best);
+        }
+        if best.rule == NONE {
+            return Ok(());
+        }
+        self.fire_with(best, by_state)
     }
 
     /// [`insert`](Self::insert) without the network.
     #[inline(always)]
     pub(super) fn fast_insert(&mut self, event: u32, time: u64, payload: &[Value]) {
-        // SAFETY (`at`, `at_mut`): the event was taken by the payload check
-        // (it is the bundle's, and `payload` fits it); its agent, its
-        // place and its windows are checked (`Program::check`); the tables
-        // indexed by agent have one entry per agent.
+        // SAFETY (`at`): the event was taken by the payload check (it is
+        // the bundle's, and `payload` fits it); its agent, its place and
+        // its windows are checked (`Program::check`).
         let ev = unsafe { *at(&self.net.event, event as usize) };
-        let a = ev.agent as usize;
-        // `u64::MAX` (never) stays `u64::MAX`.
-        let stale_at = time.saturating_add(ev.stale_after);
         let window_at = self.fast_next_window(ev.windows, time);
+        self.insert_with(event, time, payload, ev.agent, ev.stale_after, ev.payload_at, window_at, |fp, run| {
+            // SAFETY (`at`): `run_at` has one entry per event, its range
+            // in `runs` (`Program::check`).
+            let (first, cap) = unsafe { *at(&fp.run_at, event as usize) };
+            unsafe { *at(&fp.runs, first as usize + run.min(cap as u64) as usize) }
+        });
+    }
+
+    /// The insert of `event`'s fact, given its event's agent, `stale
+    /// after` and place in the arena, the deadline of its next window
+    /// (`fast_next_window`), and its bits of `have` by run length. The one
+    /// insert of the fast path and of native code (`native.rs`).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    pub(super) fn insert_with(
+        &mut self,
+        event: u32,
+        time: u64,
+        payload: &[Value],
+        agent: u32,
+        stale_after: u64,
+        payload_at: u32,
+        window_at: u64,
+        bits_of: impl FnOnce(&Program, u64) -> u64,
+    ) {
+        // `u64::MAX` (never) stays `u64::MAX`.
+        let stale_at = time.saturating_add(stale_after);
         self.seq += 1;
         let (seq, now) = (self.seq, self.now);
-        let r = unsafe { at_mut(&mut self.agents, a) };
+        // SAFETY (`at_mut`): an event's agent is checked (`Program::check`;
+        // native code: `Native`'s digest), and `agents` has one record per agent.
+        let r = unsafe { at_mut(&mut self.agents, agent as usize) };
         let old = r.slot;
         let run = if old.event == event { old.run + 1 } else { 1 };
         r.slot = Slot { event, time, run, seq };
-        // SAFETY (`at`): `run_at` has one entry per event, its range in
-        // `runs` (`Program::check`).
-        let (first, cap) = unsafe { *at(&self.fp.run_at, event as usize) };
-        let new_bit = unsafe { *at(&self.fp.runs, first as usize + run.min(cap as u64) as usize) };
+        let new_bit = bits_of(&self.fp, run);
         let old_bit = std::mem::replace(&mut r.bit, new_bit);
         // The agent's clock: a step's event is stamped at or after it
         // (`admit`); `force_fact` keeps the later of the two itself.
@@ -267,9 +351,9 @@ impl Engine {
         r.window_at = window_at;
         self.have = (self.have & !old_bit) | new_bit;
         // SAFETY: the event's place and its fields fit in the arena
-        // (`Program::check`), and `payload` has as many values as it has
-        // fields (the payload check).
-        copy_payload(unsafe { self.payload.get_unchecked_mut(ev.payload_at as usize..) }, payload);
+        // (`Program::check`; native code: `Native`'s digest), and `payload`
+        // has as many values as it has fields (the payload check).
+        copy_payload(unsafe { self.payload.get_unchecked_mut(payload_at as usize..) }, payload);
         self.next_deadline = self.next_deadline.min(stale_at).min(window_at);
     }
 
@@ -291,6 +375,19 @@ impl Engine {
                 return deadline;
             }
             i += 1;
+        }
+        u64::MAX
+    }
+
+    /// [`fast_next_window`](Self::fast_next_window) of windows given as
+    /// constants (native code).
+    #[inline(always)]
+    pub(super) fn next_window_of(&self, windows: &[u64], time: u64) -> u64 {
+        for &w in windows {
+            let deadline = time.saturating_add(w);
+            if deadline >= self.now {
+                return deadline;
+            }
         }
         u64::MAX
     }
@@ -331,7 +428,7 @@ impl Engine {
     /// ran in the step.
     #[inline(always)]
     pub(super) fn fast_rest(&mut self) -> Result<(), StepError> {
-        let mut best = Best { rule: NONE, group: 0, recency: u64::MAX };
+        let mut best = Best::NONE;
         let st = self.state as usize;
         if !self.active.is_empty() {
             // SAFETY (`at`): the state is a state of the bundle.
@@ -340,27 +437,6 @@ impl Engine {
             // Their rules are the state's.
             self.touched.clear();
         } else {
-            self.fast_best_touched(st, &mut best);
-        }
-        if best.rule == NONE {
-            return Ok(());
-        }
-        self.fast_fire(best)
-    }
-
-    /// The rest after a step's fact of `event`: the engine was at rest
-    /// before it was inserted (a rest came first, or an error returned), so
-    /// the rules of `event`'s new fact, and if expiry ran after the insert
-    /// (`late`), those of the agents in `touched` (else it is empty).
-    #[inline(always)]
-    fn fast_rest_after(&mut self, event: u32, late: bool) -> Result<(), StepError> {
-        let mut best = Best { rule: NONE, group: 0, recency: u64::MAX };
-        let st = self.state as usize;
-        // SAFETY (`at`): the state and the event (taken by the payload
-        // check) are the bundle's: `st * ne + event < ns * ne`.
-        let list = unsafe { *at(&self.fp.by_event, st * self.fp.ne + event as usize) };
-        self.fast_best_in(list, &mut best);
-        if late {
             self.fast_best_touched(st, &mut best);
         }
         if best.rule == NONE {
@@ -381,15 +457,22 @@ impl Engine {
     /// Fires `best`, then the rule that fires first in each new state,
     /// until none is activated; the bound counts the firings of the step.
     #[inline(never)]
-    fn fast_fire(&mut self, mut best: Best) -> Result<(), StepError> {
+    fn fast_fire(&mut self, best: Best) -> Result<(), StepError> {
+        self.fire_with(best, |e, best| e.fast_best_in(e.fp.by_state[e.state as usize], best))
+    }
+
+    /// [`fast_fire`](Self::fast_fire), each new state's rules searched by
+    /// `by_state` (the lists of the program, or native code's).
+    #[inline(never)]
+    fn fire_with(&mut self, mut best: Best, by_state: impl Fn(&Engine, &mut Best)) -> Result<(), StepError> {
         while best.rule != NONE {
             if self.record.firings.len() == self.cascade_limit {
                 self.fast_activate();
                 return Err(StepError::Cascade { limit: self.cascade_limit });
             }
             self.state = self.fast_record(best.rule);
-            best = Best { rule: NONE, group: 0, recency: u64::MAX };
-            self.fast_best_in(self.fp.by_state[self.state as usize], &mut best);
+            best = Best::NONE;
+            by_state(self, &mut best);
         }
         Ok(())
     }
@@ -407,25 +490,38 @@ impl Engine {
             let rule = unsafe { at(&p.rules, r as usize) };
             i += 1;
             if best.rule != NONE && rule.group < best.group {
-                // The list is in firing order: no later rule comes first.
                 return;
             }
             if self.have & rule.mask != rule.need || !self.fast_holds(rule) {
                 continue;
             }
-            if best.rule == NONE || rule.group > best.group {
-                *best = Best { rule: r, group: rule.group, recency: u64::MAX };
-                continue;
-            }
-            // The same salience and specificity: recency, then the rule
-            // declared first.
-            if best.recency == u64::MAX {
-                best.recency = self.fast_recency(best.rule);
-            }
-            let recency = self.fast_recency(r);
-            if recency > best.recency || (recency == best.recency && r < best.rule) {
-                *best = Best { rule: r, group: rule.group, recency };
-            }
+            self.take(best, r, rule.group);
+        }
+    }
+
+    /// Rule `r` of rank `group` is activated: it becomes `best` if it
+    /// fires before it (§10.4: salience and specificity by the rank, then
+    /// recency, then the rule declared first). The one conflict resolution
+    /// of the fast path and of native code (`native.rs`).
+    #[inline(always)]
+    pub(super) fn take(&self, best: &mut Best, r: u32, group: u32) {
+        if best.rule == NONE || group > best.group {
+            *best = Best { rule: r, group, recency: u64::MAX };
+        } else {
+            self.tie(best, r, group);
+        }
+    }
+
+    /// [`take`](Self::take) of a rule of `best`'s salience and
+    /// specificity: recency, then the rule declared first.
+    #[inline(never)]
+    fn tie(&self, best: &mut Best, r: u32, group: u32) {
+        if best.recency == u64::MAX {
+            best.recency = self.fast_recency(best.rule);
+        }
+        let recency = self.fast_recency(r);
+        if recency > best.recency || (recency == best.recency && r < best.rule) {
+            *best = Best { rule: r, group, recency };
         }
     }
 
@@ -450,41 +546,54 @@ impl Engine {
 
     #[inline(always)]
     fn fast_cond(&self, c: &Cond) -> bool {
-        let a = c.agent as usize;
-        // SAFETY (`at`): a condition's agent is checked, and `agents` has
-        // one record per agent.
-        let r = unsafe { at(&self.agents, a) };
-        let pos = if c.event == STALE {
-            r.stale
+        if c.event == STALE {
+            self.cond_stale(c.agent, c.negative)
         } else {
-            let slot = &r.slot;
-            slot.event == c.event
-                && slot.run >= c.min_run
-                && (c.within == u64::MAX || r.checked.saturating_sub(slot.time) <= c.within)
-                && (c.tests.0 == c.tests.1 || self.fast_tests(c.tests))
-        };
-        pos != c.negative
+            self.cond_event(c.agent, c.event, c.negative, c.min_run, c.within, |e| {
+                c.tests.0 == c.tests.1 || e.fast_tests(c.tests)
+            })
+        }
+    }
+
+    /// Whether agent `agent` is stale (`!=` `negative`).
+    #[inline(always)]
+    pub(super) fn cond_stale(&self, agent: u32, negative: bool) -> bool {
+        // SAFETY (`at`): a condition's agent is checked (`Program::check`;
+        // native code: `Native`'s digest), and `agents` has one record per agent.
+        unsafe { at(&self.agents, agent as usize) }.stale != negative
+    }
+
+    /// Whether agent `agent`'s fact is `event` with a run length of at
+    /// least `min_run`, evaluated within `within` ns of its stamp
+    /// (`u64::MAX`: no window), and passes `tests` (`!=` `negative`).
+    #[inline(always)]
+    pub(super) fn cond_event(
+        &self,
+        agent: u32,
+        event: u32,
+        negative: bool,
+        min_run: u64,
+        within: u64,
+        tests: impl FnOnce(&Engine) -> bool,
+    ) -> bool {
+        // SAFETY (`at`): as `cond_stale`.
+        let r = unsafe { at(&self.agents, agent as usize) };
+        let slot = &r.slot;
+        let pos = slot.event == event
+            && slot.run >= min_run
+            && (within == u64::MAX || r.checked.saturating_sub(slot.time) <= within)
+            && tests(self);
+        pos != negative
     }
 
     fn fast_tests(&self, (s, e): (u32, u32)) -> bool {
         for i in s as usize..e as usize {
-            // SAFETY (`at`): tests and their places in the arena are checked.
+            // SAFETY (`at`): tests are checked.
             let pass = match unsafe { *at(&self.fp.tests, i) } {
-                Test::F64 { x, op, c } => match unsafe { *at(&self.payload, x as usize) } {
-                    Value::F64(v) => float(op, v, c),
-                    other => compare(op, other, Value::F64(c)),
-                },
-                Test::F64Range { x, lo, hi, inclusive } => match unsafe { *at(&self.payload, x as usize) } {
-                    Value::F64(v) => v >= lo && if inclusive { v <= hi } else { v < hi },
-                    other => in_range(other, Value::F64(lo), Value::F64(hi), inclusive),
-                },
-                Test::Any { x, check } => {
-                    let x = unsafe { *at(&self.payload, x as usize) };
-                    match check {
-                        Check2::Compare { op, rhs } => compare(op, x, self.arg(rhs)),
-                        Check2::Range { lo, hi, inclusive } => in_range(x, self.arg(lo), self.arg(hi), inclusive),
-                    }
-                }
+                Test::F64 { x, op, c } => self.test_f64(x, op, c),
+                Test::F64Range { x, lo, hi, inclusive } => self.test_f64_range(x, lo, hi, inclusive),
+                Test::Any { x, check: Check2::Compare { op, rhs } } => self.test_compare(x, op, rhs),
+                Test::Any { x, check: Check2::Range { lo, hi, inclusive } } => self.test_range(x, lo, hi, inclusive),
             };
             if !pass {
                 return false;
@@ -493,12 +602,47 @@ impl Engine {
         true
     }
 
-    #[inline]
+    /// The payload value at place `x` of the arena.
+    #[inline(always)]
+    fn value_at(&self, x: u32) -> Value {
+        // SAFETY (`at`): places in the arena are checked (`Program::check`;
+        // native code: `Native`'s digest).
+        unsafe { *at(&self.payload, x as usize) }
+    }
+
+    /// The value at `x` (of a float field) against a float constant.
+    #[inline(always)]
+    pub(super) fn test_f64(&self, x: u32, op: Cmp, c: f64) -> bool {
+        match self.value_at(x) {
+            Value::F64(v) => float(op, v, c),
+            other => compare(op, other, Value::F64(c)),
+        }
+    }
+
+    /// The value at `x` (of a float field) in a range of float constants.
+    #[inline(always)]
+    pub(super) fn test_f64_range(&self, x: u32, lo: f64, hi: f64, inclusive: bool) -> bool {
+        match self.value_at(x) {
+            Value::F64(v) => v >= lo && if inclusive { v <= hi } else { v < hi },
+            other => in_range(other, Value::F64(lo), Value::F64(hi), inclusive),
+        }
+    }
+
+    #[inline(always)]
+    pub(super) fn test_compare(&self, x: u32, op: Cmp, rhs: Arg) -> bool {
+        compare(op, self.value_at(x), self.arg(rhs))
+    }
+
+    #[inline(always)]
+    pub(super) fn test_range(&self, x: u32, lo: Arg, hi: Arg, inclusive: bool) -> bool {
+        in_range(self.value_at(x), self.arg(lo), self.arg(hi), inclusive)
+    }
+
+    #[inline(always)]
     fn arg(&self, a: Arg) -> Value {
         match a {
             Arg::Value(v) => v,
-            // SAFETY (`at`): places in the arena are checked.
-            Arg::At(i) => unsafe { *at(&self.payload, i as usize) },
+            Arg::At(i) => self.value_at(i),
         }
     }
 

@@ -40,6 +40,7 @@ mod admit;
 mod eval;
 mod fast;
 mod infer;
+pub mod native;
 mod net;
 mod network;
 mod report;
@@ -145,6 +146,10 @@ pub struct Engine {
     /// agents (`fast::Program::stale_bit`), as bits: the `bit`s of the
     /// agents' records, or'd; kept on the fast path only.
     have: u64,
+    /// Native code that runs the steps (`native.rs`), on the fast path,
+    /// and its steps (empty without it).
+    native: Option<&'static native::Native>,
+    native_steps: &'static [native::StepFn],
 }
 
 /// The memories of the network (alpha, beta, activated rules).
@@ -218,6 +223,8 @@ impl Engine {
             touched: Vec::with_capacity(na),
             declined,
             have: 0,
+            native: None,
+            native_steps: &[],
             content,
             net,
         };
@@ -285,7 +292,10 @@ impl Engine {
     /// reusing `self`'s buffers: the explorer of `verify` copies an engine
     /// per successor it tries.
     pub fn copy_from(&mut self, other: &Engine) {
-        if !Arc::ptr_eq(&self.content, &other.content) || self.fast != other.fast {
+        if !Arc::ptr_eq(&self.content, &other.content)
+            || self.fast != other.fast
+            || self.native.map(|n| n as *const _) != other.native.map(|n| n as *const _)
+        {
             *self = other.clone();
             return;
         }
@@ -363,6 +373,10 @@ impl Engine {
     /// those of an error.
     #[inline]
     pub fn step(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Step, StepError> {
+        // Native code's step of the event (none without native code).
+        if let Some(step) = self.native_steps.get(event as usize) {
+            return step(self, time, payload);
+        }
         self.admitted(event, time, payload)?;
         if self.fast {
             self.fast_accepted(event, time, payload)
