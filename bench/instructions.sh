@@ -14,12 +14,16 @@
 #    `instructions` of situ-runtime (valgrind: scripts/install-capi-tools.sh);
 # 2. `situ build` compiles the rules to a bundle; `situ bench` generates the
 #    stream (written to a file) and its state sequence;
-# 3. runs situ's engine (`runtime/examples/instructions.rs`) and the
-#    hand-written matcher (`bench/handwritten/`) on that file under
-#    `valgrind --tool=callgrind`;
-# 4. the three state sequences (situ bench, the engine under callgrind, the
-#    hand-written matcher) must be equal, else it stops with exit 1;
-# 5. prints the instructions per event of each and `handwritten/situ ratio`.
+# 3. runs situ's engine (`runtime/examples/instructions.rs`) on its fast path
+#    (or its interpreter), situ's engine on the native code of the rules
+#    (`situ build --native`, `runtime-tests/native/outdoor.rs`, which the
+#    example links), and the hand-written matcher (`bench/handwritten/`) on
+#    that file under `valgrind --tool=callgrind`;
+# 4. the four state sequences (situ bench, the engine twice under
+#    callgrind, the hand-written matcher) must be equal, else it stops with
+#    exit 1;
+# 5. prints the instructions per event of each and the `handwritten/situ`
+#    ratios.
 #
 # What is counted: only the processing loop. Both programs read and parse
 # the stream first, then call one `#[inline(never)]` function that processes
@@ -27,7 +31,9 @@
 # `situ bench` does, with its clock, its step, the state at rest and the
 # reset of a finished mission; the hand-written one is its timed loop).
 # Callgrind collects only inside it (`--toggle-collect=*::process_stream`):
-# set-up, parsing and output are not counted.
+# set-up, parsing and output are not counted. The native run's loop is
+# `process_stream_native`, the same loop calling the module's `step` as a
+# program that links native code does.
 set -euo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -60,7 +66,7 @@ echo "== $events events, seed $seed, over rules/outdoor.situ" >&2
 callgrind() {
     local out="$1"
     shift
-    valgrind --tool=callgrind --toggle-collect='*::process_stream' \
+    valgrind --tool=callgrind --toggle-collect='*::process_stream*' \
         --callgrind-out-file="$out" "$@" >/dev/null 2>"$out.log" || {
         echo "error: $* failed under valgrind:" >&2
         cat "$out.log" >&2
@@ -69,10 +75,12 @@ callgrind() {
 }
 callgrind "$work/situ.cg" "$target/examples/instructions" "$work/outdoor.bundle" "$work/stream.events" \
     "$work/situ.states"
+INTERPRETED=0 NATIVE=1 callgrind "$work/native.cg" "$target/examples/instructions" "$work/outdoor.bundle" \
+    "$work/stream.events" "$work/native.states"
 callgrind "$work/handwritten.cg" "$target/situ-handwritten" --stream "$work/stream.events" \
     --states-out "$work/handwritten.states"
 
-for engine in situ handwritten; do
+for engine in situ native handwritten; do
     if ! cmp -s "$work/bench.states" "$work/$engine.states"; then
         echo "error: \`situ bench\` and $engine (under callgrind) reach different state sequences; first difference:" >&2
         diff "$work/bench.states" "$work/$engine.states" | head -n 6 >&2 || true
@@ -93,16 +101,23 @@ total() {
     echo "$n"
 }
 situ_ir="$(total "$work/situ.cg")"
+native_ir="$(total "$work/native.cg")"
 hand_ir="$(total "$work/handwritten.cg")"
-python3 - "$events" "$situ_ir" "$hand_ir" <<'PY'
+label="fast path"
+if [[ ${INTERPRETED:-0} == 1 ]]; then label="interpreter"; fi
+python3 - "$events" "$situ_ir" "$native_ir" "$hand_ir" "$label" <<'PY'
 import sys
-events, situ, hand = int(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3])
-print(f"situ:        {situ:>15,} instructions  {situ / events:8.1f} per event")
-print(f"handwritten: {hand:>15,} instructions  {hand / events:8.1f} per event")
-print(f"handwritten/situ ratio (instructions): {situ / hand:.2f}")
+events, situ, native, hand = (int(x) for x in sys.argv[1:5])
+label = sys.argv[5]
+for name, n in ((f"situ ({label}):", situ), ("situ (native):", native), ("handwritten:", hand)):
+    print(f"{name:<20} {n:>15,} instructions  {n / events:8.1f} per event")
+print(f"handwritten/situ ratio (instructions), {label}: {situ / hand:.2f}")
+print(f"handwritten/situ ratio (instructions), native: {native / hand:.2f}")
 PY
 if [[ $top -gt 0 ]]; then
-    echo "== situ: the $top costliest functions (exclusive instructions, inlined code in its caller)"
-    # sed, not head: the pipe is read to its end (no SIGPIPE under pipefail).
-    callgrind_annotate --threshold=100 "$work/situ.cg" 2>/dev/null | sed -n '/^Ir/,$p' | sed -n "1,$((top + 2))p"
+    for run in situ native; do
+        echo "== $run: the $top costliest functions (exclusive instructions, inlined code in its caller)"
+        # sed, not head: the pipe is read to its end (no SIGPIPE under pipefail).
+        callgrind_annotate --threshold=100 "$work/$run.cg" 2>/dev/null | sed -n '/^Ir/,$p' | sed -n "1,$((top + 2))p"
+    done
 fi

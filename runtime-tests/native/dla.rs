@@ -13,7 +13,25 @@ use situ_runtime::rete::native::rt;
 /// Per event, its step.
 pub static STEPS: [rt::StepFn; 5] = [e0, e1, e2, e3, e4];
 
+/// `Engine::step`, inlined where it is called: the event's step if the
+/// engine runs this module (`Engine::with_native`), else the engine's own.
+#[inline(always)]
+pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
+    if !rt::runs(e, &STEPS) {
+        return rt::step(e, event, time, payload);
+    }
+    match event {
+        0 => e0(e, time, payload),
+        1 => e1(e, time, payload),
+        2 => e2(e, time, payload),
+        3 => e3(e, time, payload),
+        4 => e4(e, time, payload),
+        _ => rt::fallback(e, event, time, payload),
+    }
+}
+
 /// `SCAN`.
+#[inline(always)]
 fn e0(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_)]) {
         return rt::fallback(e, 0, time, payload);
@@ -29,10 +47,11 @@ fn e0(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         2 => l2(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `POSE`.
+#[inline(always)]
 fn e1(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_)]) {
         return rt::fallback(e, 1, time, payload);
@@ -48,10 +67,11 @@ fn e1(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         2 => l3(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `ROUTE`.
+#[inline(always)]
 fn e2(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::I64(_), rt::Value::I64(_)]) {
         return rt::fallback(e, 2, time, payload);
@@ -67,10 +87,11 @@ fn e2(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         2 => l4(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `NO_ROUTE`.
+#[inline(always)]
 fn e3(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_)]) {
         return rt::fallback(e, 3, time, payload);
@@ -85,10 +106,11 @@ fn e3(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         2 => l6(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `PATH_BLOCKED`.
+#[inline(always)]
 fn e4(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::I64(_)]) {
         return rt::fallback(e, 4, time, payload);
@@ -104,7 +126,7 @@ fn e4(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         2 => l4(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// The rules that can fire in the state the engine is in.
@@ -114,6 +136,19 @@ fn by_state(e: &rt::Engine, best: &mut rt::Best) {
         1 => l1(e, best),
         2 => l0(e, best),
         _ => {}
+    }
+}
+
+/// Records the firing of rule `r`; its target.
+fn fire(e: &mut rt::Engine, r: u32) -> u32 {
+    match r {
+        0 => rt::record(e, 0, 1, &[3], &[]),
+        1 => rt::record(e, 1, 2, &[3, 4], &[]),
+        2 => rt::record(e, 2, 4, &[3], &[]),
+        3 => rt::record(e, 3, 3, &[1], &[]),
+        4 => rt::record(e, 4, 5, &[0], &[]),
+        5 => rt::record(e, 5, 5, &[], &[0]),
+        _ => unreachable!("rule {r} is in no search"),
     }
 }
 
@@ -253,4 +288,4 @@ fn r4(e: &rt::Engine) -> bool {
     rt::event(e, 0, 0, false, 1, u64::MAX, |e| rt::f64(e, 0, rt::Cmp::Lt, f64::from_bits(0x3fbeb851eb851eb8) /* 0.12 */))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "7f831361e0dcfc2184ed10169b38515cb5651625729a471903e8097a19f41a03", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "46e5b5e281d48a5220762081902d86061027f431c028dada43624e93883a9662", steps: &STEPS };

@@ -13,7 +13,26 @@ use situ_runtime::rete::native::rt;
 /// Per event, its step.
 pub static STEPS: [rt::StepFn; 6] = [e0, e1, e2, e3, e4, e5];
 
+/// `Engine::step`, inlined where it is called: the event's step if the
+/// engine runs this module (`Engine::with_native`), else the engine's own.
+#[inline(always)]
+pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
+    if !rt::runs(e, &STEPS) {
+        return rt::step(e, event, time, payload);
+    }
+    match event {
+        0 => e0(e, time, payload),
+        1 => e1(e, time, payload),
+        2 => e2(e, time, payload),
+        3 => e3(e, time, payload),
+        4 => e4(e, time, payload),
+        5 => e5(e, time, payload),
+        _ => rt::fallback(e, event, time, payload),
+    }
+}
+
 /// `RFRS`.
+#[inline(always)]
 fn e0(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 0, time, payload);
@@ -27,10 +46,11 @@ fn e0(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         0 => l3(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `LAOBS`.
+#[inline(always)]
 fn e1(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_), rt::Value::F64(_)]) {
         return rt::fallback(e, 1, time, payload);
@@ -44,10 +64,11 @@ fn e1(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         0 => l3(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `LAOBN`.
+#[inline(always)]
 fn e2(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 2, time, payload);
@@ -61,10 +82,11 @@ fn e2(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         1 => l4(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `PLRS`.
+#[inline(always)]
 fn e3(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 3, time, payload);
@@ -74,10 +96,11 @@ fn e3(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
     rt::insert(e, 3, time, payload, 3, u64::MAX, 2, &[], &[0x8]);
     let late = rt::after(e);
     let best = rt::Best::NONE;
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `PLRO`.
+#[inline(always)]
 fn e4(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 4, time, payload);
@@ -87,10 +110,11 @@ fn e4(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
     rt::insert(e, 4, time, payload, 3, u64::MAX, 2, &[], &[0x10]);
     let late = rt::after(e);
     let best = rt::Best::NONE;
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `DRSTOP`.
+#[inline(always)]
 fn e5(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 5, time, payload);
@@ -104,7 +128,7 @@ fn e5(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         2 => l2(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// The rules that can fire in the state the engine is in.
@@ -114,6 +138,18 @@ fn by_state(e: &rt::Engine, best: &mut rt::Best) {
         1 => l1(e, best),
         2 => l2(e, best),
         _ => {}
+    }
+}
+
+/// Records the firing of rule `r`; its target.
+fn fire(e: &mut rt::Engine, r: u32) -> u32 {
+    match r {
+        0 => rt::record(e, 0, 1, &[0, 1], &[]),
+        1 => rt::record(e, 1, 0, &[1], &[]),
+        2 => rt::record(e, 2, 2, &[], &[1]),
+        3 => rt::record(e, 3, 2, &[], &[0]),
+        4 => rt::record(e, 4, 3, &[4], &[]),
+        _ => unreachable!("rule {r} is in no search"),
     }
 }
 
@@ -197,4 +233,4 @@ fn r0(e: &rt::Engine) -> bool {
     rt::event(e, 1, 1, false, 1, u64::MAX, |e| rt::f64(e, 0, rt::Cmp::Lt, f64::from_bits(0x403e000000000000) /* 30.0 */) && rt::f64(e, 1, rt::Cmp::Gt, f64::from_bits(0x3fc3333333333333) /* 0.15 */))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "b9067b51d912d04c9bb625bec28d595dde2312737cbfdc8f4f7f2da35216eeb9", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "494505499b60ddaeb515a0507bb4a82a1e2b3eb30315e935bba5c37b0b3b2a13", steps: &STEPS };

@@ -13,7 +13,29 @@ use situ_runtime::rete::native::rt;
 /// Per event, its step.
 pub static STEPS: [rt::StepFn; 9] = [e0, e1, e2, e3, e4, e5, e6, e7, e8];
 
+/// `Engine::step`, inlined where it is called: the event's step if the
+/// engine runs this module (`Engine::with_native`), else the engine's own.
+#[inline(always)]
+pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
+    if !rt::runs(e, &STEPS) {
+        return rt::step(e, event, time, payload);
+    }
+    match event {
+        0 => e0(e, time, payload),
+        1 => e1(e, time, payload),
+        2 => e2(e, time, payload),
+        3 => e3(e, time, payload),
+        4 => e4(e, time, payload),
+        5 => e5(e, time, payload),
+        6 => e6(e, time, payload),
+        7 => e7(e, time, payload),
+        8 => e8(e, time, payload),
+        _ => rt::fallback(e, event, time, payload),
+    }
+}
+
 /// `BPHIT`.
+#[inline(always)]
 fn e0(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::Symbol(v0)] if *v0 < 3) {
         return rt::fallback(e, 0, time, payload);
@@ -28,10 +50,11 @@ fn e0(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         1 => l5(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `BPFREE`.
+#[inline(always)]
 fn e1(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 1, time, payload);
@@ -45,10 +68,11 @@ fn e1(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l6(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `RAIN`.
+#[inline(always)]
 fn e2(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_)]) {
         return rt::fallback(e, 2, time, payload);
@@ -62,10 +86,11 @@ fn e2(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         0 => l7(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `DRY`.
+#[inline(always)]
 fn e3(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 3, time, payload);
@@ -80,10 +105,11 @@ fn e3(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         3 => l3(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `BATT`.
+#[inline(always)]
 fn e4(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_)]) {
         return rt::fallback(e, 4, time, payload);
@@ -98,10 +124,11 @@ fn e4(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         2 => l2(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `DOCKED`.
+#[inline(always)]
 fn e5(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 5, time, payload);
@@ -115,10 +142,11 @@ fn e5(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         1 => l9(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `GPFIX`.
+#[inline(always)]
 fn e6(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_)]) {
         return rt::fallback(e, 6, time, payload);
@@ -134,10 +162,11 @@ fn e6(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l10(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `BLSTALL`.
+#[inline(always)]
 fn e7(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 7, time, payload);
@@ -152,10 +181,11 @@ fn e7(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l11(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `ARRIVED`.
+#[inline(always)]
 fn e8(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 8, time, payload);
@@ -169,7 +199,7 @@ fn e8(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         1 => l9(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// The rules that can fire in the state the engine is in.
@@ -181,6 +211,23 @@ fn by_state(e: &rt::Engine, best: &mut rt::Best) {
         3 => l3(e, best),
         4 => l4(e, best),
         _ => {}
+    }
+}
+
+/// Records the firing of rule `r`; its target.
+fn fire(e: &mut rt::Engine, r: u32) -> u32 {
+    match r {
+        0 => rt::record(e, 0, 1, &[2], &[]),
+        1 => rt::record(e, 1, 2, &[5, 2], &[]),
+        2 => rt::record(e, 2, 0, &[2, 1], &[]),
+        3 => rt::record(e, 3, 3, &[1], &[]),
+        4 => rt::record(e, 4, 0, &[1], &[]),
+        5 => rt::record(e, 5, 4, &[0], &[]),
+        6 => rt::record(e, 6, 0, &[0], &[]),
+        7 => rt::record(e, 7, 5, &[4], &[]),
+        8 => rt::record(e, 8, 5, &[3], &[]),
+        9 => rt::record(e, 9, 5, &[], &[3]),
+        _ => unreachable!("rule {r} is in no search"),
     }
 }
 
@@ -394,4 +441,4 @@ fn r8(e: &rt::Engine) -> bool {
     rt::event(e, 3, 6, false, 20, u64::MAX, |e| rt::f64(e, 3, rt::Cmp::Gt, f64::from_bits(0x3ff0000000000000) /* 1.0 */))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "b5bbb21e996bd505ab8117855d3e4e26a45de2afbe796b2b08eb0b87f133d0b4", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "e991966a9475dd309e24e381fc3c161d1763cd91a47d0b41c11ca58e4965c140", steps: &STEPS };

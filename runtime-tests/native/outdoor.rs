@@ -13,7 +13,54 @@ use situ_runtime::rete::native::rt;
 /// Per event, its step.
 pub static STEPS: [rt::StepFn; 34] = [e0, e1, e2, e3, e4, e5, e6, e7, e8, e9, e10, e11, e12, e13, e14, e15, e16, e17, e18, e19, e20, e21, e22, e23, e24, e25, e26, e27, e28, e29, e30, e31, e32, e33];
 
+/// `Engine::step`, inlined where it is called: the event's step if the
+/// engine runs this module (`Engine::with_native`), else the engine's own.
+#[inline(always)]
+pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
+    if !rt::runs(e, &STEPS) {
+        return rt::step(e, event, time, payload);
+    }
+    match event {
+        0 => e0(e, time, payload),
+        1 => e1(e, time, payload),
+        2 => e2(e, time, payload),
+        3 => e3(e, time, payload),
+        4 => e4(e, time, payload),
+        5 => e5(e, time, payload),
+        6 => e6(e, time, payload),
+        7 => e7(e, time, payload),
+        8 => e8(e, time, payload),
+        9 => e9(e, time, payload),
+        10 => e10(e, time, payload),
+        11 => e11(e, time, payload),
+        12 => e12(e, time, payload),
+        13 => e13(e, time, payload),
+        14 => e14(e, time, payload),
+        15 => e15(e, time, payload),
+        16 => e16(e, time, payload),
+        17 => e17(e, time, payload),
+        18 => e18(e, time, payload),
+        19 => e19(e, time, payload),
+        20 => e20(e, time, payload),
+        21 => e21(e, time, payload),
+        22 => e22(e, time, payload),
+        23 => e23(e, time, payload),
+        24 => e24(e, time, payload),
+        25 => e25(e, time, payload),
+        26 => e26(e, time, payload),
+        27 => e27(e, time, payload),
+        28 => e28(e, time, payload),
+        29 => e29(e, time, payload),
+        30 => e30(e, time, payload),
+        31 => e31(e, time, payload),
+        32 => e32(e, time, payload),
+        33 => e33(e, time, payload),
+        _ => rt::fallback(e, event, time, payload),
+    }
+}
+
 /// `RFRS`.
+#[inline(always)]
 fn e0(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 0, time, payload);
@@ -30,10 +77,11 @@ fn e0(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         6 => l11(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `RFRT`.
+#[inline(always)]
 fn e1(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_), rt::Value::Symbol(v1)] if *v1 < 2) {
         return rt::fallback(e, 1, time, payload);
@@ -49,10 +97,11 @@ fn e1(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l13(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `RFRB`.
+#[inline(always)]
 fn e2(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_)]) {
         return rt::fallback(e, 2, time, payload);
@@ -67,10 +116,11 @@ fn e2(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         3 => l14(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `RFRN`.
+#[inline(always)]
 fn e3(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 3, time, payload);
@@ -86,10 +136,11 @@ fn e3(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l15(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `STOBS`.
+#[inline(always)]
 fn e4(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_), rt::Value::F64(_)]) {
         return rt::fallback(e, 4, time, payload);
@@ -107,10 +158,11 @@ fn e4(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         6 => l18(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `STOBN`.
+#[inline(always)]
 fn e5(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 5, time, payload);
@@ -126,10 +178,11 @@ fn e5(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         7 => l20(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `LAOBS`.
+#[inline(always)]
 fn e6(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_), rt::Value::F64(_)]) {
         return rt::fallback(e, 6, time, payload);
@@ -148,10 +201,11 @@ fn e6(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         7 => l22(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `LAOBN`.
+#[inline(always)]
 fn e7(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 7, time, payload);
@@ -167,10 +221,11 @@ fn e7(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         7 => l20(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `LOFIX`.
+#[inline(always)]
 fn e8(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_)]) {
         return rt::fallback(e, 8, time, payload);
@@ -184,10 +239,11 @@ fn e8(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         0 => l24(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `LOLOST`.
+#[inline(always)]
 fn e9(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 9, time, payload);
@@ -207,10 +263,11 @@ fn e9(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         7 => l26(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `FURS`.
+#[inline(always)]
 fn e10(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 10, time, payload);
@@ -224,10 +281,11 @@ fn e10(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         5 => l27(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `FURT`.
+#[inline(always)]
 fn e11(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 11, time, payload);
@@ -241,10 +299,11 @@ fn e11(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         5 => l28(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `FURB`.
+#[inline(always)]
 fn e12(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 12, time, payload);
@@ -258,10 +317,11 @@ fn e12(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         5 => l29(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `FURO`.
+#[inline(always)]
 fn e13(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_)]) {
         return rt::fallback(e, 13, time, payload);
@@ -275,10 +335,11 @@ fn e13(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         7 => l30(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `FUCN`.
+#[inline(always)]
 fn e14(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 14, time, payload);
@@ -292,10 +353,11 @@ fn e14(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         7 => l20(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `FUCO`.
+#[inline(always)]
 fn e15(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_)]) {
         return rt::fallback(e, 15, time, payload);
@@ -309,10 +371,11 @@ fn e15(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         5 => l31(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `GPRS`.
+#[inline(always)]
 fn e16(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 16, time, payload);
@@ -327,10 +390,11 @@ fn e16(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         6 => l11(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `GPRT`.
+#[inline(always)]
 fn e17(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 17, time, payload);
@@ -344,10 +408,11 @@ fn e17(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         1 => l12(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `GPRB`.
+#[inline(always)]
 fn e18(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 18, time, payload);
@@ -362,10 +427,11 @@ fn e18(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         3 => l14(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `GPCC`.
+#[inline(always)]
 fn e19(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 19, time, payload);
@@ -382,10 +448,11 @@ fn e19(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         4 => l15(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `GPGL`.
+#[inline(always)]
 fn e20(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_)]) {
         return rt::fallback(e, 20, time, payload);
@@ -404,10 +471,11 @@ fn e20(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         7 => l33(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `PLRS`.
+#[inline(always)]
 fn e21(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 21, time, payload);
@@ -421,10 +489,11 @@ fn e21(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         5 => l27(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `PLRT`.
+#[inline(always)]
 fn e22(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 22, time, payload);
@@ -438,10 +507,11 @@ fn e22(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         5 => l28(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `PLRB`.
+#[inline(always)]
 fn e23(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 23, time, payload);
@@ -455,10 +525,11 @@ fn e23(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         5 => l29(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `PLRO`.
+#[inline(always)]
 fn e24(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 24, time, payload);
@@ -472,10 +543,11 @@ fn e24(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         7 => l30(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `PLCN`.
+#[inline(always)]
 fn e25(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 25, time, payload);
@@ -489,10 +561,11 @@ fn e25(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         7 => l20(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `PLCO`.
+#[inline(always)]
 fn e26(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 26, time, payload);
@@ -506,10 +579,11 @@ fn e26(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         5 => l31(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `PLF`.
+#[inline(always)]
 fn e27(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::Symbol(v0)] if *v0 < 3) {
         return rt::fallback(e, 27, time, payload);
@@ -530,10 +604,11 @@ fn e27(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         7 => l34(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `DRSTOP`.
+#[inline(always)]
 fn e28(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 28, time, payload);
@@ -547,10 +622,11 @@ fn e28(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         9 => l35(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `DRFAULT`.
+#[inline(always)]
 fn e29(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::I64(_)]) {
         return rt::fallback(e, 29, time, payload);
@@ -571,10 +647,11 @@ fn e29(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         7 => l36(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `SVRDY`.
+#[inline(always)]
 fn e30(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 30, time, payload);
@@ -588,10 +665,11 @@ fn e30(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         0 => l24(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `SVSTOP`.
+#[inline(always)]
 fn e31(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::Symbol(v0)] if *v0 < 3) {
         return rt::fallback(e, 31, time, payload);
@@ -613,10 +691,11 @@ fn e31(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         9 => l37(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `TCHB`.
+#[inline(always)]
 fn e32(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 32, time, payload);
@@ -630,10 +709,11 @@ fn e32(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         0 => l24(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `TCTAKE`.
+#[inline(always)]
 fn e33(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 33, time, payload);
@@ -655,7 +735,7 @@ fn e33(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step,
         9 => l38(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// The rules that can fire in the state the engine is in.
@@ -671,6 +751,46 @@ fn by_state(e: &rt::Engine, best: &mut rt::Best) {
         7 => l7(e, best),
         9 => l8(e, best),
         _ => {}
+    }
+}
+
+/// Records the firing of rule `r`; its target.
+fn fire(e: &mut rt::Engine, r: u32) -> u32 {
+    match r {
+        0 => rt::record(e, 0, 9, &[6], &[]),
+        1 => rt::record(e, 1, 9, &[8], &[]),
+        2 => rt::record(e, 2, 9, &[2], &[]),
+        3 => rt::record(e, 3, 9, &[3], &[]),
+        4 => rt::record(e, 4, 9, &[], &[3]),
+        5 => rt::record(e, 5, 9, &[], &[2]),
+        6 => rt::record(e, 6, 9, &[], &[0]),
+        7 => rt::record(e, 7, 9, &[], &[1]),
+        8 => rt::record(e, 8, 9, &[], &[10]),
+        9 => rt::record(e, 9, 10, &[10], &[]),
+        10 => rt::record(e, 10, 10, &[9], &[]),
+        11 => rt::record(e, 11, 10, &[8], &[]),
+        12 => rt::record(e, 12, 8, &[5], &[]),
+        13 => rt::record(e, 13, 0, &[3], &[]),
+        14 => rt::record(e, 14, 5, &[2], &[]),
+        15 => rt::record(e, 15, 5, &[1], &[]),
+        16 => rt::record(e, 16, 7, &[2], &[]),
+        17 => rt::record(e, 17, 7, &[1], &[]),
+        18 => rt::record(e, 18, 2, &[4, 6, 2], &[]),
+        19 => rt::record(e, 19, 3, &[4, 6, 2], &[]),
+        20 => rt::record(e, 20, 4, &[4, 6, 2], &[]),
+        21 => rt::record(e, 21, 7, &[4, 6], &[]),
+        22 => rt::record(e, 22, 6, &[4, 6, 2, 1], &[]),
+        23 => rt::record(e, 23, 5, &[4, 6], &[]),
+        24 => rt::record(e, 24, 1, &[9, 10, 3], &[]),
+        25 => rt::record(e, 25, 2, &[5, 0, 2, 1], &[]),
+        26 => rt::record(e, 26, 3, &[5, 0, 2, 1], &[]),
+        27 => rt::record(e, 27, 6, &[5, 2, 1], &[]),
+        28 => rt::record(e, 28, 2, &[0], &[]),
+        29 => rt::record(e, 29, 3, &[0], &[]),
+        30 => rt::record(e, 30, 4, &[0, 5], &[]),
+        31 => rt::record(e, 31, 6, &[5, 0], &[]),
+        32 => rt::record(e, 32, 2, &[5, 0], &[]),
+        _ => unreachable!("rule {r} is in no search"),
     }
 }
 
@@ -1781,4 +1901,4 @@ fn r29(e: &rt::Engine) -> bool {
     rt::event(e, 0, 1, false, 2, u64::MAX, |e| rt::f64(e, 0, rt::Cmp::Ge, f64::from_bits(0x3f947ae147ae147b) /* 0.02 */))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "bb3e5ad1c5c2ce70d12611ffcffa2ebb14a533dd6960b82d699bf3f0e1e93795", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "10d79fe4911201aaa2977dfe93d8e54caf7cc8a21896a284b2197b9ec17441db", steps: &STEPS };

@@ -13,7 +13,26 @@ use situ_runtime::rete::native::rt;
 /// Per event, its step.
 pub static STEPS: [rt::StepFn; 6] = [e0, e1, e2, e3, e4, e5];
 
+/// `Engine::step`, inlined where it is called: the event's step if the
+/// engine runs this module (`Engine::with_native`), else the engine's own.
+#[inline(always)]
+pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
+    if !rt::runs(e, &STEPS) {
+        return rt::step(e, event, time, payload);
+    }
+    match event {
+        0 => e0(e, time, payload),
+        1 => e1(e, time, payload),
+        2 => e2(e, time, payload),
+        3 => e3(e, time, payload),
+        4 => e4(e, time, payload),
+        5 => e5(e, time, payload),
+        _ => rt::fallback(e, event, time, payload),
+    }
+}
+
 /// `AX`.
+#[inline(always)]
 fn e0(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_), rt::Value::I64(_)]) {
         return rt::fallback(e, 0, time, payload);
@@ -31,10 +50,11 @@ fn e0(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l8(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `AY`.
+#[inline(always)]
 fn e1(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 1, time, payload);
@@ -52,10 +72,11 @@ fn e1(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l8(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `BX`.
+#[inline(always)]
 fn e2(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_), rt::Value::Symbol(v1)] if *v1 < 2) {
         return rt::fallback(e, 2, time, payload);
@@ -73,10 +94,11 @@ fn e2(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l9(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `BY`.
+#[inline(always)]
 fn e3(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 3, time, payload);
@@ -94,10 +116,11 @@ fn e3(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l9(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `CX`.
+#[inline(always)]
 fn e4(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::Bool(_)]) {
         return rt::fallback(e, 4, time, payload);
@@ -107,10 +130,11 @@ fn e4(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
     rt::insert(e, 4, time, payload, 2, u64::MAX, 4, &[], &[0x10]);
     let late = rt::after(e);
     let best = rt::Best::NONE;
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `CY`.
+#[inline(always)]
 fn e5(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 5, time, payload);
@@ -127,7 +151,7 @@ fn e5(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         3 => l13(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// The rules that can fire in the state the engine is in.
@@ -139,6 +163,22 @@ fn by_state(e: &rt::Engine, best: &mut rt::Best) {
         3 => l3(e, best),
         4 => l4(e, best),
         _ => {}
+    }
+}
+
+/// Records the firing of rule `r`; its target.
+fn fire(e: &mut rt::Engine, r: u32) -> u32 {
+    match r {
+        1 => rt::record(e, 1, 4, &[], &[0]),
+        2 => rt::record(e, 2, 0, &[], &[0, 0]),
+        3 => rt::record(e, 3, 1, &[], &[0]),
+        4 => rt::record(e, 4, 1, &[], &[]),
+        5 => rt::record(e, 5, 4, &[], &[0, 0]),
+        6 => rt::record(e, 6, 4, &[], &[0]),
+        7 => rt::record(e, 7, 3, &[], &[]),
+        8 => rt::record(e, 8, 4, &[2], &[]),
+        9 => rt::record(e, 9, 2, &[], &[0]),
+        _ => unreachable!("rule {r} is in no search"),
     }
 }
 
@@ -492,4 +532,4 @@ fn r5(e: &rt::Engine) -> bool {
     rt::stale(e, 0, true)
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "e44e6ff9bfe9be99c449234b951a8c866ae64997f6f672793f4490a8844c64f1", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "033e300f8e9488b72797b002a6177937bc6a9d324c8448de44e2f14fa68a16d3", steps: &STEPS };

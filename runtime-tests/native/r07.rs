@@ -13,7 +13,26 @@ use situ_runtime::rete::native::rt;
 /// Per event, its step.
 pub static STEPS: [rt::StepFn; 6] = [e0, e1, e2, e3, e4, e5];
 
+/// `Engine::step`, inlined where it is called: the event's step if the
+/// engine runs this module (`Engine::with_native`), else the engine's own.
+#[inline(always)]
+pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
+    if !rt::runs(e, &STEPS) {
+        return rt::step(e, event, time, payload);
+    }
+    match event {
+        0 => e0(e, time, payload),
+        1 => e1(e, time, payload),
+        2 => e2(e, time, payload),
+        3 => e3(e, time, payload),
+        4 => e4(e, time, payload),
+        5 => e5(e, time, payload),
+        _ => rt::fallback(e, event, time, payload),
+    }
+}
+
 /// `AX`.
+#[inline(always)]
 fn e0(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_), rt::Value::I64(_)]) {
         return rt::fallback(e, 0, time, payload);
@@ -23,10 +42,11 @@ fn e0(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
     rt::insert(e, 0, time, payload, 0, 50000000, 0, &[], &[0x1]);
     let late = rt::after(e);
     let best = rt::Best::NONE;
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `AY`.
+#[inline(always)]
 fn e1(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 1, time, payload);
@@ -42,10 +62,11 @@ fn e1(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         3 => l4(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `BX`.
+#[inline(always)]
 fn e2(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_), rt::Value::Symbol(v1)] if *v1 < 2) {
         return rt::fallback(e, 2, time, payload);
@@ -55,10 +76,11 @@ fn e2(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
     rt::insert(e, 2, time, payload, 1, u64::MAX, 2, &[], &[0x4]);
     let late = rt::after(e);
     let best = rt::Best::NONE;
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `BY`.
+#[inline(always)]
 fn e3(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 3, time, payload);
@@ -68,10 +90,11 @@ fn e3(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
     rt::insert(e, 3, time, payload, 1, u64::MAX, 2, &[], &[0x8]);
     let late = rt::after(e);
     let best = rt::Best::NONE;
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `CX`.
+#[inline(always)]
 fn e4(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::Bool(_)]) {
         return rt::fallback(e, 4, time, payload);
@@ -89,10 +112,11 @@ fn e4(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l3(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `CY`.
+#[inline(always)]
 fn e5(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 5, time, payload);
@@ -110,7 +134,7 @@ fn e5(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l3(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// The rules that can fire in the state the engine is in.
@@ -122,6 +146,16 @@ fn by_state(e: &rt::Engine, best: &mut rt::Best) {
         3 => l1(e, best),
         4 => l3(e, best),
         _ => {}
+    }
+}
+
+/// Records the firing of rule `r`; its target.
+fn fire(e: &mut rt::Engine, r: u32) -> u32 {
+    match r {
+        0 => rt::record(e, 0, 2, &[], &[]),
+        4 => rt::record(e, 4, 4, &[], &[]),
+        5 => rt::record(e, 5, 4, &[0], &[]),
+        _ => unreachable!("rule {r} is in no search"),
     }
 }
 
@@ -215,4 +249,4 @@ fn r0(e: &rt::Engine) -> bool {
     rt::event(e, 2, 5, true, 1, 30000000, |_| true)
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "b5d7ca5ad43ed9123905db4aff0e58a387c8bd0c08d72006cdcc57bb70f28fc2", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "a2b47a50e78c9e98590807cbbae04986fce9209a24dd2c09367972884c0ad768", steps: &STEPS };

@@ -13,7 +13,26 @@ use situ_runtime::rete::native::rt;
 /// Per event, its step.
 pub static STEPS: [rt::StepFn; 6] = [e0, e1, e2, e3, e4, e5];
 
+/// `Engine::step`, inlined where it is called: the event's step if the
+/// engine runs this module (`Engine::with_native`), else the engine's own.
+#[inline(always)]
+pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
+    if !rt::runs(e, &STEPS) {
+        return rt::step(e, event, time, payload);
+    }
+    match event {
+        0 => e0(e, time, payload),
+        1 => e1(e, time, payload),
+        2 => e2(e, time, payload),
+        3 => e3(e, time, payload),
+        4 => e4(e, time, payload),
+        5 => e5(e, time, payload),
+        _ => rt::fallback(e, event, time, payload),
+    }
+}
+
 /// `AX`.
+#[inline(always)]
 fn e0(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_), rt::Value::I64(_)]) {
         return rt::fallback(e, 0, time, payload);
@@ -28,10 +47,11 @@ fn e0(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l5(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `AY`.
+#[inline(always)]
 fn e1(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 1, time, payload);
@@ -46,10 +66,11 @@ fn e1(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l6(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `BX`.
+#[inline(always)]
 fn e2(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_), rt::Value::Symbol(v1)] if *v1 < 2) {
         return rt::fallback(e, 2, time, payload);
@@ -64,10 +85,11 @@ fn e2(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l5(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `BY`.
+#[inline(always)]
 fn e3(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 3, time, payload);
@@ -82,10 +104,11 @@ fn e3(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l5(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `CX`.
+#[inline(always)]
 fn e4(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::Bool(_)]) {
         return rt::fallback(e, 4, time, payload);
@@ -102,10 +125,11 @@ fn e4(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l7(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `CY`.
+#[inline(always)]
 fn e5(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 5, time, payload);
@@ -122,7 +146,7 @@ fn e5(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l7(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// The rules that can fire in the state the engine is in.
@@ -134,6 +158,20 @@ fn by_state(e: &rt::Engine, best: &mut rt::Best) {
         3 => l3(e, best),
         4 => l4(e, best),
         _ => {}
+    }
+}
+
+/// Records the firing of rule `r`; its target.
+fn fire(e: &mut rt::Engine, r: u32) -> u32 {
+    match r {
+        0 => rt::record(e, 0, 3, &[0], &[0]),
+        1 => rt::record(e, 1, 0, &[], &[]),
+        2 => rt::record(e, 2, 3, &[], &[]),
+        3 => rt::record(e, 3, 0, &[], &[]),
+        4 => rt::record(e, 4, 4, &[], &[]),
+        5 => rt::record(e, 5, 0, &[], &[]),
+        6 => rt::record(e, 6, 4, &[], &[]),
+        _ => unreachable!("rule {r} is in no search"),
     }
 }
 
@@ -295,4 +333,4 @@ fn r1(e: &rt::Engine) -> bool {
     rt::event(e, 2, 5, true, 1, 30000000, |_| true)
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "1e07c451ba64e16d3e784178b91e8a1a4be116ba61e637f6515598b7d3ca0773", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "8715ec2931867be0cc3c7ddd6de3772c9bb65bba0ade7f9002be81fec5521c24", steps: &STEPS };

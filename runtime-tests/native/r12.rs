@@ -13,7 +13,26 @@ use situ_runtime::rete::native::rt;
 /// Per event, its step.
 pub static STEPS: [rt::StepFn; 6] = [e0, e1, e2, e3, e4, e5];
 
+/// `Engine::step`, inlined where it is called: the event's step if the
+/// engine runs this module (`Engine::with_native`), else the engine's own.
+#[inline(always)]
+pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
+    if !rt::runs(e, &STEPS) {
+        return rt::step(e, event, time, payload);
+    }
+    match event {
+        0 => e0(e, time, payload),
+        1 => e1(e, time, payload),
+        2 => e2(e, time, payload),
+        3 => e3(e, time, payload),
+        4 => e4(e, time, payload),
+        5 => e5(e, time, payload),
+        _ => rt::fallback(e, event, time, payload),
+    }
+}
+
 /// `AX`.
+#[inline(always)]
 fn e0(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_), rt::Value::I64(_)]) {
         return rt::fallback(e, 0, time, payload);
@@ -23,10 +42,11 @@ fn e0(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
     rt::insert(e, 0, time, payload, 0, 50000000, 0, &[], &[0x1]);
     let late = rt::after(e);
     let best = rt::Best::NONE;
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `AY`.
+#[inline(always)]
 fn e1(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 1, time, payload);
@@ -36,10 +56,11 @@ fn e1(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
     rt::insert(e, 1, time, payload, 0, 50000000, 0, &[], &[0x2]);
     let late = rt::after(e);
     let best = rt::Best::NONE;
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `BX`.
+#[inline(always)]
 fn e2(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_), rt::Value::Symbol(v1)] if *v1 < 2) {
         return rt::fallback(e, 2, time, payload);
@@ -56,10 +77,11 @@ fn e2(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l5(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `BY`.
+#[inline(always)]
 fn e3(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 3, time, payload);
@@ -77,10 +99,11 @@ fn e3(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l5(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `CX`.
+#[inline(always)]
 fn e4(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::Bool(_)]) {
         return rt::fallback(e, 4, time, payload);
@@ -94,10 +117,11 @@ fn e4(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l7(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `CY`.
+#[inline(always)]
 fn e5(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 5, time, payload);
@@ -107,7 +131,7 @@ fn e5(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
     rt::insert(e, 5, time, payload, 2, u64::MAX, 4, &[], &[0x20, 0x20, 0x420]);
     let late = rt::after(e);
     let best = rt::Best::NONE;
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// The rules that can fire in the state the engine is in.
@@ -119,6 +143,19 @@ fn by_state(e: &rt::Engine, best: &mut rt::Best) {
         3 => l3(e, best),
         4 => l4(e, best),
         _ => {}
+    }
+}
+
+/// Records the firing of rule `r`; its target.
+fn fire(e: &mut rt::Engine, r: u32) -> u32 {
+    match r {
+        0 => rt::record(e, 0, 2, &[], &[0]),
+        1 => rt::record(e, 1, 4, &[1], &[]),
+        2 => rt::record(e, 2, 0, &[], &[]),
+        3 => rt::record(e, 3, 4, &[1], &[0]),
+        4 => rt::record(e, 4, 1, &[], &[]),
+        5 => rt::record(e, 5, 3, &[2], &[]),
+        _ => unreachable!("rule {r} is in no search"),
     }
 }
 
@@ -286,4 +323,4 @@ fn r3(e: &rt::Engine) -> bool {
     rt::event(e, 1, 3, false, 1, 30000000, |_| true)
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "853aca1504b54bbd7f9bd6e48f549f171fb42699bef5568e09adb5ec95dfb1eb", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "6dc002051e8fb293b284b8507ee2dee7e8a864434f7b37a106704bd661e1ab8f", steps: &STEPS };

@@ -13,7 +13,27 @@ use situ_runtime::rete::native::rt;
 /// Per event, its step.
 pub static STEPS: [rt::StepFn; 7] = [e0, e1, e2, e3, e4, e5, e6];
 
+/// `Engine::step`, inlined where it is called: the event's step if the
+/// engine runs this module (`Engine::with_native`), else the engine's own.
+#[inline(always)]
+pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
+    if !rt::runs(e, &STEPS) {
+        return rt::step(e, event, time, payload);
+    }
+    match event {
+        0 => e0(e, time, payload),
+        1 => e1(e, time, payload),
+        2 => e2(e, time, payload),
+        3 => e3(e, time, payload),
+        4 => e4(e, time, payload),
+        5 => e5(e, time, payload),
+        6 => e6(e, time, payload),
+        _ => rt::fallback(e, event, time, payload),
+    }
+}
+
 /// `OBS`.
+#[inline(always)]
 fn e0(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_)]) {
         return rt::fallback(e, 0, time, payload);
@@ -30,10 +50,11 @@ fn e0(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         3 => l4(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `FIX`.
+#[inline(always)]
 fn e1(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_)]) {
         return rt::fallback(e, 1, time, payload);
@@ -47,10 +68,11 @@ fn e1(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         0 => l0(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `NOFIX`.
+#[inline(always)]
 fn e2(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 2, time, payload);
@@ -66,10 +88,11 @@ fn e2(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         3 => l5(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `HINDER`.
+#[inline(always)]
 fn e3(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::Symbol(v0), rt::Value::F64(_)] if *v0 < 2) {
         return rt::fallback(e, 3, time, payload);
@@ -83,10 +106,11 @@ fn e3(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         1 => l6(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `FREE`.
+#[inline(always)]
 fn e4(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 4, time, payload);
@@ -101,10 +125,11 @@ fn e4(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         3 => l7(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `TARGET`.
+#[inline(always)]
 fn e5(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_), rt::Value::F64(_)]) {
         return rt::fallback(e, 5, time, payload);
@@ -119,10 +144,11 @@ fn e5(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         1 => l8(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `ORBIT`.
+#[inline(always)]
 fn e6(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_)]) {
         return rt::fallback(e, 6, time, payload);
@@ -137,7 +163,7 @@ fn e6(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         3 => l9(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// The rules that can fire in the state the engine is in.
@@ -148,6 +174,23 @@ fn by_state(e: &rt::Engine, best: &mut rt::Best) {
         2 => l2(e, best),
         3 => l2(e, best),
         _ => {}
+    }
+}
+
+/// Records the firing of rule `r`; its target.
+fn fire(e: &mut rt::Engine, r: u32) -> u32 {
+    match r {
+        0 => rt::record(e, 0, 5, &[0], &[]),
+        1 => rt::record(e, 1, 5, &[1], &[]),
+        2 => rt::record(e, 2, 5, &[], &[1]),
+        3 => rt::record(e, 3, 5, &[], &[0]),
+        4 => rt::record(e, 4, 5, &[4], &[]),
+        5 => rt::record(e, 5, 4, &[3], &[]),
+        6 => rt::record(e, 6, 3, &[2, 0], &[]),
+        7 => rt::record(e, 7, 2, &[2, 0], &[]),
+        8 => rt::record(e, 8, 1, &[2], &[]),
+        9 => rt::record(e, 9, 1, &[1, 3], &[]),
+        _ => unreachable!("rule {r} is in no search"),
     }
 }
 
@@ -374,4 +417,4 @@ fn r9(e: &rt::Engine) -> bool {
         && rt::event(e, 0, 0, true, 1, u64::MAX, |e| rt::f64(e, 0, rt::Cmp::Lt, f64::from_bits(0x3fd3333333333333) /* 0.3 */))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "7e82973eb654d77fc858326157475b9118cf21be8446ded0f7db032a76771f24", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "0a9977bd7550ee5cba14ba334842dab87a31621734e5ed5181d3acce4c74153e", steps: &STEPS };

@@ -13,7 +13,28 @@ use situ_runtime::rete::native::rt;
 /// Per event, its step.
 pub static STEPS: [rt::StepFn; 8] = [e0, e1, e2, e3, e4, e5, e6, e7];
 
+/// `Engine::step`, inlined where it is called: the event's step if the
+/// engine runs this module (`Engine::with_native`), else the engine's own.
+#[inline(always)]
+pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
+    if !rt::runs(e, &STEPS) {
+        return rt::step(e, event, time, payload);
+    }
+    match event {
+        0 => e0(e, time, payload),
+        1 => e1(e, time, payload),
+        2 => e2(e, time, payload),
+        3 => e3(e, time, payload),
+        4 => e4(e, time, payload),
+        5 => e5(e, time, payload),
+        6 => e6(e, time, payload),
+        7 => e7(e, time, payload),
+        _ => rt::fallback(e, event, time, payload),
+    }
+}
+
 /// `OBS`.
+#[inline(always)]
 fn e0(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_)]) {
         return rt::fallback(e, 0, time, payload);
@@ -31,10 +52,11 @@ fn e0(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l5(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `FIX`.
+#[inline(always)]
 fn e1(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_)]) {
         return rt::fallback(e, 1, time, payload);
@@ -48,10 +70,11 @@ fn e1(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         0 => l0(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `NOFIX`.
+#[inline(always)]
 fn e2(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 2, time, payload);
@@ -68,10 +91,11 @@ fn e2(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l6(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `HINDER`.
+#[inline(always)]
 fn e3(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::Symbol(v0), rt::Value::F64(_)] if *v0 < 2) {
         return rt::fallback(e, 3, time, payload);
@@ -88,10 +112,11 @@ fn e3(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l9(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `FREE`.
+#[inline(always)]
 fn e4(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, []) {
         return rt::fallback(e, 4, time, payload);
@@ -106,10 +131,11 @@ fn e4(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l10(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `TARGET`.
+#[inline(always)]
 fn e5(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_), rt::Value::F64(_)]) {
         return rt::fallback(e, 5, time, payload);
@@ -125,10 +151,11 @@ fn e5(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         2 => l12(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `ORBIT`.
+#[inline(always)]
 fn e6(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_)]) {
         return rt::fallback(e, 6, time, payload);
@@ -143,10 +170,11 @@ fn e6(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         4 => l13(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// `BLEND`.
+#[inline(always)]
 fn e7(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
     if !matches!(payload, [rt::Value::F64(_), rt::Value::F64(_)]) {
         return rt::fallback(e, 7, time, payload);
@@ -160,7 +188,7 @@ fn e7(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, 
         1 => l11(e, &mut best),
         _ => {}
     }
-    rt::finish(e, best, late, by_state)
+    rt::finish(e, best, late, by_state, fire)
 }
 
 /// The rules that can fire in the state the engine is in.
@@ -172,6 +200,26 @@ fn by_state(e: &rt::Engine, best: &mut rt::Best) {
         3 => l3(e, best),
         4 => l4(e, best),
         _ => {}
+    }
+}
+
+/// Records the firing of rule `r`; its target.
+fn fire(e: &mut rt::Engine, r: u32) -> u32 {
+    match r {
+        0 => rt::record(e, 0, 6, &[0], &[]),
+        1 => rt::record(e, 1, 6, &[1], &[]),
+        2 => rt::record(e, 2, 6, &[], &[1]),
+        3 => rt::record(e, 3, 6, &[], &[0]),
+        4 => rt::record(e, 4, 6, &[4], &[]),
+        5 => rt::record(e, 5, 5, &[3], &[]),
+        6 => rt::record(e, 6, 2, &[3, 5], &[]),
+        7 => rt::record(e, 7, 4, &[2], &[]),
+        8 => rt::record(e, 8, 3, &[2], &[]),
+        9 => rt::record(e, 9, 3, &[2], &[]),
+        10 => rt::record(e, 10, 4, &[2], &[]),
+        11 => rt::record(e, 11, 1, &[2], &[]),
+        12 => rt::record(e, 12, 1, &[1, 3], &[]),
+        _ => unreachable!("rule {r} is in no search"),
     }
 }
 
@@ -521,4 +569,4 @@ fn r12(e: &rt::Engine) -> bool {
         && rt::event(e, 0, 0, true, 1, u64::MAX, |e| rt::f64(e, 0, rt::Cmp::Lt, f64::from_bits(0x3fd3333333333333) /* 0.3 */))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "9f133ac100814cd2c91e245b2d5873d781a41929757b48ec3d5b250b2dda7680", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "32ceeadec9c182aeed03f90bf54d7b93c7ca2c2ca0e08a84dc9d8b0923444031", steps: &STEPS };

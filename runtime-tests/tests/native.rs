@@ -5,10 +5,9 @@
 //! repository's rules files and from the random rule sets of
 //! `native/random/` (drawn as `differential.rs` draws them), and are
 //! compiled into this test:
-//! - each must be what `generate` writes today, byte for byte (after a
-//!   change of the generator: `SITU_BLESS=1 cargo test -p
-//!   situ-runtime-tests --test native` writes them again, and the test
-//!   must then be built and run once more);
+//! - each must be what `generate` writes today, byte for byte
+//!   (`native_golden.rs`, a test of its own so that it builds however
+//!   stale the modules are);
 //! - each, run by `Engine::with_native`, must answer every operation as
 //!   the Rete interpreter does (`twin::twins_with`: steps, refusals,
 //!   cascade errors, recorded firings with their facts, heartbeats, forced
@@ -16,12 +15,13 @@
 //!   operations, and leave the same working memory;
 //! - a module refuses a bundle other than its own.
 
+mod native_modules;
 mod twin;
 
 use proptest::prelude::*;
 use situ_compiler::bundle::{Content, Value};
-use situ_runtime::rete::native::{self, Native, NativeError};
-use situ_runtime::rete::Engine;
+use situ_runtime::rete::native::{Native, NativeError};
+use situ_runtime::rete::{Engine, StepError};
 use situ_runtime::stream::Generator;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -82,27 +82,30 @@ mod r11;
 #[path = "../native/r12.rs"]
 mod r12;
 
+/// A module's `step`, which a program that links it calls (inlined).
+type Step = fn(&mut Engine, u32, u64, &[Value]) -> Result<situ_runtime::rete::Step, StepError>;
+
 /// Each module: its name, the rules file it was generated from (from the
-/// repository's root), its entry point.
-const MODULES: &[(&str, &str, &Native)] = &[
-    ("outdoor", "rules/outdoor.situ", &outdoor::NATIVE),
-    ("ugv", "rules/ugv.situ", &ugv::NATIVE),
-    ("ugv_merge", "rules/ugv-merge.situ", &ugv_merge::NATIVE),
-    ("dla", "rules/dla.situ", &dla::NATIVE),
-    ("fig5", "examples/fig5/fig5.situ", &fig5::NATIVE),
-    ("mower", "examples/mower/mower.situ", &mower::NATIVE),
-    ("r01", "runtime-tests/native/random/r01.situ", &r01::NATIVE),
-    ("r02", "runtime-tests/native/random/r02.situ", &r02::NATIVE),
-    ("r03", "runtime-tests/native/random/r03.situ", &r03::NATIVE),
-    ("r04", "runtime-tests/native/random/r04.situ", &r04::NATIVE),
-    ("r05", "runtime-tests/native/random/r05.situ", &r05::NATIVE),
-    ("r06", "runtime-tests/native/random/r06.situ", &r06::NATIVE),
-    ("r07", "runtime-tests/native/random/r07.situ", &r07::NATIVE),
-    ("r08", "runtime-tests/native/random/r08.situ", &r08::NATIVE),
-    ("r09", "runtime-tests/native/random/r09.situ", &r09::NATIVE),
-    ("r10", "runtime-tests/native/random/r10.situ", &r10::NATIVE),
-    ("r11", "runtime-tests/native/random/r11.situ", &r11::NATIVE),
-    ("r12", "runtime-tests/native/random/r12.situ", &r12::NATIVE),
+/// repository's root), its entry point, its `step`.
+const MODULES: &[(&str, &str, &Native, Step)] = &[
+    ("outdoor", "rules/outdoor.situ", &outdoor::NATIVE, outdoor::step),
+    ("ugv", "rules/ugv.situ", &ugv::NATIVE, ugv::step),
+    ("ugv_merge", "rules/ugv-merge.situ", &ugv_merge::NATIVE, ugv_merge::step),
+    ("dla", "rules/dla.situ", &dla::NATIVE, dla::step),
+    ("fig5", "examples/fig5/fig5.situ", &fig5::NATIVE, fig5::step),
+    ("mower", "examples/mower/mower.situ", &mower::NATIVE, mower::step),
+    ("r01", "runtime-tests/native/random/r01.situ", &r01::NATIVE, r01::step),
+    ("r02", "runtime-tests/native/random/r02.situ", &r02::NATIVE, r02::step),
+    ("r03", "runtime-tests/native/random/r03.situ", &r03::NATIVE, r03::step),
+    ("r04", "runtime-tests/native/random/r04.situ", &r04::NATIVE, r04::step),
+    ("r05", "runtime-tests/native/random/r05.situ", &r05::NATIVE, r05::step),
+    ("r06", "runtime-tests/native/random/r06.situ", &r06::NATIVE, r06::step),
+    ("r07", "runtime-tests/native/random/r07.situ", &r07::NATIVE, r07::step),
+    ("r08", "runtime-tests/native/random/r08.situ", &r08::NATIVE, r08::step),
+    ("r09", "runtime-tests/native/random/r09.situ", &r09::NATIVE, r09::step),
+    ("r10", "runtime-tests/native/random/r10.situ", &r10::NATIVE, r10::step),
+    ("r11", "runtime-tests/native/random/r11.situ", &r11::NATIVE, r11::step),
+    ("r12", "runtime-tests/native/random/r12.situ", &r12::NATIVE, r12::step),
 ];
 
 fn root() -> PathBuf {
@@ -127,32 +130,9 @@ fn native_engine(native: &'static Native) -> impl Fn(Arc<Content>) -> Engine {
 }
 
 #[test]
-fn each_module_is_what_the_generator_writes_today() {
-    let bless = std::env::var_os("SITU_BLESS").is_some_and(|v| v == "1");
-    let mut stale = Vec::new();
-    for (name, source, _) in MODULES {
-        let file = Path::new(source).file_name().unwrap().to_string_lossy().into_owned();
-        let code = native::generate(&content(source), &file).unwrap_or_else(|e| panic!("{source}: {e}"));
-        let path = root().join("runtime-tests/native").join(format!("{name}.rs"));
-        let committed = std::fs::read_to_string(&path).unwrap_or_default();
-        if committed != code {
-            if bless {
-                std::fs::write(&path, &code).unwrap();
-            }
-            stale.push(path.display().to_string());
-        }
-    }
-    assert!(
-        stale.is_empty(),
-        "native code not what the generator writes today{}: {stale:?}",
-        if bless { " (written again: build and run the test once more)" } else { " (SITU_BLESS=1 writes it again)" }
-    );
-}
-
-#[test]
 fn native_code_answers_as_the_interpreter_on_seeded_streams() {
     let mut fired = 0;
-    for (_, source, native) in MODULES {
+    for (_, source, native, _) in MODULES {
         let content = content(source);
         let engine = Engine::with_native(content.clone(), native).unwrap_or_else(|e| panic!("{source}: {e}"));
         assert!(engine.is_native() && engine.is_fast());
@@ -183,7 +163,7 @@ proptest! {
     /// code answers as the interpreter.
     #[test]
     fn native_code_answers_as_the_interpreter_on_random_operations((m, ops) in module_and_ops()) {
-        let (_, source, native) = MODULES[m];
+        let (_, source, native, _) = MODULES[m];
         let result = twins_with(&content(source), &ops, &native_engine(native));
         prop_assert!(result.is_ok(), "{}: {:?}", source, result);
     }
@@ -207,4 +187,49 @@ fn a_module_refuses_a_bundle_other_than_its_own() {
     let checked = situ_compiler::check_source("outdoor.situ", &changed);
     let other = Arc::new(situ_compiler::bundle::build(&checked));
     assert!(matches!(Engine::with_native(other, &outdoor::NATIVE), Err(NativeError::Mismatch { .. })));
+}
+
+/// A module's `step`, called directly as a program that links it calls
+/// it, is the engine's `step`: on the engine that runs the module, the same
+/// answers and working memory as `Engine::step` of a twin; on any other
+/// engine, that engine's own step.
+#[test]
+fn a_module_s_step_is_the_engine_s_step() {
+    for (_, source, native, step) in MODULES {
+        let content = content(source);
+        let mut direct = Engine::with_native(content.clone(), native).unwrap();
+        let mut through = Engine::with_native(content.clone(), native).unwrap();
+        // A fast-path engine of the same bundle does not run the module:
+        // the module's `step` is then its own.
+        let mut other = Engine::new(content.clone());
+        let mut reference = Engine::new(content.clone());
+        let mut g = Generator::new(content.clone(), 7);
+        let mut steps = 0;
+        for (event, time, payload) in (0..2000).filter_map(|_| g.next_event()).map(|e| (e.event, e.time, e.payload)) {
+            for (a, b) in [(&mut direct, &mut through), (&mut other, &mut reference)] {
+                let x = step(a, event, time, &payload);
+                let y = b.step(event, time, &payload);
+                assert_eq!(format!("{x:?}"), format!("{y:?}"), "{source}: step {steps}");
+                assert_eq!(
+                    format!("{:?}", a.last_change()),
+                    format!("{:?}", b.last_change()),
+                    "{source}: step {steps}"
+                );
+                assert_eq!(a.state(), b.state());
+                a.reset_if_final();
+                b.reset_if_final();
+            }
+            steps += 1;
+        }
+        // An event the bundle does not have is refused alike.
+        let n = content.events.len() as u32;
+        assert_eq!(format!("{:?}", step(&mut direct, n, 0, &[])), format!("{:?}", through.step(n, 0, &[])));
+        assert!(!other.is_native() && steps > 0);
+    }
+}
+
+#[test]
+fn the_modules_compiled_here_are_those_the_golden_test_checks() {
+    let here: Vec<(&str, &str)> = MODULES.iter().map(|m| (m.0, m.1)).collect();
+    assert_eq!(here, native_modules::SOURCES);
 }

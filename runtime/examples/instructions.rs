@@ -36,30 +36,43 @@ struct Flat {
     values: Vec<situ_bundle::Value>,
 }
 
-/// Every event through the engine, as `situ bench`'s timed loop: returns
-/// the state changes `(index, state)`, collected into `changes` (reserved
-/// beforehand: it does not grow here). Never inlined: callgrind counts
-/// this function and what it calls, nothing else.
-#[inline(never)]
-fn process_stream(engine: &mut Engine, flat: &Flat, changes: &mut Vec<(u64, u32)>) -> u64 {
-    let mut refused = 0;
-    let mut at_rest = engine.state();
-    for (i, &(event, time, clock, s, e)) in flat.events.iter().enumerate() {
-        engine.set_clock(clock);
-        if engine.step(event, time, &flat.values[s as usize..e as usize]).is_err() {
-            refused += 1;
+/// `process_stream` and `process_stream_native`: every event through the
+/// engine, as `situ bench`'s timed loop, each step `$step`; returns the
+/// refused events and collects the state changes `(index, state)` into
+/// `changes` (reserved beforehand: it does not grow here). Two functions
+/// with one body, so that each is compiled alone (a generic one is not
+/// inlined as a plain one is). Never inlined: callgrind counts these
+/// functions and what they call, nothing else.
+macro_rules! process {
+    ($name:ident, |$engine:ident, $event:ident, $time:ident, $payload:ident| $step:expr) => {
+        #[inline(never)]
+        fn $name($engine: &mut Engine, flat: &Flat, changes: &mut Vec<(u64, u32)>) -> u64 {
+            let mut refused = 0;
+            let mut at_rest = $engine.state();
+            for (i, &($event, $time, clock, s, e)) in flat.events.iter().enumerate() {
+                $engine.set_clock(clock);
+                let $payload = &flat.values[s as usize..e as usize];
+                if $step.is_err() {
+                    refused += 1;
+                }
+                let state = $engine.state();
+                if state != at_rest {
+                    changes.push((i as u64, state));
+                    at_rest = state;
+                }
+                if $engine.reset_if_final() {
+                    at_rest = $engine.state();
+                }
+            }
+            refused
         }
-        let state = engine.state();
-        if state != at_rest {
-            changes.push((i as u64, state));
-            at_rest = state;
-        }
-        if engine.reset_if_final() {
-            at_rest = engine.state();
-        }
-    }
-    refused
+    };
 }
+
+process!(process_stream, |engine, event, time, payload| engine.step(event, time, payload));
+// Native code's step as a program that links the module calls it: its
+// `step`, inlined, which checks that the engine runs the module.
+process!(process_stream_native, |engine, event, time, payload| outdoor_native::step(engine, event, time, payload));
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -115,7 +128,14 @@ fn main() -> ExitCode {
         Engine::new(content.clone())
     };
     let mut changes = Vec::with_capacity(flat.events.len());
-    let refused = process_stream(&mut engine, &flat, &mut changes);
+    // Native code's step is called as a program that links it calls it
+    // (inlined: `outdoor_native::step`, which checks that the engine
+    // runs it); the others through `Engine::step`.
+    let refused = if engine.is_native() {
+        process_stream_native(&mut engine, &flat, &mut changes)
+    } else {
+        process_stream(&mut engine, &flat, &mut changes)
+    };
 
     if let Some(path) = args.get(2) {
         let mut text = String::new();

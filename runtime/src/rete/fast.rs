@@ -233,7 +233,12 @@ impl Engine {
         // SAFETY (`at`): the state and the event (taken by the payload
         // check) are the bundle's: `st * ne + event < ns * ne`.
         self.fast_best_in(unsafe { *at(&self.fp.by_event, st * self.fp.ne + event as usize) }, &mut best);
-        self.rest_after(best, late, |e, best| e.fast_best_in(e.fp.by_state[e.state as usize], best))?;
+        self.rest_after(
+            best,
+            late,
+            |e, best| e.fast_best_in(e.fp.by_state[e.state as usize], best),
+            |e, r| e.fast_record(r),
+        )?;
         Ok(self.step_done())
     }
 
@@ -286,6 +291,7 @@ impl Engine {
         mut best: Best,
         late: bool,
         by_state: impl Fn(&Engine, &mut Best),
+        record: impl Fn(&mut Engine, u32) -> u32,
     ) -> Result<(), StepError> {
         if late {
             let st = self.state as usize;
@@ -294,7 +300,7 @@ impl Engine {
         if best.rule == NONE {
             return Ok(());
         }
-        self.fire_with(best, by_state)
+        self.fire_with(best, by_state, record)
     }
 
     /// [`insert`](Self::insert) without the network.
@@ -458,19 +464,24 @@ impl Engine {
     /// until none is activated; the bound counts the firings of the step.
     #[inline(never)]
     fn fast_fire(&mut self, best: Best) -> Result<(), StepError> {
-        self.fire_with(best, |e, best| e.fast_best_in(e.fp.by_state[e.state as usize], best))
+        self.fire_with(best, |e, best| e.fast_best_in(e.fp.by_state[e.state as usize], best), |e, r| e.fast_record(r))
     }
 
     /// [`fast_fire`](Self::fast_fire), each new state's rules searched by
     /// `by_state` (the lists of the program, or native code's).
     #[inline(never)]
-    fn fire_with(&mut self, mut best: Best, by_state: impl Fn(&Engine, &mut Best)) -> Result<(), StepError> {
+    fn fire_with(
+        &mut self,
+        mut best: Best,
+        by_state: impl Fn(&Engine, &mut Best),
+        record: impl Fn(&mut Engine, u32) -> u32,
+    ) -> Result<(), StepError> {
         while best.rule != NONE {
             if self.record.firings.len() == self.cascade_limit {
                 self.fast_activate();
                 return Err(StepError::Cascade { limit: self.cascade_limit });
             }
-            self.state = self.fast_record(best.rule);
+            self.state = record(self, best.rule);
             best = Best::NONE;
             by_state(self, &mut best);
         }

@@ -4,7 +4,9 @@
 //! it matched (for explanations) in the buffers of the step.
 
 use super::fast::at;
-use super::{Engine, FactRec, FiringRec, StepError};
+use super::net::Net;
+use super::{AgentRec, Engine, FactRec, FiringRec, Record, StepError};
+use situ_bundle::Value;
 
 impl Engine {
     pub(super) fn set_state(&mut self, state: u32) {
@@ -120,14 +122,62 @@ impl Engine {
         let p = &*self.fp;
         // SAFETY (`fast::at`): `r` is a rule of the program's lists, and
         // `fires` has one entry per rule; a firing's agents are in
-        // `agents`, which are agents (`Program::check`), and `self.agents`
-        // has one record per agent.
+        // `agents` (`Program::check`).
         let f = unsafe { *at(&p.fires, r as usize) };
-        let rec = &mut self.record;
+        let (matches, stale) = unsafe {
+            (
+                p.agents.get_unchecked(f.matches.0 as usize..f.matches.1 as usize),
+                p.agents.get_unchecked(f.stale.0 as usize..f.stale.1 as usize),
+            )
+        };
+        let at = Recording {
+            agents: &self.agents,
+            payload: &self.payload,
+            net: &self.net,
+            state: self.state,
+            now: self.now,
+        };
+        at.record(&mut self.record, r, f.target, matches, stale)
+    }
+
+    /// [`fast_record`](Self::fast_record) of a rule whose target and
+    /// agents are given (native code).
+    #[inline(always)]
+    pub(super) fn record_with(&mut self, r: u32, target: u32, matches: &[u32], stale: &[u32]) -> u32 {
+        let at = Recording {
+            agents: &self.agents,
+            payload: &self.payload,
+            net: &self.net,
+            state: self.state,
+            now: self.now,
+        };
+        at.record(&mut self.record, r, target, matches, stale)
+    }
+}
+
+/// The working memory a firing is recorded from.
+struct Recording<'a> {
+    agents: &'a [AgentRec],
+    payload: &'a [Value],
+    net: &'a Net,
+    state: u32,
+    now: u64,
+}
+
+impl Recording<'_> {
+    /// Records the firing of rule `r` (to `target`) with the facts of the
+    /// agents its positive patterns match (`matches`) and those of
+    /// `stale` that are stale, as the interpreter's `record_firing`;
+    /// returns `target`. The one recording of the fast path and of native
+    /// code.
+    #[inline(always)]
+    fn record(&self, rec: &mut Record, r: u32, target: u32, matches: &[u32], stale: &[u32]) -> u32 {
         let facts0 = rec.facts.len() as u32;
-        for i in f.matches.0 as usize..f.matches.1 as usize {
-            let a = unsafe { *at(&p.agents, i) };
-            let slot = unsafe { at(&self.agents, a as usize) }.slot;
+        for &a in matches {
+            // SAFETY (`fast::at`): a firing's agents are agents
+            // (`Program::check`; native code: its digest), and `agents`
+            // has one record per agent.
+            let slot = unsafe { at(self.agents, a as usize) }.slot;
             // An agent's fact is one of its events, whose place and fields
             // fit in the arena (`Program::check`): the interpreter's
             // `payload_at[a]` and field count.
@@ -138,21 +188,20 @@ impl Engine {
                 .map_or((0, 0), |e| (e.payload_at as usize, e.kinds.1.wrapping_sub(e.kinds.0) as usize));
             let v0 = rec.values.len() as u32;
             for j in s..s + n {
-                rec.values.push(unsafe { *at(&self.payload, j) });
+                rec.values.push(unsafe { *at(self.payload, j) });
             }
             let values = (v0, rec.values.len() as u32);
             rec.facts.push(FactRec { agent: a, event: slot.event, time: slot.time, run: slot.run, values });
         }
         let stale0 = rec.stale.len() as u32;
-        for i in f.stale.0 as usize..f.stale.1 as usize {
-            let a = unsafe { *at(&p.agents, i) };
-            if unsafe { at(&self.agents, a as usize) }.stale {
+        for &a in stale {
+            if unsafe { at(self.agents, a as usize) }.stale {
                 rec.stale.push(a);
             }
         }
         let facts = (facts0, rec.facts.len() as u32);
         let stale = (stale0, rec.stale.len() as u32);
-        rec.firings.push(FiringRec { rule: r, from: self.state, to: f.target, time: self.now, facts, stale });
-        f.target
+        rec.firings.push(FiringRec { rule: r, from: self.state, to: target, time: self.now, facts, stale });
+        target
     }
 }

@@ -92,6 +92,20 @@ fn body(c: &Content) -> Result<String, NativeError> {
     // The steps: one function per event.
     o.push_str("\n/// Per event, its step.\npub static STEPS: [rt::StepFn; ");
     let _ = writeln!(o, "{ne}] = [{}];", (0..ne).map(|e| format!("e{e}")).collect::<Vec<_>>().join(", "));
+    o.push_str(
+        "\n/// `Engine::step`, inlined where it is called: the event's step if the\n\
+         /// engine runs this module (`Engine::with_native`), else the engine's own.\n\
+         #[inline(always)]\n\
+         pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {\n\
+         \x20   if !rt::runs(e, &STEPS) {\n\
+         \x20       return rt::step(e, event, time, payload);\n\
+         \x20   }\n\
+         \x20   match event {\n",
+    );
+    for ev in 0..ne {
+        let _ = writeln!(o, "        {ev} => e{ev}(e, time, payload),");
+    }
+    o.push_str("        _ => rt::fallback(e, event, time, payload),\n    }\n}\n");
 
     for (ev, event) in c.events.iter().enumerate() {
         let rec = net.event[ev];
@@ -99,7 +113,7 @@ fn body(c: &Content) -> Result<String, NativeError> {
         let _ = writeln!(o, "\n/// `{}`.", event.name);
         let _ = writeln!(
             o,
-            "fn e{ev}(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {{"
+            "#[inline(always)]\nfn e{ev}(e: &mut rt::Engine, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {{"
         );
         // The payload check.
         let (pattern, guard) = payload_check(kinds);
@@ -132,7 +146,7 @@ fn body(c: &Content) -> Result<String, NativeError> {
             }
             o.push_str("        _ => {}\n    }\n");
         }
-        o.push_str("    rt::finish(e, best, late, by_state)\n}\n");
+        o.push_str("    rt::finish(e, best, late, by_state, fire)\n}\n");
     }
 
     // The search after a firing.
@@ -144,6 +158,25 @@ fn body(c: &Content) -> Result<String, NativeError> {
         }
     }
     o.push_str("        _ => {}\n    }\n}\n");
+
+    // The firings: each rule's record.
+    o.push_str("\n/// Records the firing of rule `r`; its target.\nfn fire(e: &mut rt::Engine, r: u32) -> u32 {\n    match r {\n");
+    for (r, f) in p.fires.iter().enumerate() {
+        if !used[r] {
+            continue;
+        }
+        let list = |(s, e): (u32, u32)| {
+            p.agents[s as usize..e as usize].iter().map(u32::to_string).collect::<Vec<_>>().join(", ")
+        };
+        let _ = writeln!(
+            o,
+            "        {r} => rt::record(e, {r}, {}, &[{}], &[{}]),",
+            f.target,
+            list(f.matches),
+            list(f.stale)
+        );
+    }
+    o.push_str("        _ => unreachable!(\"rule {r} is in no search\"),\n    }\n}\n");
 
     // The searches: rules in firing order.
     for (i, l) in lists.iter().enumerate() {

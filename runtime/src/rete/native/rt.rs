@@ -64,15 +64,17 @@ pub fn after(e: &mut Engine) -> bool {
 }
 
 /// The end of a step: the rest after the insert (`best`: the new fact's
-/// search), each new state's rules searched by `by_state`.
+/// search), each new state's rules searched by `by_state`, each firing
+/// recorded by `fire`.
 #[inline(always)]
 pub fn finish(
     e: &mut Engine,
     best: Best,
     late: bool,
     by_state: impl Fn(&Engine, &mut Best),
+    fire: impl Fn(&mut Engine, u32) -> u32,
 ) -> Result<Step, StepError> {
-    e.rest_after(best, late, by_state)?;
+    e.rest_after(best, late, by_state, fire)?;
     Ok(e.step_done())
 }
 
@@ -135,4 +137,25 @@ pub fn compare(e: &Engine, x: u32, op: Cmp, rhs: Arg) -> bool {
 #[inline(always)]
 pub fn range(e: &Engine, x: u32, lo: Arg, hi: Arg, inclusive: bool) -> bool {
     e.test_range(x, lo, hi, inclusive)
+}
+
+/// Records the firing of rule `r` to `target`, the agents its positive
+/// patterns match being `matches` and those it tests for staleness
+/// `stale`; returns `target`.
+#[inline(always)]
+pub fn record(e: &mut Engine, r: u32, target: u32, matches: &[u32], stale: &[u32]) -> u32 {
+    e.record_with(r, target, matches, stale)
+}
+
+/// Whether the engine runs the module whose steps are `steps`.
+#[inline(always)]
+pub fn runs(e: &Engine, steps: &'static [StepFn]) -> bool {
+    std::ptr::eq(e.native_steps, steps)
+}
+
+/// `Engine::step` of an engine that does not run the module calling.
+#[cold]
+#[inline(never)]
+pub fn step(e: &mut Engine, event: u32, time: u64, payload: &[Value]) -> Result<Step, StepError> {
+    e.step(event, time, payload)
 }
