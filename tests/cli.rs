@@ -256,6 +256,27 @@ fn build_writes_a_bundle_that_bench_and_graph_read() {
 }
 
 #[test]
+fn build_native_writes_the_module_that_the_runtime_tests_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let bundle = dir.path().join("outdoor.bundle");
+    let module = dir.path().join("outdoor_native.rs");
+    let o = situ(&["build", "rules/outdoor.situ", "-o", bundle.to_str().unwrap(), "--native", module.to_str().unwrap()]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(stdout(&o).contains("(native code, "), "{}", stdout(&o));
+    // The module is the one `runtime-tests/tests/native.rs` compiles and
+    // holds to the interpreter (and `native_golden.rs` generates again).
+    let written = std::fs::read_to_string(&module).unwrap();
+    let committed = std::fs::read_to_string("runtime-tests/native/outdoor.rs").unwrap();
+    assert!(written == committed, "situ build --native wrote another module than runtime-tests/native/outdoor.rs");
+    assert!(bundle.exists());
+    // A module that cannot be written is an error that names it.
+    let nowhere = dir.path().join("no/such/dir/x.rs");
+    let o = situ(&["build", "rules/outdoor.situ", "-o", bundle.to_str().unwrap(), "--native", nowhere.to_str().unwrap()]);
+    assert_eq!(code(&o), 2);
+    assert!(stderr(&o).contains("cannot write") && stderr(&o).contains("x.rs"), "{}", stderr(&o));
+}
+
+#[test]
 fn build_refuses_findings_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let bad = write(dir.path(), "bad.situ", "states { IT initial }\nrule r { when state == IT then RX }\n");
