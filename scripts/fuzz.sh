@@ -43,7 +43,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 CARGO_FUZZ_VERSION=0.13.1
-ALL=(parse_check format script bundle_decode mcap_read zenoh_wire scenario)
+ALL=(parse_check format script bundle_decode mcap_read zenoh_wire scenario native)
 
 seconds=${1:-60}
 [[ $seconds =~ ^[0-9]+$ ]] || { echo "usage: scripts/fuzz.sh [SECONDS] [TARGET...]" >&2; exit 2; }
