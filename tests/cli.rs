@@ -260,7 +260,8 @@ fn build_native_writes_the_module_that_the_runtime_tests_run() {
     let dir = tempfile::tempdir().unwrap();
     let bundle = dir.path().join("outdoor.bundle");
     let module = dir.path().join("outdoor_native.rs");
-    let o = situ(&["build", "rules/outdoor.situ", "-o", bundle.to_str().unwrap(), "--native", module.to_str().unwrap()]);
+    let o =
+        situ(&["build", "rules/outdoor.situ", "-o", bundle.to_str().unwrap(), "--native", module.to_str().unwrap()]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     assert!(stdout(&o).contains("(native code, "), "{}", stdout(&o));
     // The module is the one `runtime-tests/tests/native.rs` compiles and
@@ -271,7 +272,8 @@ fn build_native_writes_the_module_that_the_runtime_tests_run() {
     assert!(bundle.exists());
     // A module that cannot be written is an error that names it.
     let nowhere = dir.path().join("no/such/dir/x.rs");
-    let o = situ(&["build", "rules/outdoor.situ", "-o", bundle.to_str().unwrap(), "--native", nowhere.to_str().unwrap()]);
+    let o =
+        situ(&["build", "rules/outdoor.situ", "-o", bundle.to_str().unwrap(), "--native", nowhere.to_str().unwrap()]);
     assert_eq!(code(&o), 2);
     assert!(stderr(&o).contains("cannot write") && stderr(&o).contains("x.rs"), "{}", stderr(&o));
 }
