@@ -16,6 +16,12 @@
 #    nothing);
 # 4. prints one line per engine, then `situ/clips ratio: X` and
 #    `handwritten/situ ratio: Y`.
+#
+# In release, also situ's native code of the rules (`situ build --native`,
+# `runtime-tests/native/outdoor.rs`, linked by the example `instructions`
+# of situ-runtime: the same loop as `situ bench`'s, the module's `step`
+# inlined), on the same file, its states compared too: `situ native` and
+# `handwritten/situ-native ratio`.
 set -euo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -28,7 +34,8 @@ trap 'rm -rf "$work"' EXIT
 
 echo "== building situ and the hand-written matcher ($profile)" >&2
 case "$profile" in
-release) (cd "$root" && cargo build --release --quiet -p situ -p situ-handwritten) ;;
+release) (cd "$root" && cargo build --release --quiet -p situ -p situ-handwritten \
+    && cargo build --release --quiet -p situ-runtime --example instructions) ;;
 # The features of `cargo test --workspace --all-features`: its binary, not a rebuild.
 debug) (cd "$root" && cargo build --quiet --all-features -p situ -p situ-handwritten) ;;
 *) echo "error: PROFILE is release or debug, not $profile" >&2; exit 2 ;;
@@ -43,7 +50,14 @@ bash "$root/bench/clips/run.sh" "$work/stream.events" "$work/clips.states" >"$wo
 "$target/situ-handwritten" --stream "$work/stream.events" --states-out "$work/handwritten.states" \
     >"$work/handwritten.json"
 
-for engine in clips handwritten; do
+engines=(clips handwritten)
+if [[ $profile == release ]]; then
+    "$target/situ" build "$rules" -o "$work/outdoor.bundle" >&2
+    NATIVE=1 "$target/examples/instructions" "$work/outdoor.bundle" "$work/stream.events" "$work/native.states" \
+        >"$work/native.json"
+    engines+=(native)
+fi
+for engine in "${engines[@]}"; do
     if ! cmp -s "$work/situ.states" "$work/$engine.states"; then
         echo "error: situ and $engine reach different state sequences; first difference:" >&2
         diff "$work/situ.states" "$work/$engine.states" | head -n 6 >&2 || true
@@ -51,7 +65,7 @@ for engine in clips handwritten; do
     fi
 done
 changes="$(wc -l <"$work/situ.states")"
-echo "== the three engines agree: $changes state changes, identical" >&2
+echo "== the engines agree (${engines[*]} and situ): $changes state changes, identical" >&2
 
 field() { python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))[sys.argv[2]])' "$1" "$2"; }
 situ_rate="$(field "$work/situ.json" events_per_sec)"
@@ -69,6 +83,15 @@ print(f"handwritten: {hand:>13,.0f} events/s")
 print(f"situ/clips ratio: {situ / clips:.1f}")
 print(f"handwritten/situ ratio: {hand / situ:.2f}")
 PY
+if [[ $profile == release ]]; then
+    native_rate="$(field "$work/native.json" events_per_sec)"
+    python3 - "$native_rate" "$hand_rate" <<'PY'
+import sys
+native, hand = float(sys.argv[1]), float(sys.argv[2])
+print(f"situ native: {native:>13,.0f} events/s  (situ build --native, the module's step inlined)")
+print(f"handwritten/situ-native ratio: {hand / native:.2f}")
+PY
+fi
 if [[ $profile != release ]]; then
     echo "(a $profile build: the speeds above are not figures; docs/performance.md has the release ones)"
 fi
