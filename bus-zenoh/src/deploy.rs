@@ -48,6 +48,10 @@
 //! put on `situ/<robot>/status`, and only the processes of the table put
 //! events and data.
 
+mod error;
+
+pub use error::{DeployError, DeployErrorKind};
+
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -208,22 +212,12 @@ pub const DEFAULT_MAX_SKEW_MS: u64 = situ_runtime::runner::DEFAULT_MAX_SKEW / 1_
 /// every fact of a typical stack past its `stale after`.
 pub const MAX_SKEW_LIMIT_MS: u64 = 10_000;
 
-/// Why a deployment file is refused.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct DeployError(pub String);
-
-impl std::fmt::Display for DeployError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for DeployError {}
-
 impl Deployment {
     /// Reads and checks a deployment file against the agents of a bundle.
     pub fn load(path: &Path, agents: &[String]) -> Result<Deployment, DeployError> {
-        let cannot = |e: &dyn std::fmt::Display| DeployError(format!("cannot read `{}`: {e}", path.display()));
+        let cannot = |e: &dyn std::fmt::Display| {
+            DeployError::new(DeployErrorKind::Read, format!("cannot read `{}`: {e}", path.display()))
+        };
         // A deployment is a small TOML file: what is not a regular file (a
         // FIFO, a device) or is larger than a source file is refused.
         let bytes =
@@ -231,160 +225,224 @@ impl Deployment {
                 .map_err(|e| cannot(&e))?;
         let text = String::from_utf8(bytes).map_err(|e| cannot(&e))?;
         let mut d =
-            Deployment::parse(&text, agents).map_err(|e| DeployError(format!("{}: {}", path.display(), e.0)))?;
+            Deployment::parse(&text, agents).map_err(|e| DeployError { file: Some(path.to_path_buf()), ..e })?;
         d.dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
         Ok(d)
     }
 
     pub fn parse(text: &str, agents: &[String]) -> Result<Deployment, DeployError> {
-        let mut d: Deployment = toml::from_str(text).map_err(|e| DeployError(e.to_string()))?;
+        let mut d: Deployment =
+            toml::from_str(text).map_err(|e| DeployError::new(DeployErrorKind::Syntax, e.to_string()))?;
         for p in &mut d.processes {
             if let Some(m) = &p.mode_text {
                 p.mode = m.parse().map_err(|()| {
-                    DeployError(format!("process `{}`: `mode = \"{m}\"`: `peer`, `client` or `router`", p.name))
+                    DeployError::new(
+                        DeployErrorKind::Mode,
+                        format!("process `{}`: `mode = \"{m}\"`: `peer`, `client` or `router`", p.name),
+                    )
+                    .of(&p.name)
                 })?;
             }
         }
         if d.robot.is_empty() || !d.robot.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
-            return Err(DeployError(format!("`robot = \"{}\"`: letters, digits, `_` and `-` only", d.robot)));
+            return Err(DeployError::new(
+                DeployErrorKind::Robot,
+                format!("`robot = \"{}\"`: letters, digits, `_` and `-` only", d.robot),
+            ));
         }
         if d.max_skew_ms.is_some_and(|ms| ms > MAX_SKEW_LIMIT_MS) {
-            return Err(DeployError(format!(
-                "`max_skew_ms = {}`: at most {MAX_SKEW_LIMIT_MS} (the default is {DEFAULT_MAX_SKEW_MS})",
-                d.max_skew_ms.unwrap_or_default()
-            )));
+            return Err(DeployError::new(
+                DeployErrorKind::MaxSkew,
+                format!(
+                    "`max_skew_ms = {}`: at most {MAX_SKEW_LIMIT_MS} (the default is {DEFAULT_MAX_SKEW_MS})",
+                    d.max_skew_ms.unwrap_or_default()
+                ),
+            ));
         }
         let boards: Vec<&str> = d.processes.iter().filter(|p| p.board).map(|p| p.name.as_str()).collect();
         if boards.is_empty() {
-            return Err(DeployError(
-                "no process hosts the Bulletinboard (`board = true`): one does, or two and more (a standby group)"
-                    .into(),
+            return Err(DeployError::new(
+                DeployErrorKind::NoBoard,
+                "no process hosts the Bulletinboard (`board = true`): one does, or two and more (a standby group)",
             ));
         }
         if boards.len() > 255 {
-            return Err(DeployError(format!("{} boards: at most 255", boards.len())));
+            return Err(DeployError::new(
+                DeployErrorKind::TooManyBoards,
+                format!("{} boards: at most 255", boards.len()),
+            ));
         }
         if let Some(s) = &d.standby {
             if boards.len() < 2 {
-                return Err(DeployError(
-                    "`[standby]` with one board: a standby group has two boards or more (`board = true`)".into(),
+                return Err(DeployError::new(
+                    DeployErrorKind::Standby,
+                    "`[standby]` with one board: a standby group has two boards or more (`board = true`)",
                 ));
             }
             if s.lease_ms.is_some_and(|ms| !(50..=60_000).contains(&ms)) {
-                return Err(DeployError("`[standby] lease_ms`: from 50 to 60000".into()));
+                return Err(DeployError::new(DeployErrorKind::Standby, "`[standby] lease_ms`: from 50 to 60000"));
             }
             if s.replicate_within_ms.is_some_and(|ms| ms > 10_000) {
-                return Err(DeployError("`[standby] replicate_within_ms`: at most 10000".into()));
+                return Err(DeployError::new(
+                    DeployErrorKind::Standby,
+                    "`[standby] replicate_within_ms`: at most 10000",
+                ));
             }
             if s.give_up_ms.is_some_and(|ms| ms > 3_600_000) {
-                return Err(DeployError("`[standby] give_up_ms`: at most 3600000 (an hour)".into()));
+                return Err(DeployError::new(
+                    DeployErrorKind::Standby,
+                    "`[standby] give_up_ms`: at most 3600000 (an hour)",
+                ));
             }
         }
         let mut seen: Vec<(&str, &str)> = Vec::new();
         for p in &d.processes {
             if d.processes.iter().filter(|q| q.name == p.name).count() > 1 {
-                return Err(DeployError(format!("process `{}` is declared twice", p.name)));
+                return Err(DeployError::new(
+                    DeployErrorKind::DuplicateProcess,
+                    format!("process `{}` is declared twice", p.name),
+                )
+                .of(&p.name));
             }
             for a in &p.agents {
                 if !agents.contains(a) {
-                    return Err(DeployError(format!(
-                        "process `{}` runs `{a}`, which the rules do not declare",
-                        p.name
-                    )));
+                    return Err(DeployError::new(
+                        DeployErrorKind::UnknownAgent,
+                        format!("process `{}` runs `{a}`, which the rules do not declare", p.name),
+                    )
+                    .of(&p.name));
                 }
                 if let Some((_, other)) = seen.iter().find(|(x, _)| x == a) {
-                    return Err(DeployError(format!("agent `{a}` runs in both `{other}` and `{}`", p.name)));
+                    return Err(DeployError::new(
+                        DeployErrorKind::AgentTwice,
+                        format!("agent `{a}` runs in both `{other}` and `{}`", p.name),
+                    ));
                 }
                 seen.push((a, &p.name));
             }
             for e in p.listen.iter().chain(&p.connect) {
                 let tls_link = e.starts_with("tls/");
                 if !(e.starts_with("tcp/") || tls_link) {
-                    return Err(DeployError(format!(
-                        "process `{}`: endpoint `{e}` is not `tcp/HOST:PORT` or `tls/HOST:PORT`",
-                        p.name
-                    )));
+                    return Err(DeployError::new(
+                        DeployErrorKind::Endpoint,
+                        format!("process `{}`: endpoint `{e}` is not `tcp/HOST:PORT` or `tls/HOST:PORT`", p.name),
+                    )
+                    .of(&p.name));
                 }
                 if tls_link != d.tls.is_some() {
-                    return Err(DeployError(format!(
+                    return Err(DeployError::new(DeployErrorKind::Endpoint, format!(
                         "process `{}`: endpoint `{e}`: use `tls/` endpoints exactly when the file has a `[tls]` section",
                         p.name
-                    )));
+                    )).of(&p.name));
                 }
             }
             if d.tls.is_some() && (p.cert.is_none() || p.key.is_none()) {
-                return Err(DeployError(format!("process `{}` needs `cert` and `key` with `[tls]`", p.name)));
+                return Err(DeployError::new(
+                    DeployErrorKind::Tls,
+                    format!("process `{}` needs `cert` and `key` with `[tls]`", p.name),
+                )
+                .of(&p.name));
             }
             if p.external && p.agents.is_empty() && !p.board {
-                return Err(DeployError(format!(
+                return Err(DeployError::new(DeployErrorKind::External, format!(
                     "process `{}`: `external = true` but it runs no agents and hosts no Bulletinboard: nothing would join",
                     p.name
-                )));
+                )).of(&p.name));
             }
             if p.journal.is_some() && !p.board {
-                return Err(DeployError(format!(
-                    "process `{}`: `journal` belongs to the process that hosts the Bulletinboard (`board = true`)",
-                    p.name
-                )));
+                return Err(DeployError::new(
+                    DeployErrorKind::Journal,
+                    format!(
+                        "process `{}`: `journal` belongs to the process that hosts the Bulletinboard (`board = true`)",
+                        p.name
+                    ),
+                )
+                .of(&p.name));
             }
             if p.journal.is_some() && boards.len() > 1 {
-                return Err(DeployError(format!(
-                    "process `{}`: `journal` is for a single board; the boards of a standby group recover from \
+                return Err(DeployError::new(
+                    DeployErrorKind::Journal,
+                    format!(
+                        "process `{}`: `journal` is for a single board; the boards of a standby group recover from \
                      each other's log",
-                    p.name
-                )));
+                        p.name
+                    ),
+                )
+                .of(&p.name));
             }
             if let Some(b) = &p.beats {
                 if !p.board || boards.len() < 2 {
-                    return Err(DeployError(format!(
+                    return Err(DeployError::new(
+                        DeployErrorKind::Beats,
+                        format!(
                         "process `{}`: `beats` belongs to the boards of a standby group (two processes or more with \
                          `board = true`)",
                         p.name
-                    )));
+                    ),
+                    )
+                    .of(&p.name));
                 }
                 if b.send.is_empty() {
-                    return Err(DeployError(format!(
-                        "process `{}`: `beats` with no `send`: when it leads, its beats would reach no other board",
-                        p.name
-                    )));
+                    return Err(DeployError::new(
+                        DeployErrorKind::Beats,
+                        format!(
+                            "process `{}`: `beats` with no `send`: when it leads, its beats would reach no other board",
+                            p.name
+                        ),
+                    )
+                    .of(&p.name));
                 }
                 if let Some(q) = d.processes.iter().find(|q| q.board && q.beats.is_none()) {
-                    return Err(DeployError(format!(
+                    return Err(DeployError::new(
+                        DeployErrorKind::Beats,
+                        format!(
                         "process `{}` has `beats` and board `{}` has not: give `beats` to every board of the standby \
                          group or to none (a leader without it sends none)",
                         p.name, q.name
-                    )));
+                    ),
+                    )
+                    .of(&p.name));
                 }
                 for e in std::iter::once(&b.listen).chain(&b.send) {
                     if !crate::beats::is_endpoint(e) {
-                        return Err(DeployError(format!(
-                            "process `{}`: `beats`: endpoint `{e}` is not `udp/HOST:PORT`",
-                            p.name
-                        )));
+                        return Err(DeployError::new(
+                            DeployErrorKind::Beats,
+                            format!("process `{}`: `beats`: endpoint `{e}` is not `udp/HOST:PORT`", p.name),
+                        )
+                        .of(&p.name));
                     }
                 }
             }
             if p.mode == Mode::Client && p.connect.is_empty() {
-                return Err(DeployError(format!(
-                    "process `{}`: a client talks through what it connects to: give it `connect` (the router)",
-                    p.name
-                )));
+                return Err(DeployError::new(
+                    DeployErrorKind::Topology,
+                    format!(
+                        "process `{}`: a client talks through what it connects to: give it `connect` (the router)",
+                        p.name
+                    ),
+                )
+                .of(&p.name));
             }
             if p.mode == Mode::Router && p.listen.is_empty() && p.connect.is_empty() {
-                return Err(DeployError(format!(
-                    "process `{}`: a router needs `listen` endpoints (the others connect to it)",
-                    p.name
-                )));
+                return Err(DeployError::new(
+                    DeployErrorKind::Topology,
+                    format!("process `{}`: a router needs `listen` endpoints (the others connect to it)", p.name),
+                )
+                .of(&p.name));
             }
             // Access control is by the certificate at the other end of a
             // link: through a router, the status would come from the router.
             if d.tls.is_some() && p.mode != Mode::Peer {
-                return Err(DeployError(format!(
+                return Err(DeployError::new(
+                    DeployErrorKind::Tls,
+                    format!(
                     "process `{}`: `mode = \"{}\"` with `[tls]`: not supported (access control is by the certificate \
                      at the other end of a link, and through a router that is the router's); use peers",
                     p.name,
                     p.mode.name()
-                )));
+                ),
+                )
+                .of(&p.name));
             }
         }
         Ok(d)
@@ -449,7 +507,10 @@ impl Deployment {
     pub fn beats(&self, process: &Process) -> Result<Option<crate::beats::Beats>, DeployError> {
         let Some(b) = &process.beats else { return Ok(None) };
         let resolve = |e: &str| {
-            crate::beats::resolve(e).map_err(|why| DeployError(format!("process `{}`: `beats`: {why}", process.name)))
+            crate::beats::resolve(e).map_err(|why| {
+                DeployError::new(DeployErrorKind::Beats, format!("process `{}`: `beats`: {why}", process.name))
+                    .of(&process.name)
+            })
         };
         Ok(Some(crate::beats::Beats {
             listen: resolve(&b.listen)?,
@@ -566,7 +627,8 @@ connect = ["tcp/127.0.0.1:7447"]
     fn a_device_or_a_directory_is_refused_not_read() {
         for path in ["/dev/zero", "/"] {
             let e = Deployment::load(Path::new(path), &agents()).unwrap_err();
-            assert!(e.0.contains("cannot read") && e.0.contains(path), "{}", e.0);
+            assert!(e.message.contains("cannot read") && e.message.contains(path), "{e}");
+            assert_eq!(e.code(), "deploy-read");
         }
     }
 
@@ -638,27 +700,38 @@ connect = ["tcp/127.0.0.1:7447"]
     #[test]
     fn bad_files_say_what_is_wrong() {
         let cases = [
-            (GOOD.replace("board = true", ""), "no process hosts the Bulletinboard"),
-            (GOOD.replace("\"LADAR\"]", "\"LADAR\", \"Ghost\"]"), "`Ghost`, which the rules do not declare"),
+            (GOOD.replace("board = true", ""), "no process hosts the Bulletinboard", "deploy-no-board"),
+            (
+                GOOD.replace("\"LADAR\"]", "\"LADAR\", \"Ghost\"]"),
+                "`Ghost`, which the rules do not declare",
+                "deploy-unknown-agent",
+            ),
             (
                 GOOD.replace(
                     "tcp/127.0.0.1:7447\"]\n[[process]]\nname = \"sensors\"",
                     "udp/1.2.3.4:1\"]\n[[process]]\nname = \"sensors\"",
                 ),
                 "is not `tcp/HOST:PORT`",
+                "deploy-endpoint",
             ),
-            (GOOD.replace("robot = \"amr\"", "robot = \"a/b\""), "letters, digits"),
-            (GOOD.replace("agents = [", "agent = ["), "unknown field `agent`"),
-            (format!("{GOOD}\n[tls]\nca = \"ca.pem\"\n"), "use `tls/` endpoints"),
-            (GOOD.replace("robot = \"amr\"", "robot = \"amr\"\nmax_skew_ms = 3600000"), "at most 10000"),
-            (format!("{GOOD}[standby]\nlease_ms = 300\n"), "a standby group has two boards or more"),
+            (GOOD.replace("robot = \"amr\"", "robot = \"a/b\""), "letters, digits", "deploy-robot"),
+            (GOOD.replace("agents = [", "agent = ["), "unknown field `agent`", "deploy-syntax"),
+            (format!("{GOOD}\n[tls]\nca = \"ca.pem\"\n"), "use `tls/` endpoints", "deploy-endpoint"),
+            (
+                GOOD.replace("robot = \"amr\"", "robot = \"amr\"\nmax_skew_ms = 3600000"),
+                "at most 10000",
+                "deploy-max-skew",
+            ),
+            (format!("{GOOD}[standby]\nlease_ms = 300\n"), "a standby group has two boards or more", "deploy-standby"),
             (
                 format!("{GOOD}[[process]]\nname = \"b2\"\nboard = true\n[standby]\nlease_ms = 10\n"),
                 "`[standby] lease_ms`: from 50 to 60000",
+                "deploy-standby",
             ),
             (
                 format!("{GOOD}[[process]]\nname = \"x\"\nexternal = true\n"),
                 "process `x`: `external = true` but it runs no agents",
+                "deploy-external",
             ),
             (
                 format!(
@@ -666,14 +739,17 @@ connect = ["tcp/127.0.0.1:7447"]
                     GOOD.replace("board = true", "board = true\njournal = \"j\"")
                 ),
                 "process `board`: `journal` is for a single board",
+                "deploy-journal",
             ),
             (
                 GOOD.replace("agents = [", "journal = \"s.journal\"\nagents = ["),
                 "process `sensors`: `journal` belongs to the process that hosts the Bulletinboard",
+                "deploy-journal",
             ),
             (
                 GOOD.replace("board = true", "board = true\nbeats = { listen = \"udp/127.0.0.1:7460\" }"),
                 "process `board`: `beats` belongs to the boards of a standby group",
+                "deploy-beats",
             ),
             (
                 group(
@@ -681,6 +757,7 @@ connect = ["tcp/127.0.0.1:7447"]
                     "listen = \"tcp/127.0.0.1:7460\", send = [\"udp/127.0.0.1:1\"]",
                 ),
                 "process `b2`: `beats`: endpoint `tcp/127.0.0.1:7460` is not `udp/HOST:PORT`",
+                "deploy-beats",
             ),
             (
                 group(
@@ -688,11 +765,13 @@ connect = ["tcp/127.0.0.1:7447"]
                     "listen = \"udp/127.0.0.1:2\", send = [\"udp/127.0.0.1:1\"]",
                 ),
                 "process `board`: `beats`: endpoint `udp/127.0.0.1` is not `udp/HOST:PORT`",
+                "deploy-beats",
             ),
-            (group("listen = \"udp/127.0.0.1:1\", to = []", ""), "unknown field `to`"),
+            (group("listen = \"udp/127.0.0.1:1\", to = []", ""), "unknown field `to`", "deploy-syntax"),
             (
                 group("listen = \"udp/127.0.0.1:1\"", "listen = \"udp/127.0.0.1:2\""),
                 "process `board`: `beats` with no `send`",
+                "deploy-beats",
             ),
             (
                 format!(
@@ -700,11 +779,17 @@ connect = ["tcp/127.0.0.1:7447"]
                      send = [\"udp/127.0.0.1:2\"] }}\n"
                 ),
                 "process `b2` has `beats` and board `board` has not",
+                "deploy-beats",
             ),
         ];
-        for (text, want) in cases {
-            let e = Deployment::parse(&text, &agents()).unwrap_err().to_string();
-            assert!(e.contains(want), "{want}: {e}");
+        for (text, want, code) in cases {
+            let e = Deployment::parse(&text, &agents()).unwrap_err();
+            assert!(e.to_string().contains(want), "{want}: {e}");
+            assert_eq!(e.code(), code, "{e}");
+            // An error about a process names it in its field too.
+            if let Some(p) = want.strip_prefix("process `").and_then(|w| w.split('`').next()) {
+                assert_eq!(e.process.as_deref(), Some(p), "{e:?}");
+            }
         }
     }
 }

@@ -239,7 +239,7 @@ fn zenoh(args: &Args, content: Arc<Content>, file: Option<&[u8]>, checked: Optio
     let d = match Deployment::load(deploy, &names) {
         Ok(d) => d,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error[{}]: {e}", e.code());
             return USAGE;
         }
     };
@@ -278,7 +278,7 @@ fn zenoh(args: &Args, content: Arc<Content>, file: Option<&[u8]>, checked: Optio
     let beats = match d.beats(&process) {
         Ok(b) => b,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error[{}]: {e}", e.code());
             return USAGE;
         }
     };
@@ -429,7 +429,7 @@ type Started = (Vec<(String, bool)>, Vec<String>);
 /// ones are, to say that they are expected to join.
 #[cfg(feature = "zenoh")]
 fn local_processes(deploy: &Path, agents: &[String]) -> Result<Started, String> {
-    let d = situ_bus_zenoh::deploy::Deployment::load(deploy, agents).map_err(|e| e.to_string())?;
+    let d = situ_bus_zenoh::deploy::Deployment::load(deploy, agents).map_err(|e| format!("[{}] {e}", e.code()))?;
     let started = d.processes.iter().filter(|p| p.is_local() && !p.external);
     let external = d.processes.iter().filter(|p| p.external).map(|p| {
         let what = if p.board { "the Bulletinboard".to_string() } else { p.agents.join(", ") };
