@@ -426,10 +426,12 @@ type Started = (Vec<(String, bool)>, Vec<String>);
 
 /// The processes of the deployment that `situ up` starts on this host (not
 /// `external`), each with whether it only routes; and what the external
-/// ones are, to say that they are expected to join.
+/// ones are, to say that they are expected to join. An error is the line
+/// to print (`error[CODE]: …` or `error: …`).
 #[cfg(feature = "zenoh")]
 fn local_processes(deploy: &Path, agents: &[String]) -> Result<Started, String> {
-    let d = situ_bus_zenoh::deploy::Deployment::load(deploy, agents).map_err(|e| format!("[{}] {e}", e.code()))?;
+    let d =
+        situ_bus_zenoh::deploy::Deployment::load(deploy, agents).map_err(|e| format!("error[{}]: {e}", e.code()))?;
     let started = d.processes.iter().filter(|p| p.is_local() && !p.external);
     let external = d.processes.iter().filter(|p| p.external).map(|p| {
         let what = if p.board { "the Bulletinboard".to_string() } else { p.agents.join(", ") };
@@ -440,7 +442,7 @@ fn local_processes(deploy: &Path, agents: &[String]) -> Result<Started, String> 
 
 #[cfg(not(feature = "zenoh"))]
 fn local_processes(_deploy: &Path, _agents: &[String]) -> Result<Started, String> {
-    Err(NO_ZENOH.into())
+    Err(format!("error: {NO_ZENOH}"))
 }
 
 /// `situ up DEPLOY FILE [--stack …] [--duration S] [--trust PUBKEY]…`: the
@@ -476,8 +478,8 @@ pub fn up(args: &UpArgs) -> u8 {
     let names: Vec<String> = program.content.agents.iter().map(|a| a.name.clone()).collect();
     let (processes, external) = match local_processes(deploy, &names) {
         Ok(p) => p,
-        Err(e) => {
-            eprintln!("error: {e}");
+        Err(line) => {
+            eprintln!("{line}");
             return USAGE;
         }
     };
