@@ -9,31 +9,29 @@
 //! final state as `situ bench` does, with every allocation counted.
 
 use situ_compiler::bundle::{Content, Value};
-use situ_runtime::rete::Engine;
+use situ_runtime::rete::{Engine, Step, StepError};
 use situ_runtime::stream::Generator;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 struct Counting;
 
-static ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
-
 thread_local! {
-    /// Whether this thread's allocations are counted.
+    /// Whether this thread's allocations are counted, and how many were
+    /// (per thread: the tests of this file run at once).
     static COUNTING: Cell<bool> = const { Cell::new(false) };
+    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
 }
 
 fn note() {
     if COUNTING.with(Cell::get) {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        ALLOCATIONS.with(|n| n.set(n.get() + 1));
     }
 }
 
 // SAFETY: every call is forwarded to `System` unchanged; counting only
-// touches an atomic and a `const`-initialised thread-local `Cell`, which
-// allocate nothing.
+// touches `const`-initialised thread-local `Cell`s, which allocate nothing.
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         note();
@@ -64,11 +62,11 @@ static GLOBAL: Counting = Counting;
 
 /// Counts the allocations `f` makes on this thread.
 fn allocations(f: impl FnOnce()) -> u64 {
-    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    let before = ALLOCATIONS.with(Cell::get);
     COUNTING.with(|c| c.set(true));
     f();
     COUNTING.with(|c| c.set(false));
-    ALLOCATIONS.load(Ordering::Relaxed) - before
+    ALLOCATIONS.with(Cell::get) - before
 }
 
 fn outdoor() -> Arc<Content> {
@@ -94,12 +92,29 @@ fn stream(content: &Arc<Content>, seed: u64, n: usize) -> (Events, Vec<Value>) {
     (events, values)
 }
 
+// The native code of `rules/outdoor.situ` (`situ build --native`).
+#[rustfmt::skip]
+#[path = "../native/outdoor.rs"]
+mod outdoor_native;
+
+type StepFn = fn(&mut Engine, u32, u64, &[Value]) -> Result<Step, StepError>;
+
 /// Steps the events as `situ bench` does; returns the firings and the
 /// missions ended.
 fn steps(engine: &mut Engine, events: &[(u32, u64, usize, usize)], values: &[Value]) -> (usize, usize) {
+    steps_by(engine, events, values, |e, event, time, payload| e.step(event, time, payload))
+}
+
+/// [`steps`], each step by `step`.
+fn steps_by(
+    engine: &mut Engine,
+    events: &[(u32, u64, usize, usize)],
+    values: &[Value],
+    step: StepFn,
+) -> (usize, usize) {
     let (mut firings, mut missions) = (0, 0);
     for &(event, time, s, e) in events {
-        firings += engine.step(event, time, &values[s..e]).expect("the stream's events are accepted").firings;
+        firings += step(engine, event, time, &values[s..e]).expect("the stream's events are accepted").firings;
         if engine.reset_if_final() {
             missions += 1;
         }
@@ -128,4 +143,23 @@ fn the_counter_counts() {
     // The test above cannot pass by a counter that never counts.
     let n = allocations(|| drop(std::hint::black_box(vec![1u8; 64])));
     assert_eq!(n, 1);
+}
+
+/// The same with native code, through `Engine::step` and through the
+/// module's own `step`.
+#[test]
+fn a_warm_native_step_allocates_nothing() {
+    let content = outdoor();
+    let (warm, counted) = (20_000, 5_000);
+    let (events, values) = stream(&content, 2, warm + counted);
+    let through: StepFn = |e, event, time, payload| e.step(event, time, payload);
+    for step in [through, outdoor_native::step as StepFn] {
+        let mut engine = Engine::with_native(content.clone(), &outdoor_native::NATIVE).expect("its bundle");
+        steps_by(&mut engine, &events[..warm], &values, step);
+        let mut done = (0, 0);
+        let n = allocations(|| done = steps_by(&mut engine, &events[warm..], &values, step));
+        let (firings, missions) = done;
+        assert!(firings > 200 && missions > 50, "{firings} firings, {missions} missions");
+        assert_eq!(n, 0, "{n} allocations in {counted} warm native steps ({firings} firings, {missions} missions)");
+    }
 }
