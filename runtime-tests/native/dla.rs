@@ -4,7 +4,7 @@
 //! read as constants (situ_runtime::rete::native); `Engine::with_native`
 //! runs it only on the bundle it was generated from.
 
-#![allow(clippy::all)]
+#![allow(clippy::all, dead_code)]
 
 use situ_runtime::rete::native::rt;
 
@@ -288,4 +288,4 @@ fn r4(e: &rt::Engine) -> bool {
     rt::event(e, 0, 0, false, 1, u64::MAX, |e| rt::f64(e, 0, rt::Cmp::Lt, f64::from_bits(0x3fbeb851eb851eb8) /* 0.12 */))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "46e5b5e281d48a5220762081902d86061027f431c028dada43624e93883a9662", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "348e2928d92301a84566c1fe1bb8ade5202efd5f6f67c821962542f0e366f92e", steps: &STEPS };

@@ -4,7 +4,7 @@
 //! read as constants (situ_runtime::rete::native); `Engine::with_native`
 //! runs it only on the bundle it was generated from.
 
-#![allow(clippy::all)]
+#![allow(clippy::all, dead_code)]
 
 use situ_runtime::rete::native::rt;
 
@@ -233,4 +233,4 @@ fn r0(e: &rt::Engine) -> bool {
     rt::event(e, 1, 1, false, 1, u64::MAX, |e| rt::f64(e, 0, rt::Cmp::Lt, f64::from_bits(0x403e000000000000) /* 30.0 */) && rt::f64(e, 1, rt::Cmp::Gt, f64::from_bits(0x3fc3333333333333) /* 0.15 */))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "494505499b60ddaeb515a0507bb4a82a1e2b3eb30315e935bba5c37b0b3b2a13", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "b930962f8f046e1579272f6fe5d9ae4a3107b2fee966cf89c2fb6dc560c94aff", steps: &STEPS };

@@ -4,7 +4,7 @@
 //! read as constants (situ_runtime::rete::native); `Engine::with_native`
 //! runs it only on the bundle it was generated from.
 
-#![allow(clippy::all)]
+#![allow(clippy::all, dead_code)]
 
 use situ_runtime::rete::native::rt;
 
@@ -441,4 +441,4 @@ fn r8(e: &rt::Engine) -> bool {
     rt::event(e, 3, 6, false, 20, u64::MAX, |e| rt::f64(e, 3, rt::Cmp::Gt, f64::from_bits(0x3ff0000000000000) /* 1.0 */))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "e991966a9475dd309e24e381fc3c161d1763cd91a47d0b41c11ca58e4965c140", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "91bc46784cdff04503fd397ec89dcbf0ed73097d6bc3d0c06d0ffad5218b133d", steps: &STEPS };

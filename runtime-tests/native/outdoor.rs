@@ -4,7 +4,7 @@
 //! read as constants (situ_runtime::rete::native); `Engine::with_native`
 //! runs it only on the bundle it was generated from.
 
-#![allow(clippy::all)]
+#![allow(clippy::all, dead_code)]
 
 use situ_runtime::rete::native::rt;
 
@@ -1901,4 +1901,4 @@ fn r29(e: &rt::Engine) -> bool {
     rt::event(e, 0, 1, false, 2, u64::MAX, |e| rt::f64(e, 0, rt::Cmp::Ge, f64::from_bits(0x3f947ae147ae147b) /* 0.02 */))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "10d79fe4911201aaa2977dfe93d8e54caf7cc8a21896a284b2197b9ec17441db", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "80b439e0d3e3feab288e829e6b83efbaa07741780525ccf8e788449fac7f339f", steps: &STEPS };

@@ -4,7 +4,7 @@
 //! read as constants (situ_runtime::rete::native); `Engine::with_native`
 //! runs it only on the bundle it was generated from.
 
-#![allow(clippy::all)]
+#![allow(clippy::all, dead_code)]
 
 use situ_runtime::rete::native::rt;
 
@@ -286,4 +286,4 @@ fn r4(e: &rt::Engine) -> bool {
         && rt::event(e, 0, 0, false, 1, u64::MAX, |e| rt::f64(e, 0, rt::Cmp::Lt, f64::from_bits(0x4024000000000000) /* 10.0 */))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "02a9a26889ea7a799519f5c02d6d44f66ec0f1f1a99542caaccb99d8fe0c1eb4", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "d0c122945523b50b92a19a60ba865563f48fd77fa2cc04a8218bdb9851939a9f", steps: &STEPS };

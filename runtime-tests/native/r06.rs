@@ -4,7 +4,7 @@
 //! read as constants (situ_runtime::rete::native); `Engine::with_native`
 //! runs it only on the bundle it was generated from.
 
-#![allow(clippy::all)]
+#![allow(clippy::all, dead_code)]
 
 use situ_runtime::rete::native::rt;
 
@@ -437,4 +437,4 @@ fn r8(e: &rt::Engine) -> bool {
         && rt::event(e, 0, 0, true, 1, u64::MAX, |e| rt::f64_range(e, 0, f64::from_bits(0x4014000000000000) /* 5.0 */, f64::from_bits(0x4034000000000000) /* 20.0 */, true))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "d43515852c9f7ec5b3a960af1c8b883cffd847873a1af01c99b484e451a1b2e6", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "c80cfcefe43ade6be459e1b548cf49d932413a40ee97589268ad55b29a9d0e17", steps: &STEPS };

@@ -4,7 +4,7 @@
 //! read as constants (situ_runtime::rete::native); `Engine::with_native`
 //! runs it only on the bundle it was generated from.
 
-#![allow(clippy::all)]
+#![allow(clippy::all, dead_code)]
 
 use situ_runtime::rete::native::rt;
 
@@ -431,4 +431,4 @@ fn r7(e: &rt::Engine) -> bool {
     rt::stale(e, 0, true)
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "20e6e21ddb72c999e0ceb03ff165b783e2d14a109161102cdf5d7d7cf1461bba", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "cdf9ad7461d7fabaa0cae42f8b7da71371165455cadc25f1d4bbb421746c3360", steps: &STEPS };

@@ -4,7 +4,7 @@
 //! read as constants (situ_runtime::rete::native); `Engine::with_native`
 //! runs it only on the bundle it was generated from.
 
-#![allow(clippy::all)]
+#![allow(clippy::all, dead_code)]
 
 use situ_runtime::rete::native::rt;
 
@@ -434,4 +434,4 @@ fn r6(e: &rt::Engine) -> bool {
     rt::event(e, 0, 0, false, 3, u64::MAX, |e| rt::f64(e, 0, rt::Cmp::Lt, f64::from_bits(0x4024000000000000) /* 10.0 */))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "d271d48490a0bdc2ae1f84b3115524a9f35a1ddc87fde446768e89177c0da3fe", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "c402037f889d09a44c01da330434e45fa7c8a8d78cf7f8b86f73c4aee5f10ef8", steps: &STEPS };

@@ -4,7 +4,7 @@
 //! read as constants (situ_runtime::rete::native); `Engine::with_native`
 //! runs it only on the bundle it was generated from.
 
-#![allow(clippy::all)]
+#![allow(clippy::all, dead_code)]
 
 use situ_runtime::rete::native::rt;
 
@@ -323,4 +323,4 @@ fn r3(e: &rt::Engine) -> bool {
     rt::event(e, 1, 3, false, 1, 30000000, |_| true)
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "6dc002051e8fb293b284b8507ee2dee7e8a864434f7b37a106704bd661e1ab8f", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "40c95fdfcbdeb7a34fea5b55b0088d5ce9d7c4eb5daf9000dcd85d926cbf92d1", steps: &STEPS };

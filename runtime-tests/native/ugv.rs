@@ -4,7 +4,7 @@
 //! read as constants (situ_runtime::rete::native); `Engine::with_native`
 //! runs it only on the bundle it was generated from.
 
-#![allow(clippy::all)]
+#![allow(clippy::all, dead_code)]
 
 use situ_runtime::rete::native::rt;
 
@@ -417,4 +417,4 @@ fn r9(e: &rt::Engine) -> bool {
         && rt::event(e, 0, 0, true, 1, u64::MAX, |e| rt::f64(e, 0, rt::Cmp::Lt, f64::from_bits(0x3fd3333333333333) /* 0.3 */))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "0a9977bd7550ee5cba14ba334842dab87a31621734e5ed5181d3acce4c74153e", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "a985a406b8d96d9e0efd9307cc50f42ddcb080acd035b087b2b72a6e37c7023d", steps: &STEPS };

@@ -4,7 +4,7 @@
 //! read as constants (situ_runtime::rete::native); `Engine::with_native`
 //! runs it only on the bundle it was generated from.
 
-#![allow(clippy::all)]
+#![allow(clippy::all, dead_code)]
 
 use situ_runtime::rete::native::rt;
 
@@ -569,4 +569,4 @@ fn r12(e: &rt::Engine) -> bool {
         && rt::event(e, 0, 0, true, 1, u64::MAX, |e| rt::f64(e, 0, rt::Cmp::Lt, f64::from_bits(0x3fd3333333333333) /* 0.3 */))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "32ceeadec9c182aeed03f90bf54d7b93c7ca2c2ca0e08a84dc9d8b0923444031", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "d48355cb083c2bf6ceb3a198012e4cfadcebd5be461c8baa7dcacc88ba5e310c", steps: &STEPS };

@@ -76,7 +76,7 @@ fn body(c: &Content) -> Result<String, NativeError> {
          //! Each function is the fast path's work for this bundle with its tables\n\
          //! read as constants (situ_runtime::rete::native); `Engine::with_native`\n\
          //! runs it only on the bundle it was generated from.\n\n\
-         #![allow(clippy::all)]\n\n\
+         #![allow(clippy::all, dead_code)]\n\n\
          use situ_runtime::rete::native::rt;\n",
     );
     let _ = writeln!(
