@@ -23,7 +23,6 @@ use situ_compiler::bundle::{Content, Value};
 use situ_runtime::rete::native::{Native, NativeError};
 use situ_runtime::rete::{Engine, StepError};
 use situ_runtime::stream::Generator;
-use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use twin::{ops, pool, posts, twins_with, Op};
 
@@ -108,21 +107,8 @@ const MODULES: &[(&str, &str, &Native, Step)] = &[
     ("r12", "runtime-tests/native/random/r12.situ", &r12::NATIVE, r12::step),
 ];
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-/// The bundle's content of a rules file. The random rule sets have
-/// findings of the static checks (unreachable states, unread events): as
-/// in `differential.rs`, only the front end's errors stop a build here.
 fn content(source: &str) -> Arc<Content> {
-    let path = root().join(source);
-    let checked = situ_compiler::check(&path, &situ_compiler::loader::FsLoader).expect("readable");
-    let front: Vec<_> = checked.diagnostics.iter().filter(|d| d.code < "E0300").collect();
-    assert!(front.is_empty(), "{source}: {front:?}");
-    let content = situ_compiler::bundle::build(&checked);
-    situ_compiler::bundle::codec::validate(&content).expect("valid");
-    Arc::new(content)
+    Arc::new(native_modules::content(source))
 }
 
 fn native_engine(native: &'static Native) -> impl Fn(Arc<Content>) -> Engine {
@@ -180,7 +166,7 @@ fn a_module_refuses_a_bundle_other_than_its_own() {
         other => panic!("outdoor's native code took ugv's bundle: {:?}", other.map(|e| e.is_native())),
     }
     // The same rules with one constant changed are another bundle.
-    let path = root().join("rules/outdoor.situ");
+    let path = native_modules::root().join("rules/outdoor.situ");
     let text = std::fs::read_to_string(&path).unwrap();
     let changed = text.replacen("stale after 400ms", "stale after 401ms", 1);
     assert_ne!(changed, text, "outdoor.situ has no `stale after 400ms` to change");

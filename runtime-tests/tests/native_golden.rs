@@ -8,20 +8,7 @@
 
 mod native_modules;
 
-use std::path::{Path, PathBuf};
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-/// As in `native.rs`: only the front end's errors stop a build here (the
-/// random rule sets have findings of the static checks).
-fn content(source: &str) -> situ_compiler::bundle::Content {
-    let checked = situ_compiler::check(&root().join(source), &situ_compiler::loader::FsLoader).expect("readable");
-    let front: Vec<_> = checked.diagnostics.iter().filter(|d| d.code < "E0300").collect();
-    assert!(front.is_empty(), "{source}: {front:?}");
-    situ_compiler::bundle::build(&checked)
-}
+use std::path::Path;
 
 #[test]
 fn each_module_is_what_the_generator_writes_today() {
@@ -29,9 +16,9 @@ fn each_module_is_what_the_generator_writes_today() {
     let mut stale = Vec::new();
     for (name, source) in native_modules::SOURCES {
         let file = Path::new(source).file_name().unwrap().to_string_lossy().into_owned();
-        let code =
-            situ_runtime::rete::native::generate(&content(source), &file).unwrap_or_else(|e| panic!("{source}: {e}"));
-        let path = root().join("runtime-tests/native").join(format!("{name}.rs"));
+        let code = situ_runtime::rete::native::generate(&native_modules::content(source), &file)
+            .unwrap_or_else(|e| panic!("{source}: {e}"));
+        let path = native_modules::root().join("runtime-tests/native").join(format!("{name}.rs"));
         let committed = std::fs::read_to_string(&path).unwrap_or_default();
         if committed != code {
             if bless {
