@@ -17,7 +17,7 @@ pub static STEPS: [rt::StepFn; 6] = [e0, e1, e2, e3, e4, e5];
 /// engine runs this module (`Engine::with_native`), else the engine's own.
 #[inline(always)]
 pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
-    if !rt::runs(e, &STEPS) {
+    if !rt::runs(e, &NATIVE) {
         return rt::step(e, event, time, payload);
     }
     match event {
@@ -161,9 +161,6 @@ fn l0(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x80 == 0x80 {
         rt::take(e, best, 2, 3);
     }
-    if rt::cut(best, 3) {
-        return;
-    }
     if rt::have(e) & 0x40 == 0x40 {
         rt::take(e, best, 3, 3);
     }
@@ -182,9 +179,6 @@ fn l1(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x80 == 0x80 {
         rt::take(e, best, 2, 3);
-    }
-    if rt::cut(best, 3) {
-        return;
     }
     if rt::have(e) & 0x40 == 0x40 {
         rt::take(e, best, 3, 3);
@@ -233,4 +227,4 @@ fn r0(e: &rt::Engine) -> bool {
     rt::event(e, 1, 1, false, 1, u64::MAX, |e| rt::f64(e, 0, rt::Cmp::Lt, f64::from_bits(0x403e000000000000) /* 30.0 */) && rt::f64(e, 1, rt::Cmp::Gt, f64::from_bits(0x3fc3333333333333) /* 0.15 */))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "b930962f8f046e1579272f6fe5d9ae4a3107b2fee966cf89c2fb6dc560c94aff", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "71324418e988600fcb1a2a51321f742b15336ad3905d7e47fc98fd20c4501e28", steps: &STEPS };

@@ -17,7 +17,7 @@ pub static STEPS: [rt::StepFn; 9] = [e0, e1, e2, e3, e4, e5, e6, e7, e8];
 /// engine runs this module (`Engine::with_native`), else the engine's own.
 #[inline(always)]
 pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
-    if !rt::runs(e, &STEPS) {
+    if !rt::runs(e, &NATIVE) {
         return rt::step(e, event, time, payload);
     }
     match event {
@@ -245,9 +245,6 @@ fn l0(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x80 == 0x80 {
         rt::take(e, best, 7, 6);
     }
-    if rt::cut(best, 6) {
-        return;
-    }
     if rt::have(e) & 0x1000 == 0x1000 {
         rt::take(e, best, 9, 6);
     }
@@ -332,9 +329,6 @@ fn l4(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x80 == 0x80 {
         rt::take(e, best, 7, 6);
-    }
-    if rt::cut(best, 6) {
-        return;
     }
     if rt::have(e) & 0x1000 == 0x1000 {
         rt::take(e, best, 9, 6);
@@ -441,4 +435,4 @@ fn r8(e: &rt::Engine) -> bool {
     rt::event(e, 3, 6, false, 20, u64::MAX, |e| rt::f64(e, 3, rt::Cmp::Gt, f64::from_bits(0x3ff0000000000000) /* 1.0 */))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "91bc46784cdff04503fd397ec89dcbf0ed73097d6bc3d0c06d0ffad5218b133d", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "58d78ae21ed612944cba562953fe968b06834414404ce778316a36bdf8a57e32", steps: &STEPS };

@@ -17,7 +17,7 @@ pub static STEPS: [rt::StepFn; 34] = [e0, e1, e2, e3, e4, e5, e6, e7, e8, e9, e1
 /// engine runs this module (`Engine::with_native`), else the engine's own.
 #[inline(always)]
 pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
-    if !rt::runs(e, &STEPS) {
+    if !rt::runs(e, &NATIVE) {
         return rt::step(e, event, time, payload);
     }
     match event {
@@ -802,9 +802,6 @@ fn l0(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x8000000 == 0x8000000 {
         rt::take(e, best, 0, 13);
     }
-    if rt::cut(best, 13) {
-        return;
-    }
     if rt::have(e) & 0x20000000 == 0x20000000 {
         rt::take(e, best, 1, 13);
     }
@@ -813,9 +810,6 @@ fn l0(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x200000000 == 0x200000000 {
         rt::take(e, best, 9, 11);
-    }
-    if rt::cut(best, 11) {
-        return;
     }
     if rt::have(e) & 0x80000000 == 0x80000000 {
         rt::take(e, best, 10, 11);
@@ -836,9 +830,6 @@ fn l1(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x8000000 == 0x8000000 {
         rt::take(e, best, 0, 13);
     }
-    if rt::cut(best, 13) {
-        return;
-    }
     if rt::have(e) & 0x20000000 == 0x20000000 {
         rt::take(e, best, 1, 13);
     }
@@ -847,9 +838,6 @@ fn l1(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x200000000 == 0x200000000 {
         rt::take(e, best, 9, 11);
-    }
-    if rt::cut(best, 11) {
-        return;
     }
     if rt::have(e) & 0x80000000 == 0x80000000 {
         rt::take(e, best, 10, 11);
@@ -865,9 +853,6 @@ fn l1(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x8400000010020 == 0x8400000010020 {
         rt::take(e, best, 25, 3);
-    }
-    if rt::cut(best, 3) {
-        return;
     }
     if rt::have(e) & 0x9000000020020 == 0x9000000020020 {
         rt::take(e, best, 26, 3);
@@ -894,38 +879,20 @@ fn l2(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x8000000 == 0x8000000 {
         rt::take(e, best, 0, 13);
     }
-    if rt::cut(best, 13) {
-        return;
-    }
     if rt::have(e) & 0x20000000 == 0x20000000 {
         rt::take(e, best, 1, 13);
-    }
-    if rt::cut(best, 13) {
-        return;
     }
     if rt::have(e) & 0x200 == 0x200 {
         rt::take(e, best, 3, 13);
     }
-    if rt::cut(best, 13) {
-        return;
-    }
     if rt::have(e) & 0x2000000000 == 0x2000000000 {
         rt::take(e, best, 4, 13);
-    }
-    if rt::cut(best, 13) {
-        return;
     }
     if rt::have(e) & 0x1000000000 == 0x1000000000 {
         rt::take(e, best, 5, 13);
     }
-    if rt::cut(best, 13) {
-        return;
-    }
     if rt::have(e) & 0x400000000 == 0x400000000 {
         rt::take(e, best, 6, 13);
-    }
-    if rt::cut(best, 13) {
-        return;
     }
     if rt::have(e) & 0x100000000000 == 0x100000000000 {
         rt::take(e, best, 8, 13);
@@ -935,9 +902,6 @@ fn l2(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x200000000 == 0x200000000 {
         rt::take(e, best, 9, 11);
-    }
-    if rt::cut(best, 11) {
-        return;
     }
     if rt::have(e) & 0x80000000 == 0x80000000 {
         rt::take(e, best, 10, 11);
@@ -965,9 +929,6 @@ fn l2(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x800000000000 == 0x800000000000 && r29(e) {
         rt::take(e, best, 29, 1);
-    }
-    if rt::cut(best, 1) {
-        return;
     }
     if rt::have(e) & 0x2000000080000 == 0x2000000080000 {
         rt::take(e, best, 31, 1);
@@ -994,38 +955,20 @@ fn l3(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x8000000 == 0x8000000 {
         rt::take(e, best, 0, 13);
     }
-    if rt::cut(best, 13) {
-        return;
-    }
     if rt::have(e) & 0x20000000 == 0x20000000 {
         rt::take(e, best, 1, 13);
-    }
-    if rt::cut(best, 13) {
-        return;
     }
     if rt::have(e) & 0x200 == 0x200 {
         rt::take(e, best, 3, 13);
     }
-    if rt::cut(best, 13) {
-        return;
-    }
     if rt::have(e) & 0x2000000000 == 0x2000000000 {
         rt::take(e, best, 4, 13);
-    }
-    if rt::cut(best, 13) {
-        return;
     }
     if rt::have(e) & 0x1000000000 == 0x1000000000 {
         rt::take(e, best, 5, 13);
     }
-    if rt::cut(best, 13) {
-        return;
-    }
     if rt::have(e) & 0x400000000 == 0x400000000 {
         rt::take(e, best, 6, 13);
-    }
-    if rt::cut(best, 13) {
-        return;
     }
     if rt::have(e) & 0x100000000000 == 0x100000000000 {
         rt::take(e, best, 8, 13);
@@ -1035,9 +978,6 @@ fn l3(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x200000000 == 0x200000000 {
         rt::take(e, best, 9, 11);
-    }
-    if rt::cut(best, 11) {
-        return;
     }
     if rt::have(e) & 0x80000000 == 0x80000000 {
         rt::take(e, best, 10, 11);
@@ -1072,9 +1012,6 @@ fn l3(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x400000000000 == 0x400000000000 {
         rt::take(e, best, 28, 0);
     }
-    if rt::cut(best, 0) {
-        return;
-    }
     if rt::have(e) & 0x40004 == 0x40004 {
         rt::take(e, best, 30, 0);
     }
@@ -1094,38 +1031,20 @@ fn l4(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x8000000 == 0x8000000 {
         rt::take(e, best, 0, 13);
     }
-    if rt::cut(best, 13) {
-        return;
-    }
     if rt::have(e) & 0x20000000 == 0x20000000 {
         rt::take(e, best, 1, 13);
-    }
-    if rt::cut(best, 13) {
-        return;
     }
     if rt::have(e) & 0x200 == 0x200 {
         rt::take(e, best, 3, 13);
     }
-    if rt::cut(best, 13) {
-        return;
-    }
     if rt::have(e) & 0x2000000000 == 0x2000000000 {
         rt::take(e, best, 4, 13);
-    }
-    if rt::cut(best, 13) {
-        return;
     }
     if rt::have(e) & 0x1000000000 == 0x1000000000 {
         rt::take(e, best, 5, 13);
     }
-    if rt::cut(best, 13) {
-        return;
-    }
     if rt::have(e) & 0x400000000 == 0x400000000 {
         rt::take(e, best, 6, 13);
-    }
-    if rt::cut(best, 13) {
-        return;
     }
     if rt::have(e) & 0x100000000000 == 0x100000000000 {
         rt::take(e, best, 8, 13);
@@ -1135,9 +1054,6 @@ fn l4(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x200000000 == 0x200000000 {
         rt::take(e, best, 9, 11);
-    }
-    if rt::cut(best, 11) {
-        return;
     }
     if rt::have(e) & 0x80000000 == 0x80000000 {
         rt::take(e, best, 10, 11);
@@ -1166,9 +1082,6 @@ fn l4(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x800000000000 == 0x800000000000 && r29(e) {
         rt::take(e, best, 29, 1);
     }
-    if rt::cut(best, 1) {
-        return;
-    }
     if rt::have(e) & 0x2000000080000 == 0x2000000080000 {
         rt::take(e, best, 31, 1);
     }
@@ -1194,38 +1107,20 @@ fn l5(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x8000000 == 0x8000000 {
         rt::take(e, best, 0, 13);
     }
-    if rt::cut(best, 13) {
-        return;
-    }
     if rt::have(e) & 0x20000000 == 0x20000000 {
         rt::take(e, best, 1, 13);
-    }
-    if rt::cut(best, 13) {
-        return;
     }
     if rt::have(e) & 0x200 == 0x200 {
         rt::take(e, best, 3, 13);
     }
-    if rt::cut(best, 13) {
-        return;
-    }
     if rt::have(e) & 0x2000000000 == 0x2000000000 {
         rt::take(e, best, 4, 13);
-    }
-    if rt::cut(best, 13) {
-        return;
     }
     if rt::have(e) & 0x1000000000 == 0x1000000000 {
         rt::take(e, best, 5, 13);
     }
-    if rt::cut(best, 13) {
-        return;
-    }
     if rt::have(e) & 0x400000000 == 0x400000000 {
         rt::take(e, best, 6, 13);
-    }
-    if rt::cut(best, 13) {
-        return;
     }
     if rt::have(e) & 0x100000000000 == 0x100000000000 {
         rt::take(e, best, 8, 13);
@@ -1235,9 +1130,6 @@ fn l5(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x200000000 == 0x200000000 {
         rt::take(e, best, 9, 11);
-    }
-    if rt::cut(best, 11) {
-        return;
     }
     if rt::have(e) & 0x80000000 == 0x80000000 {
         rt::take(e, best, 10, 11);
@@ -1254,14 +1146,8 @@ fn l5(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x8000000200400 == 0x8000000200400 && r18(e) {
         rt::take(e, best, 18, 6);
     }
-    if rt::cut(best, 6) {
-        return;
-    }
     if rt::have(e) & 0x8000000400800 == 0x8000000400800 && r19(e) {
         rt::take(e, best, 19, 6);
-    }
-    if rt::cut(best, 6) {
-        return;
     }
     if rt::have(e) & 0x8000000801000 == 0x8000000801000 && r20(e) {
         rt::take(e, best, 20, 6);
@@ -1288,38 +1174,20 @@ fn l6(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x8000000 == 0x8000000 {
         rt::take(e, best, 0, 13);
     }
-    if rt::cut(best, 13) {
-        return;
-    }
     if rt::have(e) & 0x20000000 == 0x20000000 {
         rt::take(e, best, 1, 13);
-    }
-    if rt::cut(best, 13) {
-        return;
     }
     if rt::have(e) & 0x200 == 0x200 {
         rt::take(e, best, 3, 13);
     }
-    if rt::cut(best, 13) {
-        return;
-    }
     if rt::have(e) & 0x2000000000 == 0x2000000000 {
         rt::take(e, best, 4, 13);
-    }
-    if rt::cut(best, 13) {
-        return;
     }
     if rt::have(e) & 0x1000000000 == 0x1000000000 {
         rt::take(e, best, 5, 13);
     }
-    if rt::cut(best, 13) {
-        return;
-    }
     if rt::have(e) & 0x800000000 == 0x800000000 {
         rt::take(e, best, 7, 13);
-    }
-    if rt::cut(best, 13) {
-        return;
     }
     if rt::have(e) & 0x100000000000 == 0x100000000000 {
         rt::take(e, best, 8, 13);
@@ -1329,9 +1197,6 @@ fn l6(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x200000000 == 0x200000000 {
         rt::take(e, best, 9, 11);
-    }
-    if rt::cut(best, 11) {
-        return;
     }
     if rt::have(e) & 0x80000000 == 0x80000000 {
         rt::take(e, best, 10, 11);
@@ -1376,38 +1241,20 @@ fn l7(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x8000000 == 0x8000000 {
         rt::take(e, best, 0, 13);
     }
-    if rt::cut(best, 13) {
-        return;
-    }
     if rt::have(e) & 0x20000000 == 0x20000000 {
         rt::take(e, best, 1, 13);
-    }
-    if rt::cut(best, 13) {
-        return;
     }
     if rt::have(e) & 0x200 == 0x200 {
         rt::take(e, best, 3, 13);
     }
-    if rt::cut(best, 13) {
-        return;
-    }
     if rt::have(e) & 0x2000000000 == 0x2000000000 {
         rt::take(e, best, 4, 13);
-    }
-    if rt::cut(best, 13) {
-        return;
     }
     if rt::have(e) & 0x1000000000 == 0x1000000000 {
         rt::take(e, best, 5, 13);
     }
-    if rt::cut(best, 13) {
-        return;
-    }
     if rt::have(e) & 0x800000000 == 0x800000000 {
         rt::take(e, best, 7, 13);
-    }
-    if rt::cut(best, 13) {
-        return;
     }
     if rt::have(e) & 0x100000000000 == 0x100000000000 {
         rt::take(e, best, 8, 13);
@@ -1417,9 +1264,6 @@ fn l7(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x200000000 == 0x200000000 {
         rt::take(e, best, 9, 11);
-    }
-    if rt::cut(best, 11) {
-        return;
     }
     if rt::have(e) & 0x80000000 == 0x80000000 {
         rt::take(e, best, 10, 11);
@@ -1457,9 +1301,6 @@ fn l8(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x200000000 == 0x200000000 {
         rt::take(e, best, 9, 11);
-    }
-    if rt::cut(best, 11) {
-        return;
     }
     if rt::have(e) & 0x80000000 == 0x80000000 {
         rt::take(e, best, 10, 11);
@@ -1554,14 +1395,8 @@ fn l17(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x8000000200400 == 0x8000000200400 && r18(e) {
         rt::take(e, best, 18, 6);
     }
-    if rt::cut(best, 6) {
-        return;
-    }
     if rt::have(e) & 0x8000000400800 == 0x8000000400800 && r19(e) {
         rt::take(e, best, 19, 6);
-    }
-    if rt::cut(best, 6) {
-        return;
     }
     if rt::have(e) & 0x8000000801000 == 0x8000000801000 && r20(e) {
         rt::take(e, best, 20, 6);
@@ -1585,9 +1420,6 @@ fn l19(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x8400000010020 == 0x8400000010020 {
         rt::take(e, best, 25, 3);
-    }
-    if rt::cut(best, 3) {
-        return;
     }
     if rt::have(e) & 0x9000000020020 == 0x9000000020020 {
         rt::take(e, best, 26, 3);
@@ -1901,4 +1733,4 @@ fn r29(e: &rt::Engine) -> bool {
     rt::event(e, 0, 1, false, 2, u64::MAX, |e| rt::f64(e, 0, rt::Cmp::Ge, f64::from_bits(0x3f947ae147ae147b) /* 0.02 */))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "80b439e0d3e3feab288e829e6b83efbaa07741780525ccf8e788449fac7f339f", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "71e2e76cb0985e8d208a424ee80073b454438fd20f27b612a56ca9b05e0a0c95", steps: &STEPS };

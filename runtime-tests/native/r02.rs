@@ -17,7 +17,7 @@ pub static STEPS: [rt::StepFn; 6] = [e0, e1, e2, e3, e4, e5];
 /// engine runs this module (`Engine::with_native`), else the engine's own.
 #[inline(always)]
 pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
-    if !rt::runs(e, &STEPS) {
+    if !rt::runs(e, &NATIVE) {
         return rt::step(e, event, time, payload);
     }
     match event {
@@ -196,9 +196,6 @@ fn l0(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x42 == 0x0 {
         rt::take(e, best, 6, 4);
     }
-    if rt::cut(best, 4) {
-        return;
-    }
     if rt::have(e) & 0x44 == 0x40 {
         rt::take(e, best, 9, 4);
     }
@@ -213,9 +210,6 @@ fn l0(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x40 == 0x0 && r3(e) {
         rt::take(e, best, 3, 2);
-    }
-    if rt::cut(best, 2) {
-        return;
     }
     if rt::have(e) & 0x220 == 0x200 {
         rt::take(e, best, 8, 2);
@@ -235,9 +229,6 @@ fn l1(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x42 == 0x0 {
         rt::take(e, best, 6, 4);
-    }
-    if rt::cut(best, 4) {
-        return;
     }
     if rt::have(e) & 0x44 == 0x40 {
         rt::take(e, best, 9, 4);
@@ -288,9 +279,6 @@ fn l2(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x40 == 0x0 && r3(e) {
         rt::take(e, best, 3, 2);
     }
-    if rt::cut(best, 2) {
-        return;
-    }
     if rt::have(e) & 0x220 == 0x200 {
         rt::take(e, best, 8, 2);
     }
@@ -316,14 +304,8 @@ fn l3(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x40 == 0x0 {
         rt::take(e, best, 1, 4);
     }
-    if rt::cut(best, 4) {
-        return;
-    }
     if rt::have(e) & 0x42 == 0x0 {
         rt::take(e, best, 6, 4);
-    }
-    if rt::cut(best, 4) {
-        return;
     }
     if rt::have(e) & 0x44 == 0x40 {
         rt::take(e, best, 9, 4);
@@ -333,9 +315,6 @@ fn l3(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x40 == 0x0 && r3(e) {
         rt::take(e, best, 3, 2);
-    }
-    if rt::cut(best, 2) {
-        return;
     }
     if rt::have(e) & 0x220 == 0x200 {
         rt::take(e, best, 8, 2);
@@ -409,9 +388,6 @@ fn l7(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x40 == 0x0 {
         rt::take(e, best, 1, 4);
-    }
-    if rt::cut(best, 4) {
-        return;
     }
     if rt::have(e) & 0x42 == 0x0 {
         rt::take(e, best, 6, 4);
@@ -532,4 +508,4 @@ fn r5(e: &rt::Engine) -> bool {
     rt::stale(e, 0, true)
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "bdce2663a670b056a6565e11c05b6ad58f5581a15d8567e6b154cfe4f7f46bfa", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "9f9c312f067f183a19bf7849404f744eaae70549e1a0043d0c631fea40679e50", steps: &STEPS };

@@ -17,7 +17,7 @@ pub static STEPS: [rt::StepFn; 6] = [e0, e1, e2, e3, e4, e5];
 /// engine runs this module (`Engine::with_native`), else the engine's own.
 #[inline(always)]
 pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
-    if !rt::runs(e, &STEPS) {
+    if !rt::runs(e, &NATIVE) {
         return rt::step(e, event, time, payload);
     }
     match event {
@@ -221,9 +221,6 @@ fn l2(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x50 == 0x0 {
         rt::take(e, best, 1, 0);
     }
-    if rt::cut(best, 0) {
-        return;
-    }
     if rt::have(e) & 0x40 == 0x0 {
         rt::take(e, best, 4, 0);
     }
@@ -248,9 +245,6 @@ fn l3(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x50 == 0x0 {
         rt::take(e, best, 1, 0);
-    }
-    if rt::cut(best, 0) {
-        return;
     }
     if rt::have(e) & 0x40 == 0x0 {
         rt::take(e, best, 4, 0);
@@ -303,9 +297,6 @@ fn l6(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x50 == 0x0 {
         rt::take(e, best, 1, 0);
     }
-    if rt::cut(best, 0) {
-        return;
-    }
     if rt::have(e) & 0x40 == 0x0 {
         rt::take(e, best, 4, 0);
     }
@@ -347,4 +338,4 @@ fn l9(e: &rt::Engine, best: &mut rt::Best) {
     }
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "d3391a48e0c6276c766bb3183b639b2c9680645bc6ee946fb1a915f483c58238", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "8e36710a0717955731361022af12a181e3ffe4eb8c35f29733e2662bdfc301d6", steps: &STEPS };

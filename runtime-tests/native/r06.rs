@@ -17,7 +17,7 @@ pub static STEPS: [rt::StepFn; 6] = [e0, e1, e2, e3, e4, e5];
 /// engine runs this module (`Engine::with_native`), else the engine's own.
 #[inline(always)]
 pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
-    if !rt::runs(e, &STEPS) {
+    if !rt::runs(e, &NATIVE) {
         return rt::step(e, event, time, payload);
     }
     match event {
@@ -193,9 +193,6 @@ fn l0(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x40 == 0x0 {
         rt::take(e, best, 5, 2);
     }
-    if rt::cut(best, 2) {
-        return;
-    }
     if rt::have(e) & 0x0 == 0x0 {
         rt::take(e, best, 6, 2);
     }
@@ -204,9 +201,6 @@ fn l0(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x40 == 0x40 {
         rt::take(e, best, 1, 0);
-    }
-    if rt::cut(best, 0) {
-        return;
     }
     if rt::have(e) & 0x40 == 0x40 {
         rt::take(e, best, 4, 0);
@@ -437,4 +431,4 @@ fn r8(e: &rt::Engine) -> bool {
         && rt::event(e, 0, 0, true, 1, u64::MAX, |e| rt::f64_range(e, 0, f64::from_bits(0x4014000000000000) /* 5.0 */, f64::from_bits(0x4034000000000000) /* 20.0 */, true))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "c80cfcefe43ade6be459e1b548cf49d932413a40ee97589268ad55b29a9d0e17", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "6403d90a33987709760e228cdb3af706a159b241a444a42a0507ca49979505f5", steps: &STEPS };

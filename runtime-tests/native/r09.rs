@@ -17,7 +17,7 @@ pub static STEPS: [rt::StepFn; 6] = [e0, e1, e2, e3, e4, e5];
 /// engine runs this module (`Engine::with_native`), else the engine's own.
 #[inline(always)]
 pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
-    if !rt::runs(e, &STEPS) {
+    if !rt::runs(e, &NATIVE) {
         return rt::step(e, event, time, payload);
     }
     match event {
@@ -183,9 +183,6 @@ fn l0(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x0 == 0x0 {
         rt::take(e, best, 2, 0);
     }
-    if rt::cut(best, 0) {
-        return;
-    }
     if rt::have(e) & 0x0 == 0x0 {
         rt::take(e, best, 6, 0);
     }
@@ -217,9 +214,6 @@ fn l1(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x0 == 0x0 {
         rt::take(e, best, 2, 0);
     }
-    if rt::cut(best, 0) {
-        return;
-    }
     if rt::have(e) & 0x0 == 0x0 {
         rt::take(e, best, 6, 0);
     }
@@ -239,9 +233,6 @@ fn l2(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x0 == 0x0 {
         rt::take(e, best, 2, 0);
     }
-    if rt::cut(best, 0) {
-        return;
-    }
     if rt::have(e) & 0x0 == 0x0 {
         rt::take(e, best, 6, 0);
     }
@@ -254,9 +245,6 @@ fn l3(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x0 == 0x0 && r1(e) {
         rt::take(e, best, 1, 1);
-    }
-    if rt::cut(best, 1) {
-        return;
     }
     if rt::have(e) & 0x0 == 0x0 {
         rt::take(e, best, 4, 1);
@@ -276,9 +264,6 @@ fn l4(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x42 == 0x2 {
         rt::take(e, best, 0, 2);
-    }
-    if rt::cut(best, 2) {
-        return;
     }
     if rt::have(e) & 0x5 == 0x0 {
         rt::take(e, best, 3, 2);
@@ -309,9 +294,6 @@ fn l6(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x42 == 0x2 {
         rt::take(e, best, 0, 2);
     }
-    if rt::cut(best, 2) {
-        return;
-    }
     if rt::have(e) & 0x5 == 0x0 {
         rt::take(e, best, 3, 2);
     }
@@ -333,4 +315,4 @@ fn r1(e: &rt::Engine) -> bool {
     rt::event(e, 2, 5, true, 1, 30000000, |_| true)
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "232a7ef5e2105cb2a0e748e9b8849bae3f2a971cdb866ebf19cbb8c6b879edba", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "40ba6c628559c09caec32d49d1532661c877aee3c106862a92832671f3c9ccd2", steps: &STEPS };

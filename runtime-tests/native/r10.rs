@@ -17,7 +17,7 @@ pub static STEPS: [rt::StepFn; 6] = [e0, e1, e2, e3, e4, e5];
 /// engine runs this module (`Engine::with_native`), else the engine's own.
 #[inline(always)]
 pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
-    if !rt::runs(e, &STEPS) {
+    if !rt::runs(e, &NATIVE) {
         return rt::step(e, event, time, payload);
     }
     match event {
@@ -181,14 +181,8 @@ fn l0(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x8 == 0x0 {
         rt::take(e, best, 0, 3);
     }
-    if rt::cut(best, 3) {
-        return;
-    }
     if rt::have(e) & 0x40 == 0x0 {
         rt::take(e, best, 2, 3);
-    }
-    if rt::cut(best, 3) {
-        return;
     }
     if rt::have(e) & 0x0 == 0x0 {
         rt::take(e, best, 4, 3);
@@ -205,9 +199,6 @@ fn l0(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x41 == 0x0 {
         rt::take(e, best, 5, 0);
     }
-    if rt::cut(best, 0) {
-        return;
-    }
     if rt::have(e) & 0x40 == 0x40 && r7(e) {
         rt::take(e, best, 7, 0);
     }
@@ -220,9 +211,6 @@ fn l1(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x8 == 0x0 {
         rt::take(e, best, 0, 3);
-    }
-    if rt::cut(best, 3) {
-        return;
     }
     if rt::have(e) & 0x40 == 0x0 {
         rt::take(e, best, 2, 3);
@@ -255,14 +243,8 @@ fn l2(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x41 == 0x0 {
         rt::take(e, best, 5, 0);
     }
-    if rt::cut(best, 0) {
-        return;
-    }
     if rt::have(e) & 0x0 == 0x0 {
         rt::take(e, best, 6, 0);
-    }
-    if rt::cut(best, 0) {
-        return;
     }
     if rt::have(e) & 0x40 == 0x40 && r7(e) {
         rt::take(e, best, 7, 0);
@@ -277,14 +259,8 @@ fn l3(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x8 == 0x0 {
         rt::take(e, best, 0, 3);
     }
-    if rt::cut(best, 3) {
-        return;
-    }
     if rt::have(e) & 0x40 == 0x0 {
         rt::take(e, best, 2, 3);
-    }
-    if rt::cut(best, 3) {
-        return;
     }
     if rt::have(e) & 0x0 == 0x0 {
         rt::take(e, best, 4, 3);
@@ -431,4 +407,4 @@ fn r7(e: &rt::Engine) -> bool {
     rt::stale(e, 0, true)
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "cdf9ad7461d7fabaa0cae42f8b7da71371165455cadc25f1d4bbb421746c3360", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "67451f3ad2c5659a1e8b153f570f27366ab0e40948796964f2553b166ae13b28", steps: &STEPS };

@@ -17,7 +17,7 @@ pub static STEPS: [rt::StepFn; 6] = [e0, e1, e2, e3, e4, e5];
 /// engine runs this module (`Engine::with_native`), else the engine's own.
 #[inline(always)]
 pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
-    if !rt::runs(e, &STEPS) {
+    if !rt::runs(e, &NATIVE) {
         return rt::step(e, event, time, payload);
     }
     match event {
@@ -273,9 +273,6 @@ fn l2(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x40 == 0x40 {
         rt::take(e, best, 1, 1);
     }
-    if rt::cut(best, 1) {
-        return;
-    }
     if rt::have(e) & 0x60 == 0x0 {
         rt::take(e, best, 2, 1);
     }
@@ -300,9 +297,6 @@ fn l3(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x40 == 0x40 {
         rt::take(e, best, 1, 1);
-    }
-    if rt::cut(best, 1) {
-        return;
     }
     if rt::have(e) & 0x60 == 0x0 {
         rt::take(e, best, 2, 1);
@@ -434,4 +428,4 @@ fn r6(e: &rt::Engine) -> bool {
     rt::event(e, 0, 0, false, 3, u64::MAX, |e| rt::f64(e, 0, rt::Cmp::Lt, f64::from_bits(0x4024000000000000) /* 10.0 */))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "c402037f889d09a44c01da330434e45fa7c8a8d78cf7f8b86f73c4aee5f10ef8", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "20f94abc3385a78065747fa6c9831987c74f6f069e7e90098d365dbbd6c22da4", steps: &STEPS };

@@ -17,7 +17,7 @@ pub static STEPS: [rt::StepFn; 7] = [e0, e1, e2, e3, e4, e5, e6];
 /// engine runs this module (`Engine::with_native`), else the engine's own.
 #[inline(always)]
 pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
-    if !rt::runs(e, &STEPS) {
+    if !rt::runs(e, &NATIVE) {
         return rt::step(e, event, time, payload);
     }
     match event {
@@ -218,14 +218,8 @@ fn l1(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x4 == 0x4 {
         rt::take(e, best, 1, 4);
     }
-    if rt::cut(best, 4) {
-        return;
-    }
     if rt::have(e) & 0x100 == 0x100 {
         rt::take(e, best, 2, 4);
-    }
-    if rt::cut(best, 4) {
-        return;
     }
     if rt::have(e) & 0x80 == 0x80 {
         rt::take(e, best, 3, 4);
@@ -242,9 +236,6 @@ fn l1(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x9 == 0x9 && r6(e) {
         rt::take(e, best, 6, 2);
     }
-    if rt::cut(best, 2) {
-        return;
-    }
     if rt::have(e) & 0x9 == 0x9 && r7(e) {
         rt::take(e, best, 7, 2);
     }
@@ -258,9 +249,6 @@ fn l2(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x1 == 0x1 && r0(e) {
         rt::take(e, best, 0, 5);
     }
-    if rt::cut(best, 5) {
-        return;
-    }
     if rt::have(e) & 0x40 == 0x40 && r4(e) {
         rt::take(e, best, 4, 5);
     }
@@ -270,14 +258,8 @@ fn l2(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x4 == 0x4 {
         rt::take(e, best, 1, 4);
     }
-    if rt::cut(best, 4) {
-        return;
-    }
     if rt::have(e) & 0x100 == 0x100 {
         rt::take(e, best, 2, 4);
-    }
-    if rt::cut(best, 4) {
-        return;
     }
     if rt::have(e) & 0x80 == 0x80 {
         rt::take(e, best, 3, 4);
@@ -303,9 +285,6 @@ fn l3(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x9 == 0x9 && r6(e) {
         rt::take(e, best, 6, 2);
-    }
-    if rt::cut(best, 2) {
-        return;
     }
     if rt::have(e) & 0x9 == 0x9 && r7(e) {
         rt::take(e, best, 7, 2);
@@ -339,9 +318,6 @@ fn l6(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x9 == 0x9 && r6(e) {
         rt::take(e, best, 6, 2);
-    }
-    if rt::cut(best, 2) {
-        return;
     }
     if rt::have(e) & 0x9 == 0x9 && r7(e) {
         rt::take(e, best, 7, 2);
@@ -417,4 +393,4 @@ fn r9(e: &rt::Engine) -> bool {
         && rt::event(e, 0, 0, true, 1, u64::MAX, |e| rt::f64(e, 0, rt::Cmp::Lt, f64::from_bits(0x3fd3333333333333) /* 0.3 */))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "a985a406b8d96d9e0efd9307cc50f42ddcb080acd035b087b2b72a6e37c7023d", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "0aceb5813cf04fb51c6909a2d6338d66e3640d1159002c95cf432485302e43e8", steps: &STEPS };

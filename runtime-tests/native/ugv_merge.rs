@@ -17,7 +17,7 @@ pub static STEPS: [rt::StepFn; 8] = [e0, e1, e2, e3, e4, e5, e6, e7];
 /// engine runs this module (`Engine::with_native`), else the engine's own.
 #[inline(always)]
 pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {
-    if !rt::runs(e, &STEPS) {
+    if !rt::runs(e, &NATIVE) {
         return rt::step(e, event, time, payload);
     }
     match event {
@@ -247,14 +247,8 @@ fn l1(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x4 == 0x4 {
         rt::take(e, best, 1, 5);
     }
-    if rt::cut(best, 5) {
-        return;
-    }
     if rt::have(e) & 0x200 == 0x200 {
         rt::take(e, best, 2, 5);
-    }
-    if rt::cut(best, 5) {
-        return;
     }
     if rt::have(e) & 0x100 == 0x100 {
         rt::take(e, best, 3, 5);
@@ -270,9 +264,6 @@ fn l1(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x8 == 0x8 && r7(e) {
         rt::take(e, best, 7, 2);
-    }
-    if rt::cut(best, 2) {
-        return;
     }
     if rt::have(e) & 0x8 == 0x8 && r8(e) {
         rt::take(e, best, 8, 2);
@@ -293,14 +284,8 @@ fn l2(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x4 == 0x4 {
         rt::take(e, best, 1, 5);
     }
-    if rt::cut(best, 5) {
-        return;
-    }
     if rt::have(e) & 0x200 == 0x200 {
         rt::take(e, best, 2, 5);
-    }
-    if rt::cut(best, 5) {
-        return;
     }
     if rt::have(e) & 0x100 == 0x100 {
         rt::take(e, best, 3, 5);
@@ -317,9 +302,6 @@ fn l2(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x8 == 0x8 && r7(e) {
         rt::take(e, best, 7, 2);
     }
-    if rt::cut(best, 2) {
-        return;
-    }
     if rt::have(e) & 0x8 == 0x8 && r8(e) {
         rt::take(e, best, 8, 2);
     }
@@ -333,9 +315,6 @@ fn l3(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x1 == 0x1 && r0(e) {
         rt::take(e, best, 0, 6);
     }
-    if rt::cut(best, 6) {
-        return;
-    }
     if rt::have(e) & 0x40 == 0x40 && r4(e) {
         rt::take(e, best, 4, 6);
     }
@@ -345,14 +324,8 @@ fn l3(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x4 == 0x4 {
         rt::take(e, best, 1, 5);
     }
-    if rt::cut(best, 5) {
-        return;
-    }
     if rt::have(e) & 0x200 == 0x200 {
         rt::take(e, best, 2, 5);
-    }
-    if rt::cut(best, 5) {
-        return;
     }
     if rt::have(e) & 0x100 == 0x100 {
         rt::take(e, best, 3, 5);
@@ -379,9 +352,6 @@ fn l4(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x1 == 0x1 && r0(e) {
         rt::take(e, best, 0, 6);
     }
-    if rt::cut(best, 6) {
-        return;
-    }
     if rt::have(e) & 0x40 == 0x40 && r4(e) {
         rt::take(e, best, 4, 6);
     }
@@ -391,14 +361,8 @@ fn l4(e: &rt::Engine, best: &mut rt::Best) {
     if rt::have(e) & 0x4 == 0x4 {
         rt::take(e, best, 1, 5);
     }
-    if rt::cut(best, 5) {
-        return;
-    }
     if rt::have(e) & 0x200 == 0x200 {
         rt::take(e, best, 2, 5);
-    }
-    if rt::cut(best, 5) {
-        return;
     }
     if rt::have(e) & 0x100 == 0x100 {
         rt::take(e, best, 3, 5);
@@ -444,9 +408,6 @@ fn l7(e: &rt::Engine, best: &mut rt::Best) {
     }
     if rt::have(e) & 0x8 == 0x8 && r7(e) {
         rt::take(e, best, 7, 2);
-    }
-    if rt::cut(best, 2) {
-        return;
     }
     if rt::have(e) & 0x8 == 0x8 && r8(e) {
         rt::take(e, best, 8, 2);
@@ -569,4 +530,4 @@ fn r12(e: &rt::Engine) -> bool {
         && rt::event(e, 0, 0, true, 1, u64::MAX, |e| rt::f64(e, 0, rt::Cmp::Lt, f64::from_bits(0x3fd3333333333333) /* 0.3 */))
 }
 
-pub static NATIVE: rt::Native = rt::Native { digest: "d48355cb083c2bf6ceb3a198012e4cfadcebd5be461c8baa7dcacc88ba5e310c", steps: &STEPS };
+pub static NATIVE: rt::Native = rt::Native { digest: "7b4ecccd3838ed34febcec92cdfb484b9d1c18d96f81fedb1bd98e182c723691", steps: &STEPS };

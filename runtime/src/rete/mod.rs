@@ -146,10 +146,8 @@ pub struct Engine {
     /// agents (`fast::Program::stale_bit`), as bits: the `bit`s of the
     /// agents' records, or'd; kept on the fast path only.
     have: u64,
-    /// Native code that runs the steps (`native.rs`), on the fast path,
-    /// and its steps (empty without it).
+    /// Native code that runs the steps (`native.rs`), on the fast path.
     native: Option<&'static native::Native>,
-    native_steps: &'static [native::StepFn],
 }
 
 /// The memories of the network (alpha, beta, activated rules).
@@ -224,7 +222,6 @@ impl Engine {
             declined,
             have: 0,
             native: None,
-            native_steps: &[],
             content,
             net,
         };
@@ -373,8 +370,9 @@ impl Engine {
     /// those of an error.
     #[inline]
     pub fn step(&mut self, event: u32, time: u64, payload: &[Value]) -> Result<Step, StepError> {
-        // Native code's step of the event (none without native code).
-        if let Some(step) = self.native_steps.get(event as usize) {
+        // Native code's step of the event (an event the bundle does not
+        // have is refused below).
+        if let Some(step) = self.native.and_then(|n| n.steps.get(event as usize)) {
             return step(self, time, payload);
         }
         self.admitted(event, time, payload)?;

@@ -97,7 +97,7 @@ fn body(c: &Content) -> Result<String, NativeError> {
          /// engine runs this module (`Engine::with_native`), else the engine's own.\n\
          #[inline(always)]\n\
          pub fn step(e: &mut rt::Engine, event: u32, time: u64, payload: &[rt::Value]) -> Result<rt::Step, rt::StepError> {\n\
-         \x20   if !rt::runs(e, &STEPS) {\n\
+         \x20   if !rt::runs(e, &NATIVE) {\n\
          \x20       return rt::step(e, event, time, payload);\n\
          \x20   }\n\
          \x20   match event {\n",
@@ -181,9 +181,15 @@ fn body(c: &Content) -> Result<String, NativeError> {
     // The searches: rules in firing order.
     for (i, l) in lists.iter().enumerate() {
         let _ = writeln!(o, "\n#[inline]\nfn l{i}(e: &rt::Engine, best: &mut rt::Best) {{");
+        let mut group = None;
         for &r in *l {
             let rule = &p.rules[r as usize];
-            let _ = writeln!(o, "    if rt::cut(best, {}) {{\n        return;\n    }}", rule.group);
+            // The search ends before a rule of a lower rank than `best`'s.
+            // Within a rank it cannot end: a rule taken there has that rank.
+            if group != Some(rule.group) {
+                let _ = writeln!(o, "    if rt::cut(best, {}) {{\n        return;\n    }}", rule.group);
+                group = Some(rule.group);
+            }
             // A rule whose bits decide it whole has no function.
             let holds = if rule.conds.0 == rule.conds.1 { String::new() } else { format!(" && r{r}(e)") };
             let _ = writeln!(

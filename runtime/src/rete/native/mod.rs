@@ -83,7 +83,6 @@ impl Engine {
         // `generate` succeeded: the fast path took the bundle.
         debug_assert!(engine.is_fast());
         engine.native = Some(native);
-        engine.native_steps = native.steps;
         Ok(engine)
     }
 

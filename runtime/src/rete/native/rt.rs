@@ -147,10 +147,10 @@ pub fn record(e: &mut Engine, r: u32, target: u32, matches: &[u32], stale: &[u32
     e.record_with(r, target, matches, stale)
 }
 
-/// Whether the engine runs the module whose steps are `steps`.
+/// Whether the engine runs the module `native`.
 #[inline(always)]
-pub fn runs(e: &Engine, steps: &'static [StepFn]) -> bool {
-    std::ptr::eq(e.native_steps, steps)
+pub fn runs(e: &Engine, native: &'static Native) -> bool {
+    e.native.is_some_and(|n| std::ptr::eq(n, native))
 }
 
 /// `Engine::step` of an engine that does not run the module calling.
